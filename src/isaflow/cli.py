@@ -1,0 +1,76 @@
+"""Command line: ``isaflow run SCENE -o RUN.nc [--set key=value ...]``.
+
+Exit codes: 0 success; 1 the run ended in an outcome the scene does not
+accept (no output written); 2 bad input (scene or start file).
+"""
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from . import runfile, scene as scenes, solver
+
+
+def initial_state(scene):
+    """(pos0 (N, 2) cm, weight (N,) N, start_step, lattice a cm) of a scene."""
+    part = scene.spec["particles"]
+    if "from_run" in part:
+        src = part["from_run"]
+        if not Path(src).is_file():
+            raise scenes.SceneError(f"{scene.path}: field 'particles.from_run': no such file '{src}'")
+        ds = runfile.read(src)
+        if ds.attrs.get("status") == "escaped" or not np.isfinite(ds["pos"].values).all():
+            raise scenes.SceneError(f"{scene.path}: field 'particles.from_run': '{src}' holds no valid state")
+        pos = ds["pos"].values
+        lo, hi = scene.walls.reshape(-1, 2).min(0), scene.walls.reshape(-1, 2).max(0)
+        if ((pos < lo) | (pos > hi)).any():
+            raise scenes.SceneError(f"{scene.path}: field 'particles.from_run': particles of '{src}' lie outside the walls")
+        return pos, ds["weight"].values, int(ds["steps"]), float(ds.attrs["lattice_a"])
+    pos = scenes.initial_positions(scene)
+    return pos, np.full(len(pos), float(part["weight"])), 0, scene.spacing or np.nan
+
+
+def run(scene_path, out, overrides=(), config=None, quiet=False):
+    """Load, solve and write one run; returns the exit code."""
+    try:
+        scene = scenes.load(scene_path, overrides)
+        pos0, weight, start, a = initial_state(scene)
+    except scenes.SceneError as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 2
+    started = runfile.now()
+
+    def progress(step, fmax):
+        if not quiet:
+            print(f"{scene.name}: step {step:>9d}  max|F| = {fmax:.4g} N", file=sys.stderr, flush=True)
+
+    result = solver.solve(scene, pos0, weight, start_step=start, progress=progress)
+    accepted = scene.solver["accept"]
+    print(f"{scene.name}: {result.status}: {result.message} ({result.wall_time:.3f} s)", file=sys.stderr)
+    if result.status not in accepted:
+        print(f"error: {scene.path}: field 'solver.accept': outcome '{result.status}' is not accepted "
+              f"({', '.join(accepted)}); no output written", file=sys.stderr)
+        return 1
+    ds = runfile.to_dataset(scene, result, weight, started, runfile.now(), runfile.provenance(scene, config))
+    ds.attrs["lattice_a"] = a
+    runfile.write(ds, out)
+    return 0
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(prog="isaflow", description=__doc__.splitlines()[0])
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    r = sub.add_parser("run", help="relax one scene and write its netCDF run file")
+    r.add_argument("scene")
+    r.add_argument("-o", "--out", required=True)
+    r.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override a scene field")
+    r.add_argument("--config", help="workflow config file to hash into the provenance")
+    r.add_argument("-q", "--quiet", action="store_true")
+    args = ap.parse_args(argv)
+    return run(args.scene, args.out, args.set, args.config, args.quiet)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

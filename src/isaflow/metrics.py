@@ -1,0 +1,103 @@
+"""Error measures of a run file, defined once here (units cm, N).
+
+Wall-load errors compare the computed wall reactions with the hydrostatic
+theory built from the weight the vessel holds and its measured level
+(theory.py):
+- ``floor_err``: (computed floor total - theory) / theory (theory = weight held);
+- ``side_err``: mean over the side walls of (computed - theory) / theory, where
+  a side wall's theoretical total is gamma h^2 / 2 = W h / (2 B);
+- ``contact_rms``: RMS over wetted contacts of (computed - theoretical contact
+  force) / (theoretical floor contact force gamma h a), i.e. in units of one
+  floor contact load;
+- ``side_height_err``: height of the side-wall resultant minus h / 3, cm;
+- ``level_implied``: the level implied by the side-wall loads, 2 B F_side / W;
+- ``balance_y``, ``balance_x``: |sum of wall reactions + total weight| per
+  component, N (equilibrium requires <= N f_tol).
+"""
+
+import numpy as np
+
+from . import theory
+
+
+def vessel_view(ds, vessel=None):
+    """Walls, contacts and particles of one vessel of a run Dataset.
+
+    vessel: name in ds.vessel, or None for the whole scene.  Returns dict with
+    x_range (cm), width B (cm), floor_y (cm) and masks.
+    """
+    walls = ds["wall_segment"].values
+    pos = ds["pos"].values
+    if vessel is None:
+        x0, x1 = walls[:, [0, 2]].min(), walls[:, [0, 2]].max()
+    else:
+        x0, x1 = ds["vessel_x"].sel(vessel=vessel).values
+    floor_y = walls[:, [1, 3]].min()
+    eps = 1e-9
+    mid = 0.5 * (walls[:, [0, 1]] + walls[:, [2, 3]])
+    wall_in = (mid[:, 0] >= x0 - eps) & (mid[:, 0] <= x1 + eps)
+    horiz = np.isclose(walls[:, 1], walls[:, 3])
+    inside = (pos[:, 0] >= x0) & (pos[:, 0] < x1)
+    return dict(x_range=(x0, x1), width=x1 - x0, floor_y=floor_y, wall_in=wall_in, horizontal=horiz, inside=inside)
+
+
+def load_errors(ds, vessel=None):
+    """Level and wall-load error measures of a vessel (see module docstring)."""
+    v = vessel_view(ds, vessel)
+    pos = ds["pos"].values
+    a = float(ds.attrs["lattice_a"])
+    weight = float(ds["weight"].values[v["inside"]].sum())
+    level = theory.free_surface_level(pos, a, v["x_range"])
+    h = level - v["floor_y"]
+    gamma = theory.specific_weight(weight, v["width"], level, v["floor_y"])
+    walls = ds["wall_segment"].values
+    cw = ds["contact_wall"].values
+    cp = ds["contact_point"].values
+    mag = np.hypot(*ds["contact_force"].values.T)
+    th = theory.contact_theory(walls, cw, cp, gamma, level, v["wall_in"])
+    names = list(ds["wall"].values)
+    out = dict(level=level, level_max=float(pos[v["inside"], 1].max()) if v["inside"].any() else np.nan,
+               weight=weight, gamma=gamma)
+    side_err, side_h_err, implied = [], [], []
+    for w, name in enumerate(names):
+        if not v["wall_in"][w]:
+            continue
+        on = cw == w
+        total = float(mag[on].sum())
+        th_total = theory.wall_total(walls[w], gamma, level)
+        out[f"load_{name}"] = total
+        out[f"theory_{name}"] = th_total
+        if v["horizontal"][w] and walls[w, 1] == v["floor_y"]:
+            out["floor_err"] = (total - th_total) / th_total
+        elif not v["horizontal"][w] and th_total > 0:
+            side_err.append((total - th_total) / th_total)
+            side_h_err.append(theory.resultant_height(cp[on, 1], mag[on]) - v["floor_y"] - h / 3)
+            implied.append(theory.implied_level(total, weight, v["width"]) + v["floor_y"])
+    out["side_err"] = float(np.mean(side_err)) if side_err else np.nan
+    out["side_height_err"] = float(np.mean(side_h_err)) if side_h_err else np.nan
+    out["level_implied"] = float(np.mean(implied)) if implied else np.nan
+    wet = np.isfinite(th)
+    unit = gamma * h * a
+    out["contact_rms"] = float(np.sqrt(np.mean(((mag[wet] - th[wet]) / unit) ** 2))) if wet.any() else np.nan
+    return out
+
+
+def run_row(ds, vessel=None):
+    """One metrics-table row (dict) of a run Dataset."""
+    row = dict(
+        scene=ds.attrs["scene"],
+        variant=ds.attrs["variant"],
+        particles=int(ds.sizes["particle"]),
+        du_cm=float(ds.attrs["du"]),
+        steps=int(ds["steps"]),
+        wall_time_s=float(ds["wall_time"]),
+        status=ds.attrs["status"],
+        converged=bool(int(ds["converged"])),
+        max_force_N=float(ds["max_force"]),
+    )
+    total = ds["wall_resultant"].values.sum(0)
+    W = float(ds["weight"].values.sum())
+    row["balance_x_N"] = abs(total[0])
+    row["balance_y_N"] = abs(total[1] - W)
+    row.update(load_errors(ds, vessel))
+    return row

@@ -1,0 +1,89 @@
+"""Free-surface level and hydrostatic theory for the wall loads.
+
+Units: length cm, force N, pressure N/cm (2D: force per unit wall length).
+The liquid's specific weight follows from the weight it holds and its
+measured level: gamma = W / (B h) [N/cm^2] for a vessel of width B.
+"""
+
+import numpy as np
+
+
+def free_surface_level(pos, a, x_range=None):
+    """Free-surface level [cm]: mean over vertical strips of width ``a`` of the
+    highest particle in each strip (the line one reads off the paper's figures).
+
+    pos (N, 2) cm; a strip width cm (the lattice diagonal); x_range (xmin, xmax)
+    limits the particles considered (e.g. one vessel).  NaN if none.
+    """
+    pos = np.asarray(pos)
+    if x_range is not None:
+        pos = pos[(pos[:, 0] >= x_range[0]) & (pos[:, 0] < x_range[1])]
+    if len(pos) == 0:
+        return float("nan")
+    x0 = pos[:, 0].min() if x_range is None else x_range[0]
+    strip = np.floor((pos[:, 0] - x0) / a).astype(int)
+    tops = [pos[strip == s, 1].max() for s in np.unique(strip)]
+    return float(np.mean(tops))
+
+
+def specific_weight(total_weight, width, level, floor_y=0.0):
+    """gamma [N/cm^2] of liquid of ``total_weight`` N filling width x (level - floor_y)."""
+    return total_weight / (width * (level - floor_y))
+
+
+def _pressure_integral(wall, s0, s1, gamma, level):
+    """Integral of gamma (level - y)_+ ds over wall parameter [s0, s1] (arc length, cm)."""
+    x0, y0, x1, y1 = wall
+    L = np.hypot(x1 - x0, y1 - y0)
+    ey = (y1 - y0) / L
+    if ey == 0.0:
+        return gamma * max(level - y0, 0.0) * (s1 - s0)
+    s_star = (level - y0) / ey  # where the wall crosses the free surface
+    lo, hi = (s0, min(s1, s_star)) if ey > 0 else (max(s0, s_star), s1)
+    if hi <= lo:
+        return 0.0
+    mid = 0.5 * (lo + hi)
+    return gamma * (level - (y0 + mid * ey)) * (hi - lo)
+
+
+def wall_total(wall, gamma, level):
+    """Hydrostatic force magnitude [N] on a whole wall segment (x0, y0, x1, y1)."""
+    L = np.hypot(wall[2] - wall[0], wall[3] - wall[1])
+    return _pressure_integral(wall, 0.0, L, gamma, level)
+
+
+def contact_theory(walls, contact_wall, contact_point, gamma, level, wall_mask=None):
+    """Theoretical hydrostatic force magnitude [N] on each wall contact.
+
+    Each contact carries the pressure over its tributary length: from the wall
+    start (or midway to the previous contact along the wall) to midway to the
+    next contact (or the wall end).  contact_wall (C,) int, contact_point (C, 2)
+    cm.  Contacts on walls not in wall_mask (W,) bool get NaN.
+    """
+    walls = np.asarray(walls, float)
+    out = np.full(len(contact_wall), np.nan)
+    for w, seg in enumerate(walls):
+        if wall_mask is not None and not wall_mask[w]:
+            continue
+        idx = np.flatnonzero(contact_wall == w)
+        if len(idx) == 0:
+            continue
+        L = np.hypot(seg[2] - seg[0], seg[3] - seg[1])
+        s = np.hypot(contact_point[idx, 0] - seg[0], contact_point[idx, 1] - seg[1])
+        order = np.argsort(s)
+        ss = s[order]
+        bounds = np.concatenate([[0.0], 0.5 * (ss[1:] + ss[:-1]), [L]])
+        for k, c in enumerate(idx[order]):
+            out[c] = _pressure_integral(seg, bounds[k], bounds[k + 1], gamma, level)
+    return out
+
+
+def resultant_height(contact_point_y, magnitude):
+    """Height [cm] of the resultant of parallel contact loads (sum F y / sum F)."""
+    tot = np.sum(magnitude)
+    return float(np.sum(magnitude * contact_point_y) / tot) if tot > 0 else float("nan")
+
+
+def implied_level(side_load, total_weight, width):
+    """Level [cm] implied by a side-wall load: F = gamma h^2 / 2 with gamma = W / (B h)."""
+    return 2.0 * width * side_load / total_weight
