@@ -101,3 +101,60 @@ def run_row(ds, vessel=None):
     row["balance_y_N"] = abs(total[1] - W)
     row.update(load_errors(ds, vessel))
     return row
+
+
+def table(paths, vessel=None):
+    """DataFrame with one run_row per run file; 'run' is the file stem."""
+    import pandas as pd
+    from pathlib import Path
+
+    from .runfile import read
+
+    rows = []
+    for p in paths:
+        ds = read(p)
+        rows.append({"run": Path(p).stem, **run_row(ds, vessel), "variant_label": ds.attrs["variant_label"]})
+    return pd.DataFrame(rows)
+
+
+def calibration_table(paths):
+    """DataFrame of calibration runs {run}_kb{k}_r{ratio}.nc: run, k_b [N/cm],
+    k_p / k_b, levels [cm], outcome."""
+    from pathlib import Path
+
+    import pandas as pd
+
+    from .runfile import read
+
+    rows = []
+    for p in paths:
+        ds = read(p)
+        kb = ds.attrs["wall_r_u"] / ds.attrs["wall_l_u"]
+        kp = ds.attrs["pair_r_u"] / ds.attrs["pair_l_u"]
+        e = load_errors(ds)
+        rows.append(dict(run=Path(p).stem.rsplit("_kb", 1)[0], scene=ds.attrs["scene"], variant=ds.attrs["variant"], k_wall=kb, ratio=round(kp / kb, 6),
+                         level=e["level"], level_max=e["level_max"], level_implied=e["level_implied"],
+                         status=ds.attrs["status"], steps=int(ds["steps"]), max_force=float(ds["max_force"])))
+    return pd.DataFrame(rows).sort_values(["run", "k_wall", "ratio"])
+
+
+def tolerances(row, a, n_particles, f_tol):
+    """Tolerances derived from the discretisation (not from the results).
+
+    row: a run_row dict; a lattice diagonal cm.  Returns {name: (tol, why)}:
+    - level: a / 4 cm.  The surface is a layer of particles whose rows are
+      a / 2 apart, so any reading of it is uncertain by half a row pitch.
+    - floor: relative N max|F| / W.  Vertical equilibrium of the whole liquid:
+      the wall reactions balance the weight up to the residual forces.
+    - side: relative (a / 4) / h.  The side total W h / (2 B) inherits the
+      level's uncertainty.
+    - side_height: a / 4 cm.  Side contacts sit a / 2 apart.
+    """
+    h = row["level"]
+    resid = max(row["max_force_N"], f_tol) * n_particles
+    return {
+        "level": (a / 4, "half a row pitch a/2: the level is a layer of particles"),
+        "floor": (resid / row["weight"], "N max|F| / W: global vertical equilibrium up to the residuals"),
+        "side": ((a / 4) / h, "(a/4)/h: the side total W h/(2B) inherits the level's uncertainty"),
+        "side_height": (a / 4, "half the a/2 spacing of the side contacts"),
+    }

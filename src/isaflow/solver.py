@@ -20,8 +20,13 @@ VARIANT_LABELS = {
     "capped": "capped: x += du F / max(max|F|, f_ref) (variant, not in paper)",
     "fire": "fire: FIRE relaxation, Bitzek et al. 2006 (variant, not in paper)",
 }
-F_REF_FACTOR = 2.5  # capped default f_ref = 2.5 k_wall du (= w for both paper lattices)
-DT_MAX_FACTOR = 0.5  # fire default dt_max = 0.5 / k_wall (cm/N per step)
+# capped default f_ref = du (k_b + 6 k_p): du / 2 times the Gershgorin bound
+# lambda_max <= 2 k_b + 12 k_p (two walls, six neighbours) of the stiffness
+# matrix, so the capped update is linearly stable; it equals w for both of the
+# paper's lattices (50 N, 12.5 N).
+PAIR_NEIGHBOURS = 6
+# fire default dt_max = 1 / sqrt(2 k_b + 12 k_p) (unit masses): below the
+# explicit-integration limit 2 / sqrt(lambda_max) for the Gershgorin bound.
 
 
 @dataclass
@@ -51,13 +56,17 @@ class Run:
 
 
 def detect_cycle(h, window=400, max_period=50, rtol=1e-6):
-    """Smallest period p <= max_period with h[k] == h[k - p] (to rtol) over the
-    last ``window`` entries of the max|F| series h; 0 if none."""
+    """Smallest period 2 <= p <= max_period with h[k] == h[k - p] (to rtol)
+    over the last ``window`` entries of the max|F| series h; 0 if none.
+
+    Period 1 (a constant max|F|) is not a cycle of any update here: a fixed
+    point has F = 0, and a constant max|F| is e.g. a free fall.
+    """
     if len(h) < window + max_period:
         return 0
     tail = h[-(window + max_period):]
     scale = tail.max()
-    for p in range(1, max_period + 1):
+    for p in range(2, max_period + 1):
         if np.abs(tail[p:] - tail[:-p]).max() <= rtol * scale:
             return p
     return 0
@@ -81,14 +90,14 @@ def solver_params(scene):
     s = scene.solver
     wl_u, wr_u = scene.law("wall")
     pl_u, pr_u = scene.law("pair")
-    k = max(scene.stiffness("wall"), scene.stiffness("pair"))
+    kb, kp = scene.stiffness("wall"), scene.stiffness("pair")
     return dict(
         variant=s["variant"],
         du=float(s["du"]),
         f_tol=float(s["f_tol"]),
         max_steps=int(s["max_steps"]),
-        f_ref=float(s.get("f_ref", F_REF_FACTOR * k * s["du"])),
-        dt_max=float(s.get("dt_max", DT_MAX_FACTOR / k)),
+        f_ref=float(s.get("f_ref", s["du"] * (kb + PAIR_NEIGHBOURS * kp))),
+        dt_max=float(s.get("dt_max", 1.0 / np.sqrt(2 * kb + 2 * PAIR_NEIGHBOURS * kp))),
         skin=float(s.get("skin", 0.3 * pl_u)),
         chunk=int(s["chunk"]),
         wl_u=wl_u, wr_u=wr_u, pl_u=pl_u, pr_u=pr_u,
@@ -138,6 +147,7 @@ def solve(scene, pos0, weight, start_step=0, progress=None):
     n_chunk = 0
     while step < p["max_steps"]:
         n = min(chunk, p["max_steps"] - step)
+        chunk_start = pos.copy()
         done, code, info = K.relax(
             pos, vel, weight, walls, box, p["wl_u"], p["wr_u"], p["pl_u"], p["pr_u"],
             VARIANTS[p["variant"]], p["du"], p["f_ref"], p["dt_max"], p["f_tol"], n, p["skin"], force, buf,
@@ -183,6 +193,10 @@ def solve(scene, pos0, weight, start_step=0, progress=None):
             break
         if s["stop_on_cycle"]:
             period = detect_cycle(recent)
+            # a cycle returns to its states: the net move over the chunk stays
+            # within a few du, unlike a slow drift with a periodic max|F|
+            if period and np.abs(pos - chunk_start).max() > 2 * period * p["du"]:
+                period = 0
             if period:
                 tail = recent[-400:]
                 status = "cycle"

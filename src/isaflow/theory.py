@@ -87,3 +87,51 @@ def resultant_height(contact_point_y, magnitude):
 def implied_level(side_load, total_weight, width):
     """Level [cm] implied by a side-wall load: F = gamma h^2 / 2 with gamma = W / (B h)."""
     return 2.0 * width * side_load / total_weight
+
+
+def stiffness_matrix(pos, walls, wl_u, wr_u, pl_u, pr_u):
+    """Hessian (2N, 2N) [N/cm] of the potential energy of the linear force laws.
+
+    Pair/wall-end terms: k n n^T - (R / l)(I - n n^T) with k = r_u / l_u; a
+    wall's interior contributes k n n^T.  Dense: meant for N up to a few
+    thousand (stability diagnostics of the single-vessel runs).
+    """
+    n = len(pos)
+    H = np.zeros((2 * n, 2 * n))
+    eye = np.eye(2)
+
+    def block(d, l_u, r_u, line=False):
+        l = np.hypot(*d)
+        nn = np.outer(d, d) / l**2
+        b = (r_u / l_u) * nn
+        if not line:
+            b -= r_u * (1.0 - l / l_u) / l * (eye - nn)
+        return b
+
+    diff = pos[:, None, :] - pos[None, :, :]
+    dist = np.hypot(diff[..., 0], diff[..., 1])
+    for i, j in zip(*np.nonzero(np.triu(dist < pl_u, 1))):
+        b = block(diff[i, j], pl_u, pr_u)
+        si, sj = slice(2 * i, 2 * i + 2), slice(2 * j, 2 * j + 2)
+        H[si, si] += b
+        H[sj, sj] += b
+        H[si, sj] -= b
+        H[sj, si] -= b
+    for x0, y0, x1, y1 in walls:
+        e = np.array([x1 - x0, y1 - y0])
+        L2 = e @ e
+        t = ((pos - [x0, y0]) @ e) / L2
+        c = np.array([x0, y0]) + np.clip(t, 0, 1)[:, None] * e
+        d = pos - c
+        for i in np.flatnonzero(np.hypot(d[:, 0], d[:, 1]) < wl_u):
+            H[2 * i:2 * i + 2, 2 * i:2 * i + 2] += block(d[i], wl_u, wr_u, line=0 < t[i] < 1)
+    return H
+
+
+def step_floor(pos, walls, wl_u, wr_u, pl_u, pr_u, du):
+    """Smallest max|F| [N] at which the paper's update x += du F / max|F| is
+    still linearly stable: gradient descent with gain du / max|F| diverges
+    along the stiffest mode once du / max|F| > 2 / lambda_max.  Returns
+    (lambda_max N/cm, floor = lambda_max du / 2 N)."""
+    lam = float(np.linalg.eigvalsh(stiffness_matrix(pos, walls, wl_u, wr_u, pl_u, pr_u))[-1])
+    return lam, 0.5 * lam * du

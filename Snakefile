@@ -1,0 +1,16 @@
+# Replication of Papadopoulos, Koutitas & Lazaridis (2016).
+#   snakemake -c2                                   everything
+#   snakemake -c1 figures/fig06_single_coarse.png   one figure and what it needs
+configfile: "config/config.yaml"
+
+
+include: "workflow/rules/common.smk"
+include: "workflow/rules/runs.smk"
+include: "workflow/rules/single.smk"
+include: "workflow/rules/report.smk"
+
+
+rule all:
+    input:
+        ALL_TARGETS,
+    default_target: True

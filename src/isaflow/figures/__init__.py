@@ -1,0 +1,7 @@
+"""Figures, drawn only from run files (netCDF) and tables derived from them.
+
+Every public function has the signature ``f(inputs, outputs, **kw)``:
+``inputs`` are file paths, ``outputs`` the PNG and PDF paths to write.
+"""
+
+from .single import calibration_figure, convergence_figure, inputs_figure, single_vessel_figure  # noqa: F401

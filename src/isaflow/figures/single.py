@@ -1,0 +1,186 @@
+"""Single-vessel figures: paper Figs. 5-8, calibration and convergence."""
+
+import numpy as np
+
+from .. import metrics, theory
+from ..runfile import read
+from .style import COMPUTED, PAPER, THEORY, draw_walls, plt, run_caption, save
+
+
+def _law_axes(ax, l_u, r_u, sym, title):
+    l = np.linspace(0, 1.3 * l_u, 200)
+    ax.plot(l, np.where(l < l_u, r_u * (1 - l / l_u), 0.0) / 1000, color="k")
+    ax.set_xlabel(f"$l_{sym}$ (cm)")
+    ax.set_ylabel(f"$R_{sym}$ (kN)")
+    ax.set_title(title)
+    ax.annotate(f"$R_{{{sym}u}}$ = {r_u / 1000:.3g} kN", (0, r_u / 1000), xytext=(0.25 * l_u, 0.85 * r_u / 1000))
+    ax.annotate(f"$l_{{{sym}u}}$ = {l_u:.3g} cm", (l_u, 0), xytext=(0.55 * l_u, 0.15 * r_u / 1000))
+    ax.text(0.98, 0.6, f"stiffness {r_u / l_u:.4g} N/cm", transform=ax.transAxes, ha="right")
+    ax.set_xlim(0, None)
+    ax.set_ylim(0, None)
+
+
+def inputs_figure(inputs, outputs):
+    """Paper Figs. 5 / 7: initial lattice, rhombic element, both force laws."""
+    ds = read(inputs[0])
+    a = float(ds.attrs["lattice_a"])
+    pos = ds["pos0"].values
+    fig, ax = plt.subplots(2, 2, figsize=(9, 8.5))
+    ax0 = ax[0, 0]
+    draw_walls(ax0, ds)
+    ax0.plot(pos[:, 0], pos[:, 1], "o", ms=3 if len(pos) < 300 else 1.5, color=COMPUTED)
+    ax0.set_aspect("equal")
+    ax0.set_xlabel("x (cm)")
+    ax0.set_ylabel("y (cm)")
+    ax0.set_title(f"(a) vessel and initial positions: {len(pos)} particles, w = {ds['weight'].values[0]:g} N")
+    # (b) enlarged rhombic element next to the floor
+    axb = ax[0, 1]
+    c = np.array([0.0, 0.5 * a])
+    rh = np.array([c + [0, -a / 2], c + [a / 2, 0], c + [0, a / 2], c + [-a / 2, 0], c + [0, -a / 2]])
+    axb.plot(rh[:, 0], rh[:, 1], "-o", color=COMPUTED)
+    axb.plot([c[0] - a / 2, c[0] + a / 2], [c[1]] * 2, "--", color="gray")
+    axb.plot([c[0]] * 2, [c[1] - a / 2, c[1] + a / 2], "--", color="gray")
+    wl = float(ds.attrs["wall_l_u"])
+    floor_y = c[1] - a / 2 - float(pos[:, 1].min() - ds["wall_segment"].values[:, [1, 3]].min())
+    axb.axhline(floor_y, color="k", lw=2.5)
+    axb.annotate("", (c[0] + 0.15 * a, floor_y), (c[0] + 0.15 * a, c[1] - a / 2), arrowprops=dict(arrowstyle="<->"))
+    axb.text(c[0] + 0.18 * a, 0.5 * (floor_y + c[1] - a / 2), f"{c[1] - a / 2 - floor_y:.3g} cm to wall\n"
+             f"($l_{{bu}}$ = {wl:.3g} cm)", va="center")
+    axb.text(c[0], c[1] + 0.04 * a, f"a = {a:g} cm", ha="center", va="bottom")
+    axb.text(c[0] + 0.27 * a, c[1] + 0.27 * a, f"a/√2 = {a / np.sqrt(2):.3g} cm", rotation=-45)
+    axb.set_aspect("equal")
+    axb.set_xlim(-0.8 * a, 0.8 * a)
+    axb.set_xlabel("x (cm)")
+    axb.set_ylabel("y (cm)")
+    axb.set_title("(b) rhombic element and distance from the boundary")
+    _law_axes(ax[1, 0], wl, float(ds.attrs["wall_r_u"]), "b", "(c) boundary-particle function $R_b - l_b$")
+    _law_axes(ax[1, 1], float(ds.attrs["pair_l_u"]), float(ds.attrs["pair_r_u"]), "p",
+              "(d) inter-particle function $R_p - l_p$")
+    fig.suptitle(f"Inputs of scene {ds.attrs['scene']}: du = {ds.attrs['du'] * 10:g} mm, f_tol = {ds.attrs['f_tol']:g} N "
+                 f"(solver: {ds.attrs['variant_label']})")
+    save(fig, outputs)
+
+
+def _contact_bars(ax, ds, th, scale):
+    """Computed (blue) and theoretical (orange) contact loads as bars outside the walls."""
+    walls = ds["wall_segment"].values
+    cw = ds["contact_wall"].values
+    cp = ds["contact_point"].values
+    mag = np.hypot(*ds["contact_force"].values.T)
+    for k in range(len(cw)):
+        x0, y0, x1, y1 = walls[cw[k]]
+        e = np.array([x1 - x0, y1 - y0]) / np.hypot(x1 - x0, y1 - y0)
+        out = np.array([e[1], -e[0]])  # right normal: away from the liquid
+        for val, color, off in ((mag[k], COMPUTED, -0.6), (th[k], THEORY, 0.6)):
+            if not np.isfinite(val):
+                continue
+            base = cp[k] + off * e
+            tip = base + out * val * scale
+            ax.plot([base[0], tip[0]], [base[1], tip[1]], color=color, lw=2.2, solid_capstyle="butt")
+
+
+def single_vessel_figure(inputs, outputs, paper_level=None):
+    """Paper Figs. 6 / 8: final state, level, wall reactions vs hydrostatic theory."""
+    ds = read(inputs[0])
+    e = metrics.load_errors(ds)
+    pos = ds["pos"].values
+    walls = ds["wall_segment"].values
+    th = theory.contact_theory(walls, ds["contact_wall"].values, ds["contact_point"].values, e["gamma"], e["level"])
+    fig, (ax, axp) = plt.subplots(1, 2, figsize=(12, 6.2), gridspec_kw={"width_ratios": [1.15, 1]})
+    draw_walls(ax, ds)
+    ax.plot(pos[:, 0], pos[:, 1], "o", ms=3 if len(pos) < 300 else 1.6, color="k")
+    x0, x1 = walls[:, [0, 2]].min(), walls[:, [0, 2]].max()
+    ax.axhline(e["level"], color=COMPUTED, ls="--", lw=1)
+    ax.text(x0 + 2, e["level"] + 1.5, f"level {e['level']:.1f} cm (ours)", color=COMPUTED)
+    if paper_level is not None:
+        ax.axhline(paper_level, color=PAPER, ls=":", lw=1.2)
+        ax.text(x1 - 2, paper_level - 4, f"paper {paper_level:g} cm", color=PAPER, ha="right")
+    fmax = np.nanmax(np.concatenate([np.hypot(*ds["contact_force"].values.T), th]))
+    scale = 25.0 / fmax
+    _contact_bars(ax, ds, th, scale)
+    ax.plot([], [], color=COMPUTED, lw=2.2, label="computed reaction $R_b$")
+    ax.plot([], [], color=THEORY, lw=2.2, label="hydrostatic theory (tributary length)")
+    ax.plot([x1 + 3, x1 + 3], [-20, -20 + 1000 * scale], color="gray", lw=2)
+    ax.text(x1 + 5, -20, "1 kN", color="gray", va="bottom")
+    ax.legend(loc="upper center", fontsize=8, ncol=2, bbox_to_anchor=(0.5, 1.0))
+    ax.set_aspect("equal")
+    ax.set_xlim(x0 - 30, x1 + 30)
+    ax.set_ylim(-30, 110)
+    ax.set_xlabel("x (cm)")
+    ax.set_ylabel("y (cm)")
+    names = list(ds["wall"].values)
+    totals = ", ".join(f"{n} {e['load_' + n]:.0f} N (theory {e['theory_' + n]:.0f})" for n in names)
+    ax.set_title(f"(a) final positions and wall reactions\n{totals}")
+    # (b) theoretical pressure diagram
+    h, gamma = e["level"], e["gamma"]
+    draw_walls(axp, ds)
+    pbot = gamma * h  # N/cm per cm of wall = N/cm^2 x cm
+    s = 30.0 / pbot
+    y = np.linspace(0, h, 50)
+    axp.fill_betweenx(y, x0, x0 - gamma * (h - y) * s, color=THEORY, alpha=0.5)
+    axp.fill_betweenx(y, x1, x1 + gamma * (h - y) * s, color=THEORY, alpha=0.5)
+    axp.fill_between([x0, x1], 0, -pbot * s, color=THEORY, alpha=0.5)
+    axp.axhline(h, color=COMPUTED, ls="--", lw=1)
+    axp.text(x0 - 2, -pbot * s - 6, f"p = γh = {pbot:.1f} N/cm", ha="left")
+    axp.text(0.5 * (x0 + x1), h + 2, f"h = {h:.1f} cm, γ = W/(B h) = {gamma:.3f} N/cm²", ha="center")
+    axp.text(0.5 * (x0 + x1), 0.45 * h, f"floor: γhB = W = {e['theory_floor']:.0f} N\n"
+             f"each side: γh²/2 = {e['theory_' + names[0]]:.0f} N at h/3 = {h / 3:.1f} cm", ha="center")
+    axp.set_aspect("equal")
+    axp.set_xlim(x0 - 40, x1 + 40)
+    axp.set_ylim(-45, 110)
+    axp.set_xlabel("x (cm)")
+    axp.set_ylabel("y (cm)")
+    axp.set_title("(b) theoretical hydrostatic pressure on the boundaries (2D, per unit depth)")
+    fig.suptitle(run_caption(ds), fontsize=8)
+    save(fig, outputs)
+
+
+def calibration_figure(inputs, outputs, paper_levels=None):
+    """Free-surface level against wall stiffness and stiffness ratio, per resolution."""
+    tab = metrics.calibration_table(inputs)
+    scenes = list(dict.fromkeys(tab["run"]))
+    fig, axes = plt.subplots(1, len(scenes), figsize=(5.2 * len(scenes), 4.4), sharey=True, squeeze=False)
+    for ax, sc in zip(axes[0], scenes):
+        t = tab[tab["run"] == sc]
+        for ratio, g in t.groupby("ratio"):
+            g = g.sort_values("k_wall")
+            line, = ax.plot(g["k_wall"], g["level"], "-", label=f"$k_p/k_b$ = {ratio:g}")
+            ok = g["status"] == "converged"
+            ax.plot(g["k_wall"][ok], g["level"][ok], "o", color=line.get_color())
+            ax.plot(g["k_wall"][~ok], g["level"][~ok], "o", mfc="none", color=line.get_color())
+        base = sc.removesuffix("_lbu25")
+        if paper_levels and base in paper_levels:
+            ax.axhline(paper_levels[base], color=PAPER, ls=":", label=f"paper {paper_levels[base]:g} cm")
+        ax.set_xscale("log")
+        ax.set_xlabel("wall stiffness $k_b = R_{bu}/l_{bu}$ (N/cm)")
+        ax.set_title(f"{sc} ({t['variant'].iloc[0]} variant)")
+        ax.legend(fontsize=8)
+    axes[0, 0].set_ylabel("free-surface level (cm)")
+    fig.suptitle("Free-surface level vs force-law stiffness (filled: converged to f_tol, open: not converged)")
+    save(fig, outputs)
+
+
+def convergence_figure(inputs, outputs):
+    """max|F| against the step: the paper's update and the capped variant."""
+    runs = [read(p) for p in inputs]
+    scenes = list(dict.fromkeys(ds.attrs["scene"] for ds in runs))
+    fig, axes = plt.subplots(1, len(scenes), figsize=(6 * len(scenes), 4.4), squeeze=False)
+    for ax, sc in zip(axes[0], scenes):
+        for ds in (d for d in runs if d.attrs["scene"] == sc):
+            a = ds.attrs
+            st = ds["hist_step"].values
+            line, = ax.plot(st, ds["hist_fmax"].values, lw=0.8, label=f"{a['variant_label']}\n-> {a['status']} at step {int(ds['steps'])}")
+            ax.fill_between(st, ds["hist_fmax_lo"].values, ds["hist_fmax_hi"].values, color=line.get_color(), alpha=0.25, lw=0)
+            if a["variant"] == "paper":
+                lam, floor = theory.step_floor(ds["pos"].values, ds["wall_segment"].values, a["wall_l_u"],
+                                               a["wall_r_u"], a["pair_l_u"], a["pair_r_u"], a["du"])
+                ax.axhline(floor, color=line.get_color(), ls="--", lw=1,
+                           label=f"stability floor λ_max du/2 = {floor:.3g} N (λ_max = {lam:.0f} N/cm)")
+        ax.axhline(float(runs[0].attrs["f_tol"]), color="k", ls=":", label="f_tol = 0.1 N")
+        ax.set_yscale("log")
+        ax.set_xlabel("algorithm step")
+        ax.set_ylabel("max|F| (N)")
+        ax.set_title(sc)
+        ax.legend(fontsize=7)
+    fig.suptitle("Convergence of the single-vessel runs (band: min-max of max|F| over each record stride)")
+    save(fig, outputs)

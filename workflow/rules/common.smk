@@ -1,0 +1,43 @@
+# Config validation and input functions shared by all rules.
+from snakemake.utils import validate
+
+validate(config, "../schemas/config.schema.yaml")
+
+RUNS = config["runs"]
+ALL_TARGETS = []
+
+
+def figure(name):
+    """PNG and PDF paths of a figure."""
+    return [f"figures/{name}.png", f"figures/{name}.pdf"]
+
+
+def run_file(run):
+    return f"results/runs/{run}.nc"
+
+
+def run_overrides(wildcards):
+    return " ".join(f"--set '{s}'" for s in RUNS[wildcards.run].get("set", []))
+
+
+def start_file(scene_path):
+    """The run file a scene continues from (particles.from_run), if any."""
+    import yaml
+
+    with open(scene_path) as fh:
+        src = yaml.safe_load(fh).get("particles", {}).get("from_run")
+    return [src] if src else []
+
+
+def scene_law(scene_path, which):
+    """(l_u cm, r_u N) of a scene's 'wall' or 'pair' force law."""
+    import yaml
+
+    with open(scene_path) as fh:
+        law = yaml.safe_load(fh)["forces"][which]
+    return law["l_u"], law["r_u"]
+
+
+# runs whose metrics go into results/metrics.csv (rule files append to it)
+METRIC_RUNS = list(RUNS)
+REPORT_PARTS = []

@@ -1,0 +1,117 @@
+# Single-vessel applications 1-2: Figures 5-8, free-surface calibration, convergence.
+CAL = config["calibration"]
+CAL_FILES = [
+    f"results/calibration/{run}_kb{kb:g}_r{ratio:g}.nc"
+    for run in CAL["runs"]
+    for kb in CAL["wall_stiffness"]
+    for ratio in CAL["stiffness_ratio"]
+]
+
+
+def calibration_overrides(wc):
+    """Scene overrides of one calibration point: k_b = kb, k_p = ratio kb."""
+    scene = RUNS[wc.run]["scene"]
+    wl_u, _ = scene_law(scene, "wall")
+    pl_u, _ = scene_law(scene, "pair")
+    kb, ratio = float(wc.kb), float(wc.ratio)
+    sets = [
+        f"forces.wall.r_u={kb * wl_u}",
+        f"forces.pair.r_u={kb * ratio * pl_u}",
+        f"solver.variant={CAL['variant']}",
+        f"solver.max_steps={CAL['max_steps']}",
+        "solver.accept=[converged,cycle,step_limit]",
+        "solver.history={}",
+    ]
+    return " ".join(f"--set '{s}'" for s in sets)
+
+
+rule calibration_run:
+    input:
+        scene=lambda wc: RUNS[wc.run]["scene"],
+    output:
+        "results/calibration/{run}_kb{kb}_r{ratio}.nc",
+    params:
+        overrides=calibration_overrides,
+    log:
+        "logs/calibration/{run}_kb{kb}_r{ratio}.log",
+    benchmark:
+        "results/benchmarks/calibration/{run}_kb{kb}_r{ratio}.tsv"
+    shell:
+        "isaflow run {input.scene} -o {output} {params.overrides} --config config/config.yaml -q 2> {log}"
+
+
+rule calibration_table:
+    input:
+        CAL_FILES,
+    output:
+        "results/calibration.csv",
+    log:
+        "logs/calibration_table.log",
+    script:
+        "../scripts/calibration_table.py"
+
+
+FIGS = config["figures"]
+
+
+rule fig_inputs:
+    input:
+        lambda wc: run_file(FIGS[wc.name]),
+    output:
+        figure("{name}"),
+    params:
+        func="inputs_figure",
+    log:
+        "logs/figures/{name}.log",
+    wildcard_constraints:
+        name="fig05_inputs_coarse|fig07_inputs_refined",
+    script:
+        "../scripts/plot.py"
+
+
+rule fig_single:
+    input:
+        lambda wc: run_file(FIGS[wc.name]),
+    output:
+        figure("{name}"),
+    params:
+        func="single_vessel_figure",
+        kw=lambda wc: {"paper_level": config["paper"][FIGS[wc.name].removesuffix("_capped")]["level"]},
+    log:
+        "logs/figures/{name}.log",
+    wildcard_constraints:
+        name="fig06_single_coarse|fig08_single_refined",
+    script:
+        "../scripts/plot.py"
+
+
+rule fig_calibration:
+    input:
+        CAL_FILES,
+    output:
+        figure("calibration_free_surface"),
+    params:
+        func="calibration_figure",
+        kw={"paper_levels": {k: v["level"] for k, v in config["paper"].items()}},
+    log:
+        "logs/figures/calibration_free_surface.log",
+    script:
+        "../scripts/plot.py"
+
+
+rule fig_convergence:
+    input:
+        [run_file(r) for r in ["single_coarse", "single_coarse_capped", "single_refined", "single_refined_capped"]],
+    output:
+        figure("convergence_single"),
+    params:
+        func="convergence_figure",
+    log:
+        "logs/figures/convergence_single.log",
+    script:
+        "../scripts/plot.py"
+
+
+ALL_TARGETS += figure("fig05_inputs_coarse") + figure("fig06_single_coarse")
+ALL_TARGETS += figure("fig07_inputs_refined") + figure("fig08_single_refined")
+ALL_TARGETS += figure("calibration_free_surface") + figure("convergence_single")
