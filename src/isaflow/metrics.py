@@ -82,6 +82,34 @@ def load_errors(ds, vessel=None):
     return out
 
 
+def stress_ratio(ds, vessel=None):
+    """Horizontal-to-vertical stress ratio K = sigma_xx / sigma_yy of the lattice.
+
+    Virial sum over particle pairs whose midpoint lies in the interior of the
+    vessel (middle 60 % of the width, 10-60 % of the liquid height), away from
+    walls and surface.  A fluid has K = 1; the hydrostatic side-wall loads
+    scale with K, so 1 - K is the side-wall deficit a solid-like lattice shows.
+    """
+    from . import kernels as K
+
+    v = vessel_view(ds, vessel)
+    pos = ds["pos"].values
+    a = ds.attrs
+    (x0, x1), y0 = v["x_range"], v["floor_y"]
+    h = theory.free_surface_level(pos, float(a["lattice_a"]), v["x_range"]) - y0
+    box = np.array([pos[:, 0].min(), pos[:, 1].min(), pos[:, 0].max() + 1e-9, pos[:, 1].max() + 1e-9])
+    pi, pj, m = K.build_pairs(pos, box, float(a["pair_l_u"]))
+    d = pos[pi[:m]] - pos[pj[:m]]
+    mid = 0.5 * (pos[pi[:m]] + pos[pj[:m]])
+    sel = ((mid[:, 0] > x0 + 0.2 * (x1 - x0)) & (mid[:, 0] < x1 - 0.2 * (x1 - x0))
+           & (mid[:, 1] > y0 + 0.1 * h) & (mid[:, 1] < y0 + 0.6 * h))
+    dist = np.hypot(d[sel, 0], d[sel, 1])
+    force = float(a["pair_r_u"]) * (1 - dist / float(a["pair_l_u"]))  # repulsive magnitude, N
+    sxx = np.sum(force * d[sel, 0] ** 2 / dist)
+    syy = np.sum(force * d[sel, 1] ** 2 / dist)
+    return float(sxx / syy) if syy > 0 else float("nan")
+
+
 def run_row(ds, vessel=None):
     """One metrics-table row (dict) of a run Dataset."""
     row = dict(
@@ -100,6 +128,7 @@ def run_row(ds, vessel=None):
     row["balance_x_N"] = abs(total[0])
     row["balance_y_N"] = abs(total[1] - W)
     row.update(load_errors(ds, vessel))
+    row["stress_ratio"] = stress_ratio(ds, vessel)
     return row
 
 

@@ -66,6 +66,8 @@ def detect_cycle(h, window=400, max_period=50, rtol=1e-6):
         return 0
     tail = h[-(window + max_period):]
     scale = tail.max()
+    if np.abs(tail[1:] - tail[:-1]).max() <= rtol * scale:
+        return 0  # constant
     for p in range(2, max_period + 1):
         if np.abs(tail[p:] - tail[:-p]).max() <= rtol * scale:
             return p

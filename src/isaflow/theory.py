@@ -8,20 +8,19 @@ measured level: gamma = W / (B h) [N/cm^2] for a vessel of width B.
 import numpy as np
 
 
-def free_surface_level(pos, a, x_range=None):
+def free_surface_level(pos, a, x_range):
     """Free-surface level [cm]: mean over vertical strips of width ``a`` of the
     highest particle in each strip (the line one reads off the paper's figures).
 
     pos (N, 2) cm; a strip width cm (the lattice diagonal); x_range (xmin, xmax)
-    limits the particles considered (e.g. one vessel).  NaN if none.
+    is the vessel: strips start at xmin, particles outside are ignored.  Strips
+    holding no particle are skipped.  NaN if the vessel is empty.
     """
     pos = np.asarray(pos)
-    if x_range is not None:
-        pos = pos[(pos[:, 0] >= x_range[0]) & (pos[:, 0] < x_range[1])]
+    pos = pos[(pos[:, 0] >= x_range[0]) & (pos[:, 0] < x_range[1])]
     if len(pos) == 0:
         return float("nan")
-    x0 = pos[:, 0].min() if x_range is None else x_range[0]
-    strip = np.floor((pos[:, 0] - x0) / a).astype(int)
+    strip = np.floor((pos[:, 0] - x_range[0]) / a).astype(int)
     tops = [pos[strip == s, 1].max() for s in np.unique(strip)]
     return float(np.mean(tops))
 

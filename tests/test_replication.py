@@ -1,0 +1,93 @@
+"""CI tolerance check: single-vessel free-surface levels and wall loads.
+
+Tolerances come from isaflow.metrics.tolerances (derived from the lattice,
+not from the results; see docs/replication.md).  Known, explained differences
+from hydrostatic theory are strict xfails: they fail loudly if they vanish.
+"""
+
+import numpy as np
+import pytest
+
+from isaflow import metrics, theory
+
+PAPER_LEVEL = {"single_coarse": 72.5, "single_refined": 75.0}
+A = {"single_coarse": 10.0, "single_refined": 5.0}
+CASES = [(s, v) for s in PAPER_LEVEL for v in ("paper", "capped")]
+
+
+def row_and_tol(single_runs, name, variant):
+    ds = single_runs[name, variant]
+    row = metrics.run_row(ds)
+    return row, metrics.tolerances(row, A[name], row["particles"], 0.1)
+
+
+@pytest.mark.parametrize("name,variant", CASES)
+def test_free_surface_level_matches_the_paper(single_runs, name, variant):
+    row, tol = row_and_tol(single_runs, name, variant)
+    assert abs(row["level"] - PAPER_LEVEL[name]) <= tol["level"][0]
+
+
+@pytest.mark.parametrize("name,variant", CASES)
+def test_floor_carries_the_weight(single_runs, name, variant):
+    row, tol = row_and_tol(single_runs, name, variant)
+    assert abs(row["floor_err"]) <= tol["floor"][0]
+
+
+SIDE_DEFICIT = pytest.mark.xfail(
+    strict=True,
+    reason="the relaxed lattice is not a fluid: its horizontal/vertical stress ratio is about 0.88, so the side "
+           "walls carry less than the hydrostatic gamma h^2/2 (docs/replication.md, Wall loads)",
+)
+
+
+@pytest.mark.parametrize("name,variant", [pytest.param(*c, marks=SIDE_DEFICIT) for c in CASES])
+def test_side_wall_totals_match_hydrostatics(single_runs, name, variant):
+    row, tol = row_and_tol(single_runs, name, variant)
+    assert abs(row["side_err"]) <= tol["side"][0]
+
+
+@pytest.mark.parametrize("name,variant", CASES)
+def test_side_wall_deficit_is_bounded(single_runs, name, variant):
+    """The documented deficit itself: side walls carry 75-100 % of hydrostatics, never more."""
+    row, _ = row_and_tol(single_runs, name, variant)
+    assert -0.25 <= row["side_err"] <= 0.0
+    assert 0.8 <= row["stress_ratio"] <= 0.95
+
+
+REFINED_HEIGHT = pytest.mark.xfail(strict=True, reason="refined side resultant sits 1.7-1.9 cm above h/3 "
+                                   "(tolerance a/4 = 1.25 cm): the side deficit is largest near the floor")
+
+
+@pytest.mark.parametrize("name,variant", [
+    ("single_coarse", "paper"), ("single_coarse", "capped"),
+    pytest.param("single_refined", "paper", marks=REFINED_HEIGHT),
+    pytest.param("single_refined", "capped", marks=REFINED_HEIGHT),
+])
+def test_side_resultant_acts_at_a_third_of_the_depth(single_runs, name, variant):
+    row, tol = row_and_tol(single_runs, name, variant)
+    assert abs(row["side_height_err"]) <= tol["side_height"][0]
+
+
+@pytest.mark.parametrize("name", PAPER_LEVEL)
+def test_literal_update_settles_in_a_cycle_at_the_stability_floor(single_runs, name):
+    """The paper's x += du F/max|F| cannot reach 0.1 N: once max|F| < lambda_max du / 2
+    the gain du / max|F| exceeds 2 / lambda_max, and it oscillates around that floor."""
+    ds = single_runs[name, "paper"]
+    a = ds.attrs
+    assert a["status"] == "cycle" and a["cycle_period"] == 2
+    lam, floor = theory.step_floor(ds["pos"].values, ds["wall_segment"].values, a["wall_l_u"], a["wall_r_u"],
+                                   a["pair_l_u"], a["pair_r_u"], a["du"])
+    tail = ds["hist_fmax"].values[-20:]
+    lo, hi = ds["hist_fmax_lo"].values[-20:].min(), ds["hist_fmax_hi"].values[-20:].max()
+    assert lo > 10 * a["f_tol"]
+    assert lo < floor < hi
+    assert 0.5 * (lo + hi) == pytest.approx(floor, rel=0.05)
+    assert np.all(tail > a["f_tol"])
+
+
+@pytest.mark.parametrize("name", PAPER_LEVEL)
+def test_capped_variant_converges_to_the_same_state(single_runs, name):
+    p, c = single_runs[name, "paper"], single_runs[name, "capped"]
+    assert c.attrs["status"] == "converged" and float(c["max_force"]) < 0.1
+    rp, rc = metrics.run_row(p), metrics.run_row(c)
+    assert rc["level"] == pytest.approx(rp["level"], abs=0.5)

@@ -1,0 +1,91 @@
+"""Hydrostatic theory, free-surface level, cycle detection and the step-stability floor."""
+
+import numpy as np
+import pytest
+
+from isaflow import solver, theory
+from isaflow.scene import rhombic_lattice
+
+from conftest import box_walls
+
+
+def test_wall_totals_are_the_hydrostatic_integrals():
+    walls = box_walls()
+    W, B, h = 9000.0, 100.0, 72.5
+    g = theory.specific_weight(W, B, h)
+    assert g == pytest.approx(W / (B * h))
+    assert theory.wall_total(walls[1], g, h) == pytest.approx(W)  # floor carries the weight
+    side = 0.5 * g * h**2
+    assert theory.wall_total(walls[0], g, h) == pytest.approx(side)  # downward-oriented wall
+    assert theory.wall_total(walls[2], g, h) == pytest.approx(side)  # upward-oriented wall
+    assert theory.implied_level(side, W, B) == pytest.approx(h)
+
+
+def test_contact_theory_partitions_each_wall_total():
+    walls = box_walls()
+    g, h = 1.2, 70.0
+    ys = np.arange(5.0, 100.0, 5.0)
+    xs = np.arange(10.0, 91.0, 10.0)
+    cw = np.concatenate([np.zeros(len(ys), int), np.ones(len(xs), int), np.full(len(ys), 2)])
+    cp = np.concatenate([np.column_stack([np.zeros_like(ys), ys]), np.column_stack([xs, np.zeros_like(xs)]),
+                         np.column_stack([np.full_like(ys, 100.0), ys])])
+    th = theory.contact_theory(walls, cw, cp, g, h)
+    for w in range(3):
+        assert th[cw == w].sum() == pytest.approx(theory.wall_total(walls[w], g, h))
+    # floor contacts in the middle carry gamma h times their 10 cm tributary width
+    assert th[len(ys) + 4] == pytest.approx(g * h * 10.0)
+    # a side contact above the surface carries nothing
+    assert th[np.flatnonzero((cw == 0) & (cp[:, 1] > h + 2.5))].max() == 0.0
+
+
+def test_resultant_height_of_a_triangle_is_a_third():
+    y = np.linspace(0, 60, 6001)
+    assert theory.resultant_height(y, 60 - y) == pytest.approx(20.0, abs=0.01)
+
+
+def test_free_surface_level_of_the_initial_coarse_lattice():
+    pos = rhombic_lattice(10.0, 19, [9, 10], 50.0, 5.0)
+    # strips [0, 10), [10, 20), ...: the top row of 9 (y = 95) reaches all strips but
+    # the first, which holds only x = 5 of the rows of 10 (top at y = 90)
+    assert theory.free_surface_level(pos, 10.0, (0.0, 100.0)) == pytest.approx((90 + 9 * 95) / 10)
+    assert theory.free_surface_level(pos, 10.0, (0.0, 20.0)) == pytest.approx(92.5)
+    assert np.isnan(theory.free_surface_level(pos, 10.0, (200.0, 300.0)))
+
+
+def test_detect_cycle():
+    rng = np.random.default_rng(0)
+    assert solver.detect_cycle(np.tile([8.0, 23.6], 400)) == 2
+    assert solver.detect_cycle(np.tile([1.0, 2.0, 3.0], 300)) == 3
+    assert solver.detect_cycle(np.full(800, 50.0)) == 0  # constant max|F| (free fall) is no cycle
+    assert solver.detect_cycle(rng.uniform(1, 2, 800)) == 0
+    assert solver.detect_cycle(np.tile([8.0, 23.6], 100)) == 0  # too short to tell
+
+
+def test_stiffness_matrix_of_one_particle_on_the_floor():
+    walls = box_walls()
+    lam, floor = theory.step_floor(np.array([[50.0, 4.0]]), walls, 5.0, 10000.0, 7.07, 3535.5, 0.01)
+    assert lam == pytest.approx(2000.0)  # k_b = 10000 / 5 N/cm, vertical only
+    assert floor == pytest.approx(10.0)
+
+
+def test_stiffness_matrix_is_the_force_jacobian():
+    pos = rhombic_lattice(10.0, 5, [3, 4], 20.0, 4.0) + np.random.default_rng(1).normal(0, 0.3, (17, 2))
+    walls = box_walls(40.0, 40.0)
+    args = (walls, 5.0, 10000.0, 7.0710678, 3535.5339)
+    H = theory.stiffness_matrix(pos, *args)
+
+    def force(p):
+        from isaflow import kernels as K
+
+        f = np.zeros_like(p)
+        pi, pj, m = K.build_pairs(p, np.array([0, 0, 40.0, 40.0]), 8.0)
+        K.forces(p, np.zeros(len(p)), walls, *args[1:], pi, pj, m, f)
+        return f.ravel()
+
+    eps = 1e-6
+    J = np.empty_like(H)
+    for k in range(H.shape[0]):
+        d = np.zeros(H.shape[0])
+        d[k] = eps
+        J[:, k] = -(force(pos + d.reshape(-1, 2)) - force(pos - d.reshape(-1, 2))) / (2 * eps)
+    np.testing.assert_allclose(H, J, atol=1e-3 * np.abs(H).max())
