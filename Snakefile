@@ -7,6 +7,7 @@ configfile: "config/config.yaml"
 include: "workflow/rules/common.smk"
 include: "workflow/rules/runs.smk"
 include: "workflow/rules/single.smk"
+include: "workflow/rules/flow.smk"
 include: "workflow/rules/report.smk"
 
 

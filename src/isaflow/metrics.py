@@ -23,8 +23,11 @@ from . import theory
 def vessel_view(ds, vessel=None):
     """Walls, contacts and particles of one vessel of a run Dataset.
 
-    vessel: name in ds.vessel, or None for the whole scene.  Returns dict with
-    x_range (cm), width B (cm), floor_y (cm) and masks.
+    vessel: name in ds.vessel, or None for the whole scene.  A wall belongs to
+    the vessel when its x-extent touches the vessel's [xmin, xmax]; the floor
+    is the lowest horizontal wall among them.  Returns dict with x_range (cm),
+    width B (cm), floor_y (cm), wall_in (W,) and horizontal (W,) bool masks,
+    inside (N,) bool mask of the particles in the vessel.
     """
     walls = ds["wall_segment"].values
     pos = ds["pos"].values
@@ -32,11 +35,14 @@ def vessel_view(ds, vessel=None):
         x0, x1 = walls[:, [0, 2]].min(), walls[:, [0, 2]].max()
     else:
         x0, x1 = ds["vessel_x"].sel(vessel=vessel).values
-    floor_y = walls[:, [1, 3]].min()
     eps = 1e-9
-    mid = 0.5 * (walls[:, [0, 1]] + walls[:, [2, 3]])
-    wall_in = (mid[:, 0] >= x0 - eps) & (mid[:, 0] <= x1 + eps)
+    wx0, wx1 = walls[:, [0, 2]].min(1), walls[:, [0, 2]].max(1)
+    overlap = np.minimum(wx1, x1) - np.maximum(wx0, x0)
+    vertical = wx1 - wx0 <= eps
+    wall_in = (overlap > eps) | (vertical & (overlap >= -eps))
     horiz = np.isclose(walls[:, 1], walls[:, 3])
+    floors = wall_in & horiz
+    floor_y = walls[floors, 1].min() if floors.any() else walls[:, [1, 3]].min()
     inside = (pos[:, 0] >= x0) & (pos[:, 0] < x1)
     return dict(x_range=(x0, x1), width=x1 - x0, floor_y=floor_y, wall_in=wall_in, horizontal=horiz, inside=inside)
 
@@ -51,12 +57,14 @@ def load_errors(ds, vessel=None):
     h = level - v["floor_y"]
     gamma = theory.specific_weight(weight, v["width"], level, v["floor_y"])
     walls = ds["wall_segment"].values
-    cw = ds["contact_wall"].values
+    # contacts of this vessel's particles only (a dividing wall has two sides)
+    mine = v["inside"][ds["contact_particle"].values]
+    cw = np.where(mine, ds["contact_wall"].values, -1)
     cp = ds["contact_point"].values
     mag = np.hypot(*ds["contact_force"].values.T)
     th = theory.contact_theory(walls, cw, cp, gamma, level, v["wall_in"])
     names = list(ds["wall"].values)
-    out = dict(level=level, level_max=float(pos[v["inside"], 1].max()) if v["inside"].any() else np.nan,
+    out = dict(level=level, depth=h, level_max=float(pos[v["inside"], 1].max()) if v["inside"].any() else np.nan,
                weight=weight, gamma=gamma)
     side_err, side_h_err, implied = [], [], []
     for w, name in enumerate(names):
@@ -67,7 +75,7 @@ def load_errors(ds, vessel=None):
         th_total = theory.wall_total(walls[w], gamma, level)
         out[f"load_{name}"] = total
         out[f"theory_{name}"] = th_total
-        if v["horizontal"][w] and walls[w, 1] == v["floor_y"]:
+        if v["horizontal"][w] and np.isclose(walls[w, 1], v["floor_y"]):
             out["floor_err"] = (total - th_total) / th_total
         elif not v["horizontal"][w] and th_total > 0:
             side_err.append((total - th_total) / th_total)
@@ -127,9 +135,35 @@ def run_row(ds, vessel=None):
     W = float(ds["weight"].values.sum())
     row["balance_x_N"] = abs(total[0])
     row["balance_y_N"] = abs(total[1] - W)
+    if vessel is None and "vessel" in ds.coords:
+        vessel = str(ds["vessel"].values[-1])  # flows: wall loads of the receiving vessel
+    if "vessel" in ds.coords:
+        row.update(flow_measures(ds))
+    row["loads_vessel"] = vessel or "all"
     row.update(load_errors(ds, vessel))
     row["stress_ratio"] = stress_ratio(ds, vessel)
     return row
+
+
+def flow_measures(ds):
+    """Flow diagnostics of a run with vessels (first = source, last = receiver).
+
+    particles_<vessel>: final count per vessel; particles_left: in the first
+    vessel; sum_fx_N: horizontal resultant of all wall reactions (the paper's
+    sign of non-equilibrium); mass_conserved: every recorded sample accounts
+    for every particle in some vessel.
+    """
+    names = [str(n) for n in ds["vessel"].values]
+    out = {}
+    for name in names:
+        x0, x1 = ds["vessel_x"].sel(vessel=name).values
+        x = ds["pos"].values[:, 0]
+        out[f"particles_{name}"] = int(np.count_nonzero((x >= x0) & (x < x1)))
+    out["particles_left"] = out[f"particles_{names[0]}"]
+    out["sum_fx_N"] = float(ds["wall_resultant"].sel(xy="x").sum())
+    if "hist_vessel_count" in ds:
+        out["mass_conserved"] = bool((ds["hist_vessel_count"].sum("vessel") == ds.sizes["particle"]).all())
+    return out
 
 
 def table(paths, vessel=None):

@@ -148,7 +148,9 @@ def solve(scene, pos0, weight, start_step=0, progress=None):
     t0 = time.perf_counter()
     n_chunk = 0
     while step < p["max_steps"]:
-        n = min(chunk, p["max_steps"] - step)
+        # chunks end on multiples of `chunk` counted from the chain's start, so
+        # a run continued from a state file repeats an uninterrupted run exactly
+        n = min(chunk - step % chunk, p["max_steps"] - step)
         chunk_start = pos.copy()
         done, code, info = K.relax(
             pos, vel, weight, walls, box, p["wl_u"], p["wr_u"], p["pl_u"], p["pr_u"],

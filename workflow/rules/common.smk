@@ -20,11 +20,14 @@ def run_overrides(wildcards):
     return " ".join(f"--set '{s}'" for s in RUNS[wildcards.run].get("set", []))
 
 
-def start_file(scene_path):
-    """The run file a scene continues from (particles.from_run), if any."""
+def start_file(run):
+    """The run file a run continues from (particles.from_run, after overrides), if any."""
     import yaml
 
-    with open(scene_path) as fh:
+    for item in RUNS[run].get("set", []):
+        if item.startswith("particles.from_run="):
+            return [item.split("=", 1)[1]]
+    with open(RUNS[run]["scene"]) as fh:
         src = yaml.safe_load(fh).get("particles", {}).get("from_run")
     return [src] if src else []
 

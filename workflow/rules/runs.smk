@@ -4,7 +4,7 @@
 rule run:
     input:
         scene=lambda wc: RUNS[wc.run]["scene"],
-        start=lambda wc: start_file(RUNS[wc.run]["scene"]),
+        start=lambda wc: start_file(wc.run),
     output:
         "results/runs/{run}.nc",
     params:

@@ -1,0 +1,68 @@
+# Applications 3-6: flow into the second vessel, Figures 9-10, flow history, Table 1.
+FLOW = config["flow"]
+TABLE1_RUNS = sorted({run for row in config["table1"] for run in row["chain"]})
+
+
+rule fig_flow:
+    input:
+        lambda wc: run_file(FIGS[wc.name]),
+    output:
+        figure("{name}"),
+    params:
+        func=lambda wc: {"fig09_flow_incomplete": "flow_incomplete_figure", "fig10_flow_complete": "flow_complete_figure"}[wc.name],
+        kw={"paper": FLOW["paper"]},
+    log:
+        "logs/figures/{name}.log",
+    wildcard_constraints:
+        name="fig09_flow_incomplete|fig10_flow_complete",
+    script:
+        "../scripts/plot.py"
+
+
+rule fig_flow_history:
+    input:
+        sorted({run_file(r) for chain in FLOW["chains"].values() for r in chain}),
+    output:
+        figure("flow_history"),
+    params:
+        func="flow_history_figure",
+        kw={"chains": FLOW["chains"]},
+    log:
+        "logs/figures/flow_history.log",
+    script:
+        "../scripts/plot.py"
+
+
+rule table1:
+    input:
+        runs=[run_file(r) for r in TABLE1_RUNS],
+        benchmarks=[f"results/benchmarks/run/{r}.tsv" for r in TABLE1_RUNS],
+    output:
+        csv="figures/table1.csv",
+        md="figures/table1.md",
+    log:
+        "logs/table1.log",
+    params:
+        rows=config["table1"],
+    script:
+        "../scripts/table1.py"
+
+
+rule report_flow:
+    input:
+        metrics="results/metrics.csv",
+        table1="figures/table1.csv",
+        config="config/config.yaml",
+    output:
+        "results/report/20_flow.md",
+    params:
+        func="flow_section",
+    log:
+        "logs/report/flow.log",
+    script:
+        "../scripts/report.py"
+
+
+REPORT_PARTS += ["results/report/20_flow.md"]
+ALL_TARGETS += figure("fig09_flow_incomplete") + figure("fig10_flow_complete") + figure("flow_history")
+ALL_TARGETS += ["figures/table1.csv", "figures/table1.md"]
