@@ -142,7 +142,27 @@ def run_row(ds, vessel=None):
     row["loads_vessel"] = vessel or "all"
     row.update(load_errors(ds, vessel))
     row["stress_ratio"] = stress_ratio(ds, vessel)
+    row.update(convergence_measures(ds))
     return row
+
+
+DENSE_LIMIT = 1000  # particles: largest run whose stiffness matrix is diagonalised
+
+
+def convergence_measures(ds):
+    """lambda_max [N/cm] of the final state's stiffness matrix and the literal
+    update's stability floor lambda_max du / 2 [N] (theory.step_floor; NaN above
+    DENSE_LIMIT particles), and the max|F| band [N] of the last records."""
+    a = ds.attrs
+    out = {"lambda_max": np.nan, "stability_floor_N": np.nan, "band_lo_N": np.nan, "band_hi_N": np.nan}
+    if ds.sizes["particle"] <= DENSE_LIMIT:
+        lam, floor = theory.step_floor(ds["pos"].values, ds["wall_segment"].values, a["wall_l_u"], a["wall_r_u"],
+                                       a["pair_l_u"], a["pair_r_u"], a["du"])
+        out.update(lambda_max=lam, stability_floor_N=floor)
+    if "hist_fmax_lo" in ds:
+        out.update(band_lo_N=float(ds["hist_fmax_lo"].values[-10:].min()),
+                   band_hi_N=float(ds["hist_fmax_hi"].values[-10:].max()))
+    return out
 
 
 def flow_measures(ds):
@@ -221,3 +241,93 @@ def tolerances(row, a, n_particles, f_tol):
         "side": ((a / 4) / h, "(a/4)/h: the side total W h/(2B) inherits the level's uncertainty"),
         "side_height": (a / 4, "half the a/2 spacing of the side contacts"),
     }
+
+
+# --- single-vessel error measures of the error-vs-run-time study --------------
+
+
+def contact_errors(ds, vessel=None):
+    """Per-contact wall-load errors of a vessel, in units of one floor-contact load.
+
+    (computed - theoretical) / (gamma h a) for every wetted contact (theory from
+    theory.contact_theory, gamma and h from load_errors); (C,) array, empty if
+    the vessel has no wetted contact.
+    """
+    v = vessel_view(ds, vessel)
+    e = load_errors(ds, vessel)
+    walls = ds["wall_segment"].values
+    mag = np.hypot(*ds["contact_force"].values.T)
+    th = theory.contact_theory(walls, ds["contact_wall"].values, ds["contact_point"].values, e["gamma"], e["level"],
+                               v["wall_in"])
+    wet = np.isfinite(th)
+    unit = e["gamma"] * (e["level"] - v["floor_y"]) * float(ds.attrs["lattice_a"])
+    return (mag[wet] - th[wet]) / unit
+
+
+def hydrostatic_errors(ds, paper_level=None, vessel=None):
+    """Error measures of a single-vessel equilibrium against the paper and hydrostatics.
+
+    Keys (units in the names; relative errors are fractions):
+    - level_cm: free-surface level (theory.free_surface_level);
+    - level_err_paper_cm: level - paper_level, the level the paper reports for
+      this configuration (NaN when it reports none);
+    - level_err_hydro_cm: level - level_implied, where level_implied = 2 B F_side / W
+      is the level a hydrostatic liquid of the same weight W needs to load the
+      side walls (width B) as computed: zero when level and side loads agree;
+    - wall_err_<wall>: (computed total - theory) / theory of every wall the
+      liquid wets (theory.wall_total); wall_err_max: the largest |wall_err_*|;
+    - floor_err, side_err: as load_errors (floor; mean over the side walls);
+    - contact_rms, contact_max: RMS and largest |contact_errors| (units of one
+      floor-contact load gamma h a);
+    - side_height_err_cm: height of the side-wall resultant minus h / 3;
+    - residual_N: final max|F|, the solver's own convergence measure.
+    """
+    e = load_errors(ds, vessel)
+    v = vessel_view(ds, vessel)
+    out = dict(level_cm=e["level"],
+               level_err_paper_cm=e["level"] - paper_level if paper_level is not None else np.nan,
+               level_err_hydro_cm=e["level"] - e["level_implied"])
+    errs = []
+    for w, name in enumerate(str(n) for n in ds["wall"].values):
+        th = e.get(f"theory_{name}")
+        if v["wall_in"][w] and th:
+            out[f"wall_err_{name}"] = (e[f"load_{name}"] - th) / th
+            errs.append(abs(out[f"wall_err_{name}"]))
+    out["wall_err_max"] = max(errs) if errs else np.nan
+    out["floor_err"] = e.get("floor_err", np.nan)
+    out["side_err"] = e["side_err"]
+    c = contact_errors(ds, vessel)
+    out["contact_rms"] = float(np.sqrt(np.mean(c**2))) if len(c) else np.nan
+    out["contact_max"] = float(np.abs(c).max()) if len(c) else np.nan
+    out["side_height_err_cm"] = e["side_height_err"]
+    out["residual_N"] = float(ds["max_force"])
+    return out
+
+
+def law_usage(ds):
+    """How much of the force laws' range the final state uses (1 = exhausted).
+
+    wall_use = largest wall reaction / R_bu (1: a particle sits on a wall, which
+    can push no harder); pair_use = largest pair force / R_pu (1: two particles
+    coincide); min_pair_cm: smallest inter-particle distance (NaN without a
+    pair in range).  All NaN when positions are not finite.
+    """
+    from . import kernels as K
+
+    pos = ds["pos"].values
+    a = ds.attrs
+    out = dict(wall_use=np.nan, pair_use=np.nan, min_pair_cm=np.nan)
+    if not np.isfinite(pos).all():
+        return out
+    mag = np.hypot(*ds["contact_force"].values.T)
+    out["wall_use"] = float(mag.max() / a["wall_r_u"]) if len(mag) else 0.0
+    l_u = float(a["pair_l_u"])
+    box = np.array([pos[:, 0].min(), pos[:, 1].min(), pos[:, 0].max() + 1e-9, pos[:, 1].max() + 1e-9])
+    pi, pj, m = K.build_pairs(pos, box, l_u)
+    if m:
+        d = np.hypot(*(pos[pi[:m]] - pos[pj[:m]]).T)
+        out["min_pair_cm"] = float(d.min())
+        out["pair_use"] = float(1.0 - d.min() / l_u)
+    else:
+        out["pair_use"] = 0.0
+    return out

@@ -7,6 +7,14 @@ RUNS = config["runs"]
 ALL_TARGETS = []
 
 
+def code(*modules):
+    """Package source files a rule depends on, so editing them reruns the rule."""
+    return [f"src/isaflow/{m}.py" for m in modules]
+
+
+SOLVER_CODE = code("kernels", "solver", "scene", "runfile", "cli")
+
+
 def figure(name):
     """PNG and PDF paths of a figure."""
     return [f"figures/{name}.png", f"figures/{name}.pdf"]

@@ -5,7 +5,8 @@ TABLE1_RUNS = sorted({run for row in config["table1"] for run in row["chain"]})
 
 rule fig_flow:
     input:
-        lambda wc: run_file(FIGS[wc.name]),
+        runs=lambda wc: [run_file(FIGS[wc.name])],
+        code=code("figures/__init__", "figures/style", "figures/single", "figures/flow", "metrics", "theory"),
     output:
         figure("{name}"),
     params:
@@ -21,7 +22,8 @@ rule fig_flow:
 
 rule fig_flow_history:
     input:
-        sorted({run_file(r) for chain in FLOW["chains"].values() for r in chain}),
+        runs=sorted({run_file(r) for chain in FLOW["chains"].values() for r in chain}),
+        code=code("figures/__init__", "figures/style", "figures/single", "figures/flow", "metrics", "theory"),
     output:
         figure("flow_history"),
     params:
@@ -37,6 +39,7 @@ rule table1:
     input:
         runs=[run_file(r) for r in TABLE1_RUNS],
         benchmarks=[f"results/benchmarks/run/{r}.tsv" for r in TABLE1_RUNS],
+        code=code("tables", "report"),
     output:
         csv="figures/table1.csv",
         md="figures/table1.md",
@@ -53,6 +56,7 @@ rule report_flow:
         metrics="results/metrics.csv",
         table1="figures/table1.csv",
         config="config/config.yaml",
+        code=code("report", "metrics"),
     output:
         "results/report/20_flow.md",
     params:

@@ -4,7 +4,8 @@
 
 rule metrics:
     input:
-        [run_file(r) for r in METRIC_RUNS],
+        runs=[run_file(r) for r in METRIC_RUNS],
+        code=code("metrics", "theory"),
     output:
         "results/metrics.csv",
     log:
@@ -18,6 +19,7 @@ rule report_single:
         metrics="results/metrics.csv",
         calibration="results/calibration.csv",
         config="config/config.yaml",
+        code=code("report", "metrics"),
     output:
         "results/report/10_single.md",
     params:
@@ -32,6 +34,7 @@ rule report_inferred:
     input:
         inferred="config/inferred.yaml",
         scenes=sorted({r["scene"] for r in RUNS.values()}),
+        code=code("report"),
     output:
         "results/report/90_inferred.md",
     log:
@@ -47,7 +50,8 @@ REPORT_PARTS += ["results/report/10_single.md", "results/report/90_inferred.md"]
 
 rule replication_report:
     input:
-        REPORT_PARTS,
+        parts=REPORT_PARTS,
+        code=code("report"),
     output:
         "docs/replication.md",
     log:
@@ -55,7 +59,7 @@ rule replication_report:
     run:
         from isaflow import report
 
-        report.assemble(input, output[0])
+        report.assemble(input.parts, output[0])
 
 
 ALL_TARGETS += ["results/metrics.csv", "docs/replication.md"]

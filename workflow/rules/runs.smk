@@ -5,6 +5,7 @@ rule run:
     input:
         scene=lambda wc: RUNS[wc.run]["scene"],
         start=lambda wc: start_file(wc.run),
+        code=SOLVER_CODE,
     output:
         "results/runs/{run}.nc",
     params:

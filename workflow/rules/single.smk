@@ -28,6 +28,7 @@ def calibration_overrides(wc):
 rule calibration_run:
     input:
         scene=lambda wc: RUNS[wc.run]["scene"],
+        code=SOLVER_CODE,
     output:
         "results/calibration/{run}_kb{kb}_r{ratio}.nc",
     params:
@@ -42,7 +43,8 @@ rule calibration_run:
 
 rule calibration_table:
     input:
-        CAL_FILES,
+        runs=CAL_FILES,
+        code=code("metrics", "theory"),
     output:
         "results/calibration.csv",
     log:
@@ -56,7 +58,8 @@ FIGS = config["figures"]
 
 rule fig_inputs:
     input:
-        lambda wc: run_file(FIGS[wc.name]),
+        runs=lambda wc: [run_file(FIGS[wc.name])],
+        code=code("figures/__init__", "figures/style", "figures/single", "figures/flow", "metrics", "theory"),
     output:
         figure("{name}"),
     params:
@@ -71,7 +74,8 @@ rule fig_inputs:
 
 rule fig_single:
     input:
-        lambda wc: run_file(FIGS[wc.name]),
+        runs=lambda wc: [run_file(FIGS[wc.name])],
+        code=code("figures/__init__", "figures/style", "figures/single", "figures/flow", "metrics", "theory"),
     output:
         figure("{name}"),
     params:
@@ -87,12 +91,13 @@ rule fig_single:
 
 rule fig_calibration:
     input:
-        CAL_FILES,
+        runs=CAL_FILES,
+        code=code("figures/__init__", "figures/style", "figures/single", "figures/flow", "metrics", "theory"),
     output:
         figure("calibration_free_surface"),
     params:
         func="calibration_figure",
-        kw={"paper_levels": {k: v["level"] for k, v in config["paper"].items()}},
+        kw={"paper_levels": {k: v["level"] for k, v in config["paper"].items()}, "adopted": CAL["adopted"]},
     log:
         "logs/figures/calibration_free_surface.log",
     script:
@@ -101,7 +106,8 @@ rule fig_calibration:
 
 rule fig_convergence:
     input:
-        [run_file(r) for r in ["single_coarse", "single_coarse_capped", "single_refined", "single_refined_capped"]],
+        runs=[run_file(r) for r in ["single_coarse", "single_coarse_capped", "single_refined", "single_refined_capped"]],
+        code=code("figures/__init__", "figures/style", "figures/single", "figures/flow", "metrics", "theory"),
     output:
         figure("convergence_single"),
     params:

@@ -5,4 +5,5 @@ sys.stderr = open(snakemake.log[0], "w")  # noqa: F821
 
 from isaflow import report  # noqa: E402
 
-getattr(report, snakemake.params.func)(**dict(snakemake.input), out=snakemake.output[0])  # noqa: F821
+inputs = {k: v for k, v in snakemake.input.items() if k != "code"}  # noqa: F821
+getattr(report, snakemake.params.func)(**inputs, out=snakemake.output[0])  # noqa: F821

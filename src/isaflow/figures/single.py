@@ -47,7 +47,8 @@ def inputs_figure(inputs, outputs):
     axb.text(c[0] + 0.18 * a, 0.5 * (floor_y + c[1] - a / 2), f"{c[1] - a / 2 - floor_y:.3g} cm to wall\n"
              f"($l_{{bu}}$ = {wl:.3g} cm)", va="center")
     axb.text(c[0], c[1] + 0.04 * a, f"a = {a:g} cm", ha="center", va="bottom")
-    axb.text(c[0] + 0.27 * a, c[1] + 0.27 * a, f"a/√2 = {a / np.sqrt(2):.3g} cm", rotation=-45)
+    axb.text(c[0] + 0.3 * a, c[1] + 0.3 * a, f"a/√2 = {a / np.sqrt(2):.3g} cm", rotation=-45, ha="center",
+             va="center")
     axb.set_aspect("equal")
     axb.set_xlim(-0.8 * a, 0.8 * a)
     axb.set_xlabel("x (cm)")
@@ -135,8 +136,10 @@ def single_vessel_figure(inputs, outputs, paper_level=None):
     save(fig, outputs)
 
 
-def calibration_figure(inputs, outputs, paper_levels=None):
-    """Free-surface level against wall stiffness and stiffness ratio, per resolution."""
+def calibration_figure(inputs, outputs, paper_levels=None, adopted=None):
+    """Free-surface level against wall stiffness and stiffness ratio, per resolution.
+
+    adopted: {k_wall, ratio} of the scenes' reading, starred in every panel."""
     tab = metrics.calibration_table(inputs)
     scenes = list(dict.fromkeys(tab["run"]))
     fig, axes = plt.subplots(1, len(scenes), figsize=(5.2 * len(scenes), 4.4), sharey=True, squeeze=False)
@@ -151,7 +154,14 @@ def calibration_figure(inputs, outputs, paper_levels=None):
         base = sc.removesuffix("_lbu25")
         if paper_levels and base in paper_levels:
             ax.axhline(paper_levels[base], color=PAPER, ls=":", label=f"paper {paper_levels[base]:g} cm")
+        if adopted:
+            pick = t[(t["k_wall"] == adopted["k_wall"]) & (t["ratio"] == adopted["ratio"])]
+            ax.plot(pick["k_wall"], pick["level"], "*", ms=16, mfc="none", color="k",
+                    label=f"adopted: k_b = {adopted['k_wall']:g} N/cm, k_p/k_b = {adopted['ratio']:g}")
         ax.set_xscale("log")
+        ks = sorted(t["k_wall"].unique())
+        ax.set_xticks(ks, [f"{k:g}" for k in ks])
+        ax.minorticks_off()
         ax.set_xlabel("wall stiffness $k_b = R_{bu}/l_{bu}$ (N/cm)")
         ax.set_title(f"{sc} ({t['variant'].iloc[0]} variant)")
         ax.legend(fontsize=8)
