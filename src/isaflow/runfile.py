@@ -97,6 +97,8 @@ def to_dataset(scene, run, weight, started, finished, prov):
     if len(run.chunk_walls):
         data["hist_wall_resultant"] = _var(("sample", "wall", "xy"), run.chunk_walls, "N",
                                            "resultant force of wall on liquid over the run")
+        data["hist_sum_fx"] = _var(("sample",), run.chunk_walls[:, :, 0].sum(1), "N",
+                                   "horizontal resultant of all wall reactions (0 in equilibrium)")
     if len(run.chunk_vessels) and vessels:
         data["hist_vessel_count"] = _var(("sample", "vessel"), run.chunk_vessels, "1", "particles per vessel")
     if len(run.snap_step):

@@ -114,7 +114,7 @@ def flow_history_figure(inputs, outputs, chains=None):
                 for name, color in zip(ds["vessel"].values, ("tab:green", "k")):
                     ax_n.plot(st, ds["hist_vessel_count"].sel(vessel=name), color=color,
                               label=f"{name} vessel" if stem == stems[1] else None)
-                ax_f.plot(st, ds["hist_wall_resultant"].sel(xy="x").sum("wall"), color=COMPUTED)
+                ax_f.plot(st, ds["hist_sum_fx"], color=COMPUTED)
             ax_m.axvline(int(ds["start_step"]), color="gray", ls=":", lw=0.8)
             ax_m.text(int(ds["start_step"]), 1e3, f" {stem}\n {ds.attrs['variant']}", fontsize=6, va="top")
         ax_n.set_ylabel("particles")
