@@ -52,3 +52,23 @@ def scene_law(scene_path, which):
 # runs whose metrics go into results/metrics.csv (rule files append to it)
 METRIC_RUNS = list(RUNS)
 REPORT_PARTS = []
+
+
+CAL = config["calibration"]
+
+
+def calibration_overrides(wc):
+    """Scene overrides of one calibration point: k_b = kb, k_p = ratio kb."""
+    scene = RUNS[wc.run]["scene"]
+    wl_u, _ = scene_law(scene, "wall")
+    pl_u, _ = scene_law(scene, "pair")
+    kb, ratio = float(wc.kb), float(wc.ratio)
+    sets = [
+        f"forces.wall.r_u={kb * wl_u}",
+        f"forces.pair.r_u={kb * ratio * pl_u}",
+        f"solver.variant={CAL['variant']}",
+        f"solver.max_steps={CAL['max_steps']}",
+        "solver.accept=[converged,cycle,step_limit]",
+        "solver.history={}",
+    ]
+    return " ".join(f"--set '{s}'" for s in sets)

@@ -1,28 +1,10 @@
 # Single-vessel applications 1-2: Figures 5-8, free-surface calibration, convergence.
-CAL = config["calibration"]
 CAL_FILES = [
     f"results/calibration/{run}_kb{kb:g}_r{ratio:g}.nc"
     for run in CAL["runs"]
     for kb in CAL["wall_stiffness"]
     for ratio in CAL["stiffness_ratio"]
 ]
-
-
-def calibration_overrides(wc):
-    """Scene overrides of one calibration point: k_b = kb, k_p = ratio kb."""
-    scene = RUNS[wc.run]["scene"]
-    wl_u, _ = scene_law(scene, "wall")
-    pl_u, _ = scene_law(scene, "pair")
-    kb, ratio = float(wc.kb), float(wc.ratio)
-    sets = [
-        f"forces.wall.r_u={kb * wl_u}",
-        f"forces.pair.r_u={kb * ratio * pl_u}",
-        f"solver.variant={CAL['variant']}",
-        f"solver.max_steps={CAL['max_steps']}",
-        "solver.accept=[converged,cycle,step_limit]",
-        "solver.history={}",
-    ]
-    return " ".join(f"--set '{s}'" for s in sets)
 
 
 rule calibration_run:
