@@ -203,6 +203,224 @@ def crossed_wall(x0, y0, x1, y1, walls):
 
 
 @njit(**JIT)
+def _cell_rows(pos, box, rc, cpart, cstart, start, nbr):
+    """The pair list of :func:`build_pairs`, in the same order, stored by rows.
+
+    The particles are counting-sorted into the same cells; cpart (N,) int32
+    receives them cell by cell (ascending within a cell, i.e. the order in
+    which :func:`build_pairs` visits them), cstart (ncx ncy + 1,) int32 the
+    cell boundaries in cpart.  Row q holds the pairs (cpart[q], nbr[k]) for
+    start[q] <= k < start[q + 1], in :func:`build_pairs`' order.  nbr (cap,)
+    int32 is reused and returned (grown when full); cstart is returned too
+    (reallocated if the grid changed size).
+    """
+    n = pos.shape[0]
+    ncx = max(1, int((box[2] - box[0]) / rc))
+    ncy = max(1, int((box[3] - box[1]) / rc))
+    csx = (box[2] - box[0]) / ncx
+    csy = (box[3] - box[1]) / ncy
+    nc = ncx * ncy
+    if cstart.shape[0] != nc + 1:
+        cstart = np.empty(nc + 1, np.int32)
+    cstart[:] = 0
+    cell = start[:n]  # scratch: start is rewritten below, after the cells are used
+    for i in range(n):
+        cx = min(ncx - 1, max(0, int((pos[i, 0] - box[0]) / csx)))
+        cy = min(ncy - 1, max(0, int((pos[i, 1] - box[1]) / csy)))
+        c = cy * ncx + cx
+        cell[i] = c
+        cstart[c + 1] += 1
+    for c in range(nc):
+        cstart[c + 1] += cstart[c]
+    # stable fill: ascending particles within each cell
+    for i in range(n):
+        c = cell[i]
+        cpart[cstart[c]] = i
+        cstart[c] += 1
+    for c in range(nc, 0, -1):
+        cstart[c] = cstart[c - 1]
+    cstart[0] = 0
+    rc2 = rc * rc
+    m = 0
+    for cy in range(ncy):
+        for cx in range(ncx):
+            c = cy * ncx + cx
+            for q in range(cstart[c], cstart[c + 1]):
+                i = cpart[q]
+                start[q] = m
+                xi = pos[i, 0]
+                yi = pos[i, 1]
+                # half stencil: own cell (later entries), E, NW, N, NE
+                for k in range(5):
+                    if k == 0:
+                        a = q + 1
+                        b = cstart[c + 1]
+                    else:
+                        nx_ = cx + (1, -1, 0, 1)[k - 1]
+                        ny_ = cy + (0, 1, 1, 1)[k - 1]
+                        if nx_ < 0 or nx_ >= ncx or ny_ >= ncy:
+                            continue
+                        a = cstart[ny_ * ncx + nx_]
+                        b = cstart[ny_ * ncx + nx_ + 1]
+                    for r in range(a, b):
+                        j = cpart[r]
+                        dx = xi - pos[j, 0]
+                        dy = yi - pos[j, 1]
+                        if dx * dx + dy * dy < rc2:
+                            if m == nbr.shape[0]:
+                                grown = np.empty(2 * m + 16, np.int32)
+                                grown[:m] = nbr[:m]
+                                nbr = grown
+                            nbr[m] = j
+                            m += 1
+    start[n] = m
+    return nbr, cstart
+
+
+@njit(**JIT)
+def _wall_candidates(pos, walls, reach):
+    """(particle, wall) int32 pairs, ascending, with the particle closer than reach to the wall."""
+    n = pos.shape[0]
+    nw = walls.shape[0]
+    r2 = reach * reach
+    ci = np.empty(64, np.int32)
+    cw = np.empty(64, np.int32)
+    c = 0
+    for i in range(n):
+        for w in range(nw):
+            cx, cy = segment_closest(pos[i, 0], pos[i, 1], walls[w, 0], walls[w, 1], walls[w, 2], walls[w, 3])
+            dx = pos[i, 0] - cx
+            dy = pos[i, 1] - cy
+            if dx * dx + dy * dy < r2:
+                if c == ci.shape[0]:
+                    ci2 = np.empty(2 * c, np.int32)
+                    cw2 = np.empty(2 * c, np.int32)
+                    ci2[:c] = ci[:c]
+                    cw2[:c] = cw[:c]
+                    ci = ci2
+                    cw = cw2
+                ci[c] = i
+                cw[c] = w
+                c += 1
+    return ci[:c], cw[:c]
+
+
+@njit(**JIT)
+def _move_init(ps, gs, scale, move, ws, walls, wl_u, wr_u, ci, cw, fs):
+    """If move: ps += scale * gs.  Then fs = weight + wall forces at ps (one pass).
+
+    Walls are taken from the candidate list (ci, cw) only: the other walls
+    would add exact zeros, so fs is the same as in :func:`forces`.
+    """
+    n = ps.shape[0]
+    c = 0
+    nc = ci.shape[0]
+    for q in range(n):
+        if move:
+            ps[q, 0] = ps[q, 0] + scale * gs[q, 0]
+            ps[q, 1] = ps[q, 1] + scale * gs[q, 1]
+        fx = 0.0
+        fy = -ws[q]
+        while c < nc and ci[c] == q:
+            w = cw[c]
+            gx, gy = wall_push(ps[q, 0], ps[q, 1], walls[w, 0], walls[w, 1], walls[w, 2], walls[w, 3], wl_u, wr_u)
+            fx += gx
+            fy += gy
+            c += 1
+        fs[q, 0] = fx
+        fs[q, 1] = fy
+
+
+@njit(**JIT)
+def _pair_pass(ps, pl_u, pr_u, start, nbr, fs):
+    """Add the pair forces of the row list to fs; returns max|F| as :func:`forces` does.
+
+    Arrays are in list (cell) order: row q belongs to particle q.  Rows are
+    visited in list order and each row's pairs in order, so every force
+    component receives the same additions in the same order as in
+    :func:`forces` with :func:`build_pairs`' list.  A row's particle is
+    complete after its row (the rows that reach it come from its own cell,
+    earlier entries, and from the cells W, SW, S, SE, which all come first),
+    so max|F| is taken on the fly (the finiteness check sums |F| in list
+    order rather than particle order: the same verdict for any forces short
+    of a sum overflowing 1.8e308 N).
+    """
+    fmax = 0.0
+    check = 0.0
+    for q in range(ps.shape[0]):
+        xi = ps[q, 0]
+        yi = ps[q, 1]
+        fx = fs[q, 0]
+        fy = fs[q, 1]
+        for k in range(start[q], start[q + 1]):
+            j = nbr[k]
+            gx, gy = pair_push(xi - ps[j, 0], yi - ps[j, 1], pl_u, pr_u)
+            fx += gx
+            fy += gy
+            fs[j, 0] -= gx
+            fs[j, 1] -= gy
+        fs[q, 0] = fx
+        fs[q, 1] = fy
+        a = abs(fx)
+        b = abs(fy)
+        check += a + b
+        if a > fmax:
+            fmax = a
+        if b > fmax:
+            fmax = b
+    if not np.isfinite(check):
+        return np.nan
+    return fmax
+
+
+@njit(**JIT)
+def _first_crossing(ps, gs, scale, walls, cpart, ci, use_all):
+    """(particle, wall) of the lowest-numbered particle whose move ps += scale * gs
+    crosses a wall, or (-1, -1).  Only the candidates ci (list order) are
+    tested unless use_all; particle numbers are the caller's (cpart[q])."""
+    best = -1
+    bw = -1
+    last = -1
+    for c in range(ps.shape[0] if use_all else ci.shape[0]):
+        q = c if use_all else ci[c]
+        if q == last:
+            continue
+        last = q
+        i = cpart[q]
+        if best >= 0 and i > best:
+            continue
+        w = crossed_wall(ps[q, 0], ps[q, 1], ps[q, 0] + scale * gs[q, 0], ps[q, 1] + scale * gs[q, 1], walls)
+        if w >= 0:
+            best = i
+            bw = w
+    return best, bw
+
+
+@njit(**JIT)
+def _sort_state(pos, vel, weight, cpart, nbr, m, inv, ps, vs, ws):
+    """Gather the state into list order (ps, vs, ws) and renumber nbr[:m] to it."""
+    for q in range(pos.shape[0]):
+        i = cpart[q]
+        inv[i] = q
+        ps[q, 0] = pos[i, 0]
+        ps[q, 1] = pos[i, 1]
+        vs[q, 0] = vel[i, 0]
+        vs[q, 1] = vel[i, 1]
+        ws[q] = weight[i]
+    for k in range(m):
+        nbr[k] = inv[nbr[k]]
+
+
+@njit(**JIT)
+def _unsort(cpart, src, dst):
+    """dst[cpart[q]] = src[q]."""
+    for q in range(src.shape[0]):
+        i = cpart[q]
+        dst[i, 0] = src[q, 0]
+        dst[i, 1] = src[q, 1]
+
+
+@njit(**JIT)
 def relax(pos, vel, weight, walls, box, wl_u, wr_u, pl_u, pr_u, variant, du, f_ref,
           dt_max, f_tol, n_steps, skin, f, fmax_hist):
     """Run up to n_steps relaxation steps in place; the whole loop is compiled.
@@ -219,34 +437,67 @@ def relax(pos, vel, weight, walls, box, wl_u, wr_u, pl_u, pr_u, variant, du, f_r
     Returns (steps_done, status, info): status CONVERGED when max|F| < f_tol,
     NONFINITE on NaN/inf, CROSSED if a step would carry a particle across a
     wall (info = particle * W + wall; the step is not taken); else RUNNING.
+
+    Implementation (results identical, to the last bit, to the plain loop
+    "move; rebuild with :func:`build_pairs` if due; :func:`forces`"): the
+    pair list is that of :func:`build_pairs`, in the same order, stored by
+    rows, and the state is kept in that (cell) order between builds, so the
+    passes stream through memory; the caller's arrays are written back on
+    return.  The move and the weight + wall forces share one pass; wall
+    forces and the crossing test only visit particles that were within
+    wl_u + skin of a wall at the last build (no other particle can come
+    within wl_u of a wall, or reach one, before the next build; if one step
+    could reach farther, every particle is tested).
     """
     n = pos.shape[0]
-    pi, pj, m = build_pairs(pos, box, pl_u + skin)
+    nw = walls.shape[0]
+    rc = pl_u + skin
+    reach = wl_u + skin
+    cpart = np.empty(n, np.int32)
+    inv = np.empty(n, np.int32)
+    start = np.empty(n + 1, np.int32)
+    ps = np.empty((n, 2))
+    vs = np.empty((n, 2))
+    fs = np.empty((n, 2))
+    ws = np.empty(n)
+    nbr, cstart = _cell_rows(pos, box, rc, cpart, np.empty(1, np.int32), start, np.empty(4 * n + 16, np.int32))
+    _sort_state(pos, vel, weight, cpart, nbr, start[n], inv, ps, vs, ws)
+    ci, cw = _wall_candidates(ps, walls, reach)
     moved = 0.0
-    fmax = forces(pos, weight, walls, wl_u, wr_u, pl_u, pr_u, pi, pj, m, f)
+    _move_init(ps, fs, 0.0, False, ws, walls, wl_u, wr_u, ci, cw, fs)
+    fmax = _pair_pass(ps, pl_u, pr_u, start, nbr, fs)
     # FIRE state (Bitzek et al. 2006 default constants)
     dt = 0.1 * dt_max
     alpha = 0.1
     n_pos = 0
+    status = RUNNING
+    info = -1
+    done = n_steps
     for step in range(n_steps):
         fmax_hist[step] = fmax
         if not np.isfinite(fmax):
-            return step, NONFINITE, -1
+            status = NONFINITE
+            done = step
+            break
         if fmax < f_tol:
-            return step, CONVERGED, -1
+            status = CONVERGED
+            done = step
+            break
         if variant == FIRE:
+            # sums in the caller's particle order, as in the plain loop
             p = 0.0
             vn = 0.0
             fn = 0.0
             for i in range(n):
-                p += vel[i, 0] * f[i, 0] + vel[i, 1] * f[i, 1]
-                vn += vel[i, 0] ** 2 + vel[i, 1] ** 2
-                fn += f[i, 0] ** 2 + f[i, 1] ** 2
+                q = inv[i]
+                p += vs[q, 0] * fs[q, 0] + vs[q, 1] * fs[q, 1]
+                vn += vs[q, 0] ** 2 + vs[q, 1] ** 2
+                fn += fs[q, 0] ** 2 + fs[q, 1] ** 2
             if p > 0.0:
                 c = alpha * np.sqrt(vn / fn)
-                for i in range(n):
-                    vel[i, 0] = (1.0 - alpha) * vel[i, 0] + c * f[i, 0]
-                    vel[i, 1] = (1.0 - alpha) * vel[i, 1] + c * f[i, 1]
+                for q in range(n):
+                    vs[q, 0] = (1.0 - alpha) * vs[q, 0] + c * fs[q, 0]
+                    vs[q, 1] = (1.0 - alpha) * vs[q, 1] + c * fs[q, 1]
                 n_pos += 1
                 if n_pos > 5:
                     dt = min(1.1 * dt, dt_max)
@@ -255,45 +506,52 @@ def relax(pos, vel, weight, walls, box, wl_u, wr_u, pl_u, pr_u, variant, du, f_r
                 n_pos = 0
                 dt *= 0.5
                 alpha = 0.1
-                vel[:, :] = 0.0
+                vs[:, :] = 0.0
             # semi-implicit Euler with the step capped at du
             vmax = 0.0
-            for i in range(n):
-                vel[i, 0] += dt * f[i, 0]
-                vel[i, 1] += dt * f[i, 1]
-                vmax = max(vmax, abs(vel[i, 0]), abs(vel[i, 1]))
+            for q in range(n):
+                vs[q, 0] += dt * fs[q, 0]
+                vs[q, 1] += dt * fs[q, 1]
+                vmax = max(vmax, abs(vs[q, 0]), abs(vs[q, 1]))
             scale = dt
             if vmax * dt > du:
                 scale = du / vmax
-            sx = 0.0
-            sy = 0.0
+            gs = vs
+            inc = np.sqrt(2.0) * du
         else:
             scale = du / fmax if variant == PAPER else du / max(fmax, f_ref)
-        # move, refusing any move across a wall
-        for i in range(n):
-            if variant == FIRE:
-                sx = scale * vel[i, 0]
-                sy = scale * vel[i, 1]
-            else:
-                sx = scale * f[i, 0]
-                sy = scale * f[i, 1]
-            x1 = pos[i, 0] + sx
-            y1 = pos[i, 1] + sy
-            w = crossed_wall(pos[i, 0], pos[i, 1], x1, y1, walls)
-            if w >= 0:
-                for k in range(i):  # undo: the step is not taken
-                    g = vel if variant == FIRE else f
-                    pos[k, 0] -= scale * g[k, 0]
-                    pos[k, 1] -= scale * g[k, 1]
-                return step, CROSSED, i * walls.shape[0] + w
-            pos[i, 0] = x1
-            pos[i, 1] = y1
-        moved += np.sqrt(2.0) * (du if variant == FIRE else scale * fmax)
+            gs = fs
+            inc = np.sqrt(2.0) * (scale * fmax)
+        # refuse any move across a wall (moved bounds every displacement since the build)
+        i, w = _first_crossing(ps, gs, scale, walls, cpart, ci, not (moved + inc < reach))
+        if i >= 0:
+            for k in range(i):  # as if particles before i had moved and been moved back
+                q = inv[k]
+                ps[q, 0] = (ps[q, 0] + scale * gs[q, 0]) - scale * gs[q, 0]
+                ps[q, 1] = (ps[q, 1] + scale * gs[q, 1]) - scale * gs[q, 1]
+            status = CROSSED
+            info = i * nw + w
+            done = step
+            break
+        moved += inc
         if moved > 0.5 * skin:
-            pi, pj, m = build_pairs(pos, box, pl_u + skin)
+            for q in range(n):
+                ps[q, 0] = ps[q, 0] + scale * gs[q, 0]
+                ps[q, 1] = ps[q, 1] + scale * gs[q, 1]
+            _unsort(cpart, ps, pos)
+            _unsort(cpart, vs, vel)
+            nbr, cstart = _cell_rows(pos, box, rc, cpart, cstart, start, nbr)
+            _sort_state(pos, vel, weight, cpart, nbr, start[n], inv, ps, vs, ws)
+            ci, cw = _wall_candidates(ps, walls, reach)
             moved = 0.0
-        fmax = forces(pos, weight, walls, wl_u, wr_u, pl_u, pr_u, pi, pj, m, f)
-    return n_steps, RUNNING, -1
+            _move_init(ps, gs, scale, False, ws, walls, wl_u, wr_u, ci, cw, fs)
+        else:
+            _move_init(ps, gs, scale, True, ws, walls, wl_u, wr_u, ci, cw, fs)
+        fmax = _pair_pass(ps, pl_u, pr_u, start, nbr, fs)
+    _unsort(cpart, ps, pos)
+    _unsort(cpart, vs, vel)
+    _unsort(cpart, fs, f)
+    return done, status, info
 
 
 @njit(**JIT)
@@ -329,3 +587,4 @@ def wall_contacts(pos, walls, l_u, r_u):
                 force[c, 1] = gy
                 c += 1
     return part, wall, point, force
+
