@@ -16,7 +16,7 @@ the large ones by tiling a relaxed 1,890-particle vessel: its left 450 cm,
 k copies of its central 100 cm strip and its right 450 cm (particles chosen by
 their initial lattice x, so every tile holds whole lattice columns).
 
-Outputs (benchmarks/results/): step_cost[_TAG].csv, compile[_TAG].csv,
+Outputs (benchmarks/results/, or results/quick/ with --quick): step_cost[_TAG].csv, compile[_TAG].csv,
 memory[_TAG].csv, summary[_TAG].txt, machine.txt, step_cost.png.
 ``--kernels FILE --tag before`` times another copy of kernels.py (e.g. the
 version before optimisation, ``git show REV:src/isaflow/kernels.py``).
@@ -279,7 +279,7 @@ def plot(outdir, tables):
         ax.loglog(ns, ns_ps, mk, color=col, label=f"{label}: cost/step ~ N^{p:.2f} (fit N >= 1e4)")
     ax.axhline(20.0, color="k", lw=0.8, ls=":", label="target 20 ns")
     ax.set_xlabel("N, particles [-]")
-    ax.set_ylabel("cost per particle-step [ns]")
+    ax.set_ylabel("CPU time per particle-step [ns]")
     ax.set_title("kernels.relax (PAPER) vs vectorised NumPy, 1 core")
     ax.grid(True, which="both", lw=0.3)
     ax.legend(fontsize=8)
@@ -302,7 +302,7 @@ def main():
     ap.add_argument("--kernels", help="time this copy of kernels.py instead of isaflow.kernels")
     ap.add_argument("--tag", default="", help="suffix of the output files, e.g. 'before'")
     ap.add_argument("--no-numpy", action="store_true", help="skip the NumPy reference")
-    ap.add_argument("--out", default=str(HERE / "results"))
+    ap.add_argument("--out", help="output folder (default benchmarks/results, or benchmarks/results/quick with --quick)")
     ap.add_argument("--probe-compile", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--probe-memory", help=argparse.SUPPRESS)
     args = ap.parse_args()
@@ -312,7 +312,7 @@ def main():
         return probe_memory(args.kernels, args.probe_memory)
 
     t_start = time.perf_counter()
-    out = Path(args.out)
+    out = Path(args.out or (HERE / "results" / "quick" if args.quick else HERE / "results"))
     out.mkdir(parents=True, exist_ok=True)
     sfx = f"_{args.tag}" if args.tag else ""
     kpath = str(Path(args.kernels).resolve()) if args.kernels else None
