@@ -8,6 +8,13 @@ include: "workflow/rules/common.smk"
 include: "workflow/rules/runs.smk"
 include: "workflow/rules/single.smk"
 include: "workflow/rules/flow.smk"
+
+
+# error against run time and stability study; after common.smk, whose validation covers config.yaml only
+configfile: "config/study.yaml"
+
+
+include: "workflow/rules/study.smk"
 include: "workflow/rules/report.smk"
 
 

@@ -249,16 +249,17 @@ def tolerances(row, a, n_particles, f_tol):
 def contact_errors(ds, vessel=None):
     """Per-contact wall-load errors of a vessel, in units of one floor-contact load.
 
-    (computed - theoretical) / (gamma h a) for every wetted contact (theory from
-    theory.contact_theory, gamma and h from load_errors); (C,) array, empty if
-    the vessel has no wetted contact.
+    (computed - theoretical) / (gamma h a) for every wetted contact of the
+    vessel's own particles (theory from theory.contact_theory, gamma and h as
+    load_errors); (C,) array, empty if the vessel has no wetted contact.
     """
     v = vessel_view(ds, vessel)
     e = load_errors(ds, vessel)
     walls = ds["wall_segment"].values
+    mine = v["inside"][ds["contact_particle"].values]
+    cw = np.where(mine, ds["contact_wall"].values, -1)
     mag = np.hypot(*ds["contact_force"].values.T)
-    th = theory.contact_theory(walls, ds["contact_wall"].values, ds["contact_point"].values, e["gamma"], e["level"],
-                               v["wall_in"])
+    th = theory.contact_theory(walls, cw, ds["contact_point"].values, e["gamma"], e["level"], v["wall_in"])
     wet = np.isfinite(th)
     unit = e["gamma"] * (e["level"] - v["floor_y"]) * float(ds.attrs["lattice_a"])
     return (mag[wet] - th[wet]) / unit

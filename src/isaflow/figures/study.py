@@ -1,0 +1,154 @@
+"""Study figures: error against run time, stability map.  Drawn from the study tables
+(figures/error_vs_runtime.csv, results/study/stability_map.csv, figures/stability_cases.csv),
+which isaflow.study builds from the run files."""
+
+import numpy as np
+import pandas as pd
+
+from ..study import OUTCOME_STYLE, VARIANTS
+from .style import plt, save
+
+VARIANT_COLOR = {"paper": "tab:red", "capped": "tab:blue", "fire": "tab:green"}
+VARIANT_NAME = {"paper": "paper: x += du F/max|F| (section 3.3)", "capped": "capped (variant, not in paper)",
+                "fire": "FIRE (variant, not in paper)"}
+LATTICE_MARKER = {"coarse": "o", "refined": "s", "fine": "^", "finer": "D"}
+FLOOR = 1e-4  # smallest |error| drawn on the log axes (exact zeros sit on it)
+
+PANELS = [
+    ("level_err_paper_cm", "|level - paper's level| (cm)", "(a) free-surface level against the paper"),
+    ("level_err_hydro_cm", "|level - level implied by side loads| (cm)",
+     "(b) level against hydrostatic consistency (2 B F_side / W)"),
+    ("side_err", "|side-wall total / hydrostatic - 1| (-)", "(c) side-wall loads against hydrostatics"),
+    ("contact_rms", "RMS contact error (floor-contact loads γha)", "(d) per-contact wall loads against hydrostatics"),
+    ("residual_N", "residual max|F| (N)", "(e) residual out-of-balance force"),
+]
+
+
+def error_vs_runtime_figure(inputs, outputs):
+    """Every error measure against solver wall-clock time, log-log: one marker per run,
+    colour = algorithm, marker = lattice, filled = converged to f_tol."""
+    tab = pd.read_csv(inputs[0])
+    fig, axes = plt.subplots(2, 3, figsize=(15, 9))
+    axes = axes.ravel()
+    for ax, (col, ylabel, title) in zip(axes, PANELS):
+        for var in [v for v in VARIANTS if v in set(tab["variant"])]:
+            for lat, marker in LATTICE_MARKER.items():
+                g = tab[(tab["variant"] == var) & (tab["lattice"] == lat)].sort_values("du_factor")
+                g = g[np.isfinite(g[col])]
+                if g.empty:
+                    continue
+                y = np.maximum(g[col].abs(), FLOOR)
+                conv = (g["status"] == "converged").values
+                c = VARIANT_COLOR[var]
+                ax.scatter(g["wall_time_s"][conv], y[conv], marker=marker, color=c, s=36, zorder=3)
+                ax.scatter(g["wall_time_s"][~conv], y[~conv], marker=marker, facecolors="none", edgecolors=c, s=36,
+                           zorder=3)
+        paper = tab[tab["paper_config"].astype(bool)]
+        for k, (_, r) in enumerate(paper.iterrows()):
+            if np.isfinite(r[col]):
+                ax.annotate(f"paper's config\n({r['lattice']}, du {10 * r['du_cm']:g} mm)",
+                            (r["wall_time_s"], max(abs(r[col]), FLOOR)), xytext=((-80, -34), (14, 18))[k % 2],
+                            textcoords="offset points", fontsize=7, arrowprops=dict(arrowstyle="->", lw=0.6))
+        if col == "residual_N":
+            for ft in sorted(set(tab["f_tol_N"])):
+                ax.axhline(ft, color="gray", ls=":", lw=0.8)
+            ax.text(0.02, 0.02, "dotted: f_tol of each lattice", transform=ax.transAxes, fontsize=7, color="gray")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("solver wall-clock time (s)")
+        ax.set_ylabel(ylabel)
+        ax.set_title(title)
+        ax.grid(True, which="major", alpha=0.3)
+    # legend panel
+    leg = axes[-1]
+    leg.axis("off")
+    for var in [v for v in VARIANTS if v in set(tab["variant"])]:
+        leg.plot([], [], "o", color=VARIANT_COLOR[var], label=VARIANT_NAME[var])
+    for lat, marker in LATTICE_MARKER.items():
+        g = tab[tab["lattice"] == lat]
+        if len(g):
+            leg.plot([], [], marker, color="gray", label=f"{lat}: a = {g['a_cm'].iloc[0]:g} cm, "
+                                                        f"{int(g['particles'].iloc[0])} particles")
+    leg.plot([], [], "o", color="gray", label="filled: converged (max|F| < f_tol)")
+    leg.plot([], [], "o", mfc="none", color="gray", label="open: cycle / step limit / escaped")
+    leg.legend(loc="center", fontsize=8, frameon=False)
+    leg.text(0.5, 0.05, "du swept from 0.1x to 100x the paper's rule;\n"
+             f"|errors| below {FLOOR:g} are drawn at {FLOOR:g}", transform=leg.transAxes, ha="center", fontsize=7)
+    fig.suptitle("Error against run time, single 100 cm vessel: paper's update and two variants (not in the paper)")
+    save(fig, outputs)
+
+
+def stability_map_figure(inputs, outputs):
+    """Outcome over (k_b du / w, du / a) per update rule, and the extreme cases as a table.
+
+    inputs: [stability_map.csv, stability_cases.csv]."""
+    smap = pd.read_csv(inputs[0])
+    cases = pd.read_csv(inputs[1])
+    variants = [v for v in VARIANTS if v in set(smap["variant"])]
+    fig = plt.figure(figsize=(5 * len(variants), 10.5))
+    gs = fig.add_gridspec(2, len(variants), height_ratios=[1, 1.05])
+    for k, var in enumerate(variants):
+        ax = fig.add_subplot(gs[0, k])
+        g = smap[smap["variant"] == var]
+        for status, (color, marker) in OUTCOME_STYLE.items():
+            s = g[g["status"] == status]
+            if len(s):
+                ax.scatter(s["k_du_over_w"], s["du_over_a"], color=color, marker=marker, s=80, label=status,
+                           edgecolors="k", linewidths=0.4, zorder=3)
+        paper = g[(g["k_factor"] == 1) & (g["du_factor"] == 1)]
+        if len(paper):
+            ax.scatter(paper["k_du_over_w"], paper["du_over_a"], s=260, facecolors="none", edgecolors="k", lw=1.2,
+                       zorder=4)
+            ax.annotate("paper's\nsetting", (paper["k_du_over_w"].iloc[0], paper["du_over_a"].iloc[0]),
+                        xytext=(-10, 18), textcoords="offset points", fontsize=7, ha="right")
+        for kf, kg in g.groupby("k_factor"):
+            kg = kg.sort_values("du_factor")
+            ax.plot(kg["k_du_over_w"], kg["du_over_a"], color="gray", lw=0.4, zorder=1)
+            ax.text(kg["k_du_over_w"].iloc[-1], kg["du_over_a"].iloc[-1] * 1.5, f"k_b = {kg['k_wall'].iloc[0]:.0e}",
+                    fontsize=6, ha="center", color="gray", rotation=60)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("k_b du / w (-)  [k_b: wall stiffness, N/cm; du: cm; w: N]")
+        ax.set_ylabel("du / a (-)  [a: lattice spacing, cm]")
+        ax.set_ylim(top=g["du_over_a"].max() * 8)
+        ax.set_title(f"{VARIANT_NAME[var]}\nstep limit {int(g['max_steps'].max()):,} steps; "
+                     "lines: constant k_b (N/cm)")
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=7, loc="lower right")
+    # table of extreme cases
+    ax = fig.add_subplot(gs[1, :])
+    ax.axis("off")
+    case_ids = list(dict.fromkeys(cases["case"]))
+    cvars = [v for v in VARIANTS if v in set(cases["variant"])]
+    cells, colors = [], []
+    for c in case_ids:
+        g = cases[cases["case"] == c].set_index("variant")
+        row, col = [g["note"].iloc[0]], ["white"]
+        for v in cvars:
+            if v in g.index:
+                r = g.loc[v]
+                txt = f"{r['status']}" + (" (wall crossing refused)" if "crossed" in r["outcome_detail"] else "")
+                txt += " (left box)" if "box" in r["outcome_detail"] else ""
+                txt += f", {int(r['steps']):,} steps"
+                row.append(txt)
+                col.append(_light(OUTCOME_STYLE[r["status"]][0]))
+            else:
+                row.append("not run")
+                col.append("white")
+        cells.append(row)
+        colors.append(col)
+    table = ax.table(cellText=cells, cellColours=colors, colLabels=["extreme case"] + [VARIANT_NAME[v] for v in cvars],
+                     loc="upper center", cellLoc="left", colWidths=[0.43] + [0.19] * len(cvars))
+    table.auto_set_font_size(False)
+    table.set_fontsize(6.5)
+    table.scale(1, 1.5)
+    ax.set_title("Extreme cases (figures/stability_cases.csv): outcome and steps per update rule", fontsize=9)
+    fig.suptitle("Numerical stability of the single vessel: outcome classes of every run (status in its run file)")
+    save(fig, outputs)
+
+
+def _light(color):
+    from matplotlib.colors import to_rgb
+
+    r, g, b = to_rgb(color)
+    return (0.65 + 0.35 * r, 0.65 + 0.35 * g, 0.65 + 0.35 * b)

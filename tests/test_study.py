@@ -1,0 +1,208 @@
+"""Error measures, the study's run plan and tables, and the CI-sized study workflow."""
+
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+import xarray as xr
+import yaml
+
+from isaflow import metrics, scene, study, theory
+
+from conftest import ROOT
+
+STUDY = yaml.safe_load((ROOT / "config" / "study.yaml").read_text())["study"]
+CI_CONFIG = ROOT / "tests" / "data" / "study_ci.yaml"
+
+
+# -- error measures -----------------------------------------------------------
+
+
+def hydrostatic_run(h=60.0, a=10.0, width=100.0, w=50.0):
+    """A run Dataset whose wall contacts carry exactly the hydrostatic loads of a liquid
+    of level h [cm] (theory.contact_theory), with the free surface exactly at h."""
+    walls = np.array([[0, 100, 0, 0], [0, 0, width, 0], [width, 0, width, 100]], float)
+    xs = np.arange(a / 2, width, a)
+    pos = np.array([[x, y] for x in xs for y in np.arange(h, 0, -a)])  # top of every strip at h
+    W = w * len(pos)
+    gamma = theory.specific_weight(W, width, h)
+    ys = np.arange(a / 4, 100, a / 2)
+    cw = np.concatenate([np.zeros(len(ys), int), np.ones(len(xs), int), np.full(len(ys), 2)])
+    cp = np.concatenate([np.column_stack([np.zeros_like(ys), ys]), np.column_stack([xs, np.zeros_like(xs)]),
+                         np.column_stack([np.full_like(ys, width), ys])])
+    mag = theory.contact_theory(walls, cw, cp, gamma, h)
+    normal = np.array([[1.0, 0.0], [0.0, 1.0], [-1.0, 0.0]])[cw]
+    keep = mag > 0
+    # each contact belongs to the particle nearest its point (only used to assign contacts to the vessel)
+    owner = np.argmin(np.hypot(*(cp[keep, None, :] - pos[None, :, :]).transpose(2, 0, 1)), axis=1)
+    ds = xr.Dataset(
+        {"pos": (("particle", "xy"), pos), "weight": (("particle",), np.full(len(pos), w)),
+         "wall_segment": (("wall", "end"), walls), "contact_wall": (("contact",), cw[keep]),
+         "contact_particle": (("contact",), owner),
+         "contact_point": (("contact", "xy"), cp[keep]),
+         "contact_force": (("contact", "xy"), normal[keep] * mag[keep, None]), "max_force": ((), 0.05)},
+        coords={"wall": ["left", "floor", "right"], "xy": ["x", "y"]})
+    ds.attrs.update(lattice_a=a, wall_l_u=5.0, wall_r_u=10000.0, pair_l_u=a / np.sqrt(2), pair_r_u=500 * a / np.sqrt(2))
+    return ds
+
+
+def test_hydrostatic_loads_have_zero_error():
+    ds = hydrostatic_run(h=60.0)
+    e = metrics.hydrostatic_errors(ds, paper_level=62.5)
+    assert e["level_cm"] == pytest.approx(60.0)
+    assert e["level_err_paper_cm"] == pytest.approx(-2.5)
+    # every wall total and every contact equals hydrostatics; the side loads imply the measured level
+    for key in ("wall_err_left", "wall_err_floor", "wall_err_right", "wall_err_max", "side_err", "floor_err",
+                "contact_rms", "contact_max", "level_err_hydro_cm"):
+        assert e[key] == pytest.approx(0.0, abs=1e-9), key
+    assert e["residual_N"] == 0.05
+    # side contacts a/2 apart: the resultant of the tributary loads sits within a/4 of h/3
+    assert abs(e["side_height_err_cm"]) < 10.0 / 4
+
+
+def test_halved_side_loads_show_in_every_side_measure():
+    ds = hydrostatic_run(h=60.0)
+    side = np.isin(ds["contact_wall"].values, [0, 2])
+    ds["contact_force"].values[side] *= 0.5
+    e = metrics.hydrostatic_errors(ds)
+    assert e["side_err"] == pytest.approx(-0.5) and e["wall_err_max"] == pytest.approx(0.5)
+    assert e["floor_err"] == pytest.approx(0.0, abs=1e-12)
+    # F_side = gamma h^2 / 4 implies a level of h / 2
+    assert e["level_err_hydro_cm"] == pytest.approx(30.0)
+    assert np.isnan(e["level_err_paper_cm"])
+
+
+def test_law_usage_by_hand():
+    ds = hydrostatic_run(h=60.0)
+    pos = ds["pos"].values.copy()
+    l_pu = ds.attrs["pair_l_u"]
+    pos[1] = pos[0] + [0.5 * l_pu, 0.0]  # one pair at half the pair law's range
+    ds["pos"].values[:] = pos
+    u = metrics.law_usage(ds)
+    assert u["pair_use"] == pytest.approx(0.5) and u["min_pair_cm"] == pytest.approx(0.5 * l_pu)
+    biggest = np.hypot(*ds["contact_force"].values.T).max()
+    assert u["wall_use"] == pytest.approx(biggest / 10000.0)
+
+
+# -- plan ----------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def plan():
+    return study.plan(STUDY)
+
+
+def test_plan_covers_the_issue(plan):
+    er = {k: v for k, v in plan.items() if v["group"] == "error_runtime"}
+    assert {v["lattice"] for v in er.values()} >= {"coarse", "refined", "fine", "finer"}
+    assert {v["variant"] for v in er.values()} == {"paper", "capped", "fire"}
+    factors = {v["du_factor"] for v in er.values()}
+    assert min(factors) <= 0.1 and max(factors) >= 10
+    spacings = [scene.load(STUDY["lattices"][k]["scene"]).spacing for k in ("coarse", "refined", "fine", "finer")]
+    assert spacings == sorted(spacings, reverse=True) and spacings[-1] < 5.0 / 2 + 1e-12  # two finer than the paper's
+    cases = {v["case"] for v in plan.values() if v["group"] == "cases"}
+    assert cases >= {"stiff", "du_large", "du_small", "overlap", "coincident", "on_wall", "narrow_opening", "shallow",
+                     "tall", "lattice_100k", "float_limit"}
+    big = scene.load(STUDY["cases"]["list"]["lattice_100k"]["scene"])
+    assert len(scene.initial_positions(big)) >= 100_000
+    # the map reaches k du far above w and du far above and below the paper's
+    sm = [v for v in plan.values() if v["group"] == "stability_map"]
+    assert max(v["k_factor"] * v["du_factor"] for v in sm) * 0.4 >= 1e4  # paper: k_b du / w = 0.4
+    assert min(v["du_factor"] for v in sm) <= 0.1 and max(v["du_factor"] for v in sm) >= 100
+
+
+def test_every_planned_run_is_a_valid_scene_with_its_du(plan):
+    for sid, m in plan.items():
+        sc = scene.load(m["scene"], m["set"])  # raises SceneError naming the field otherwise
+        s = sc.solver
+        assert s["variant"] == m["variant"] and s["history"] == {} and set(s["accept"]) == set(study.OUTCOMES), sid
+        if m["group"] != "cases":
+            base = scene.load(m["scene"]).solver["du"]
+            assert s["du"] == pytest.approx(m["du_factor"] * base, rel=1e-7), sid
+        if m["variant"] == "fire":
+            k = 2 * sc.stiffness("wall") + 12 * sc.stiffness("pair")
+            assert s["dt_max"] == pytest.approx(m.get("dt_factor", STUDY["fire_dt_factor"]) / np.sqrt(k), rel=1e-7)
+
+
+def test_fire_dt_max_of_the_paper_stiffness():
+    # 2 / sqrt(2 x 2000 + 12 x 500) = 2 / 100 s
+    assert study.fire_dt_max(2000.0, 500.0, 2.0) == pytest.approx(0.02)
+
+
+@pytest.mark.parametrize("x", [1e-5, 0.01, 3535.5339, 1e8, 1e308, 2.5e-300])
+def test_override_numbers_read_back_as_floats(x):
+    y = yaml.safe_load(study._num(x))
+    assert isinstance(y, float) and y == pytest.approx(x, rel=1e-7)
+
+
+def test_outcome_detail_separates_the_two_escapes():
+    assert study.outcome_detail("escaped", "particle 3 at (1, 2) cm would cross wall 'floor' at step 0; step refused, "
+                                           "run stopped") == "crossed a wall (step refused)"
+    assert study.outcome_detail("escaped", "2 particle(s) left the walls' bounding box by step 1000") == \
+        "left the walls' bounding box"
+    assert study.outcome_detail("step_limit", "") == "step limit"
+
+
+def test_recommend_takes_the_fastest_converged_run_on_a_robust_lattice():
+    tab = pd.DataFrame([
+        dict(run="a", lattice="coarse", variant="paper", du_cm=0.01, status="cycle", side_err=0.001, wall_time_s=0.01,
+             steps=10),
+        dict(run="b", lattice="coarse", variant="fire", du_cm=0.1, status="converged", side_err=-0.04, wall_time_s=0.1,
+             steps=300),
+        dict(run="c", lattice="coarse", variant="capped", du_cm=0.01, status="converged", side_err=0.03,
+             wall_time_s=0.5, steps=9000),
+        dict(run="d", lattice="refined", variant="fire", du_cm=0.1, status="converged", side_err=-0.2,
+             wall_time_s=0.05, steps=600),
+        dict(run="e", lattice="refined", variant="capped", du_cm=0.01, status="converged", side_err=0.02,
+             wall_time_s=0.02, steps=600),
+    ])
+    rec = study.recommend(tab, {"side_err": [0.25, 0.05, 0.035, 0.01]}).set_index("target")
+    # both lattices stay within 0.25: the fastest converged run of all ('a' never converged)
+    assert rec.loc[0.25, "run"] == "e" and rec.loc[0.25, "robust_lattices"] == "coarse, refined"
+    # only the coarse lattice is within 0.05 on every path; 'e' meets it on its path only
+    assert rec.loc[0.05, "run"] == "b" and rec.loc[0.05, "lattice_worst"] == pytest.approx(0.04)
+    assert rec.loc[0.05, "by_chance"] == "e"
+    assert rec.loc[0.035, "run"] == "none" and rec.loc[0.035, "by_chance"] == "e"
+    assert rec.loc[0.01, "run"] == "none" and rec.loc[0.01, "by_chance"] == "none"
+
+
+# -- CI-sized workflow ---------------------------------------------------------
+
+
+def test_reduced_study_builds_both_figures_and_the_report_fragment(tmp_path):
+    """The study's rules on a few coarse points (tests/data/study_ci.yaml) in a scratch copy."""
+    for item in ("Snakefile", "workflow", "config"):
+        src = ROOT / item
+        (shutil.copytree if src.is_dir() else shutil.copy)(src, tmp_path / item)
+    (tmp_path / "src").symlink_to(ROOT / "src")  # rules depend on the package sources
+    shutil.copy(CI_CONFIG, tmp_path / "config" / "study.yaml")
+    env = {**os.environ, "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}"}
+    targets = ["figures/error_vs_runtime.png", "figures/stability_map.png", "results/report/30_study.md"]
+    proc = subprocess.run([sys.executable, "-m", "snakemake", "-c2", "--quiet", *targets], cwd=tmp_path, env=env,
+                          capture_output=True, text=True, timeout=400)
+    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
+    for t in targets:
+        assert (tmp_path / t).stat().st_size > 0
+    err = pd.read_csv(tmp_path / "figures" / "error_vs_runtime.csv").set_index("run")
+    assert len(err) == 6
+    # physics: the capped update reaches f_tol at the paper's level (tolerance a/4 = 2.5 cm);
+    # the literal update ends in its period-2 cycle
+    cap = err.loc["er_coarse_capped_du1"]
+    assert cap["status"] == "converged" and cap["residual_N"] < 0.1 and abs(cap["level_err_paper_cm"]) <= 2.5
+    assert err.loc["er_coarse_paper_du1", "status"] == "cycle" and err.loc["er_coarse_paper_du1", "paper_config"]
+    cases = pd.read_csv(tmp_path / "figures" / "stability_cases.csv").set_index("run")
+    big = cases.loc["sc_du_large_paper"]
+    assert big["status"] == "escaped" and "would cross wall 'floor' at step 0" in big["message"]
+    assert (cases.loc[["sc_on_wall_paper", "sc_on_wall_fire"], "positions_finite"]).all()
+    smap = pd.read_csv(tmp_path / "results" / "study" / "stability_map.csv")
+    assert len(smap) == 8 and set(smap["status"]) <= set(study.OUTCOMES)
+    # FIRE needs fewer force evaluations than the capped update and than the paper's reported 2000 steps
+    ratio = pd.read_csv(tmp_path / "results" / "study" / "fire_ratio.csv").iloc[0]
+    assert ratio["ratio_vs_capped"] > 1 and ratio["ratio_vs_paper_reported"] > 1
+    text = (tmp_path / "results" / "report" / "30_study.md").read_text()
+    assert "## Error against run time and numerical stability" in text and "Which configuration to pick" in text

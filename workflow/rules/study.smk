@@ -1,0 +1,168 @@
+# Error against run time, FIRE tuning and numerical stability (config/study.yaml).
+# Every point is one `isaflow run` with its own netCDF under results/study/runs/.
+import re
+
+from isaflow import study as S
+
+validate(config["study"], "../schemas/study.schema.yaml")
+
+STUDY = config["study"]
+STUDY_RUNS = S.plan(STUDY)
+STUDY_META = S.meta(STUDY_RUNS)
+
+
+def study_files(group, **match):
+    """Run files of one plan group whose entries match the given fields."""
+    return [
+        f"results/study/runs/{sid}.nc"
+        for sid, m in STUDY_RUNS.items()
+        if m["group"] == group and all(m.get(k) == v for k, v in match.items())
+    ]
+
+
+def study_overrides(wc):
+    return " ".join(f"--set '{s}'" for s in STUDY_RUNS[wc.sid]["set"])
+
+
+STUDY_FIG_CODE = code("figures/__init__", "figures/style", "figures/study", "study")
+
+
+rule study_run:
+    input:
+        scene=lambda wc: STUDY_RUNS[wc.sid]["scene"],
+        code=SOLVER_CODE,
+    output:
+        "results/study/runs/{sid}.nc",
+    params:
+        overrides=study_overrides,
+    log:
+        "logs/study/run/{sid}.log",
+    benchmark:
+        "results/benchmarks/study/{sid}.tsv"
+    wildcard_constraints:
+        sid="|".join(re.escape(s) for s in STUDY_RUNS),
+    shell:
+        "isaflow run {input.scene} -o {output} {params.overrides} --config config/study.yaml -q 2> {log}"
+
+
+rule study_error_table:
+    input:
+        runs=study_files("error_runtime"),
+        code=code("study", "metrics", "theory"),
+    output:
+        "figures/error_vs_runtime.csv",
+    params:
+        func="study.error_table",
+        kw={"meta": STUDY_META, "paper": config["paper"]},
+    log:
+        "logs/study/error_table.log",
+    script:
+        "../scripts/study.py"
+
+
+rule study_fire_tables:
+    input:
+        tuning=study_files("fire_tuning"),
+        references=[
+            f
+            for lat in STUDY["fire_tuning"]["lattices"]
+            for var in ("capped", "paper")
+            for f in study_files("error_runtime", lattice=lat, variant=var, du_factor=1)
+        ],
+        code=code("study", "metrics", "theory"),
+    output:
+        "results/study/fire_tuning.csv",
+        "results/study/fire_ratio.csv",
+    params:
+        func="study.fire_tables",
+        kw={
+            "meta": STUDY_META,
+            "paper": config["paper"],
+            "required_ratio": STUDY["fire_tuning"]["required_ratio"],
+        },
+    log:
+        "logs/study/fire_tables.log",
+    script:
+        "../scripts/study.py"
+
+
+rule study_map_table:
+    input:
+        runs=study_files("stability_map"),
+        code=code("study", "metrics", "theory"),
+    output:
+        "results/study/stability_map.csv",
+    params:
+        func="study.map_table",
+        kw={"meta": STUDY_META},
+    log:
+        "logs/study/map_table.log",
+    script:
+        "../scripts/study.py"
+
+
+rule study_cases_table:
+    input:
+        runs=study_files("cases"),
+        code=code("study", "metrics", "theory"),
+    output:
+        "figures/stability_cases.csv",
+    params:
+        func="study.cases_table",
+        kw={"meta": STUDY_META},
+    log:
+        "logs/study/cases_table.log",
+    script:
+        "../scripts/study.py"
+
+
+rule fig_error_vs_runtime:
+    input:
+        inputs=["figures/error_vs_runtime.csv"],
+        code=STUDY_FIG_CODE,
+    output:
+        figure("error_vs_runtime"),
+    params:
+        func="figures.study.error_vs_runtime_figure",
+    log:
+        "logs/figures/error_vs_runtime.log",
+    script:
+        "../scripts/study.py"
+
+
+rule fig_stability_map:
+    input:
+        inputs=["results/study/stability_map.csv", "figures/stability_cases.csv"],
+        code=STUDY_FIG_CODE,
+    output:
+        figure("stability_map"),
+    params:
+        func="figures.study.stability_map_figure",
+    log:
+        "logs/figures/stability_map.log",
+    script:
+        "../scripts/study.py"
+
+
+rule report_study:
+    input:
+        errors="figures/error_vs_runtime.csv",
+        fire_ratio="results/study/fire_ratio.csv",
+        fire_grid="results/study/fire_tuning.csv",
+        stability_map="results/study/stability_map.csv",
+        cases="figures/stability_cases.csv",
+        study_config="config/study.yaml",
+        code=code("study", "report"),
+    output:
+        "results/report/30_study.md",
+    params:
+        func="study.report_section",
+    log:
+        "logs/report/study.log",
+    script:
+        "../scripts/study.py"
+
+
+REPORT_PARTS += ["results/report/30_study.md"]
+ALL_TARGETS += figure("error_vs_runtime") + figure("stability_map")
+ALL_TARGETS += ["figures/error_vs_runtime.csv", "figures/stability_cases.csv", "results/study/fire_ratio.csv"]
