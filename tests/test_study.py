@@ -183,7 +183,7 @@ def test_reduced_study_builds_both_figures_and_the_report_fragment(tmp_path):
     shutil.copy(CI_CONFIG, tmp_path / "config" / "study.yaml")
     env = {**os.environ, "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}"}
     targets = ["figures/error_vs_runtime.png", "figures/stability_map.png", "results/report/30_study.md"]
-    proc = subprocess.run([sys.executable, "-m", "snakemake", "-c2", "--quiet", *targets], cwd=tmp_path, env=env,
+    proc = subprocess.run([sys.executable, "-m", "snakemake", "-c2", *targets], cwd=tmp_path, env=env,
                           capture_output=True, text=True, timeout=400)
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
     for t in targets:

@@ -286,7 +286,8 @@ def stability_row(sid, ds, m):
     row.update(variant_label=a["variant_label"], message=a["status_message"], max_steps=int(a["max_steps"]), k_wall=kb,
                k_pair=a["pair_r_u"] / a["pair_l_u"], weight_N=w, a_cm=lat_a, k_du_over_w=kb * a["du"] / w,
                du_over_a=a["du"] / lat_a if np.isfinite(lat_a) else np.nan, positions_finite=finite,
-               top_cm=float(pos[:, 1].max()) if finite else np.nan,
+               floor_cm=float(ds["wall_segment"].values[:, [1, 3]].min()),
+               top_cm=float(pos[:, 1].max()) if finite else np.nan, top0_cm=float(ds["pos0"].values[:, 1].max()),
                level_cm=theory.free_surface_level(pos, lat_a, _x_range(ds)) if finite and np.isfinite(lat_a) else np.nan)
     row.update(metrics.law_usage(ds))
     if "vessel" in ds.coords and finite:
@@ -453,8 +454,10 @@ def report_section(errors, fire_ratio, fire_grid, stability_map, cases, study_co
                 "residual_N"]].copy()
     show.insert(0, "paper's config", np.where(err["paper_config"], "yes", ""))
     show["du_cm"] = show["du_cm"].map(lambda x: f"{x:.3g}")
-    t += ["### Sweep", "", "du is given as a factor of the paper's rule (0.1 mm coarse, 0.025 mm refined, "
-          "0.00625 mm a = 2.5 cm, 0.0016 mm a = 1.25 cm) and in cm.", "", _md(show), ""]
+    t += ["### Sweep", "", "du is given as a factor of the paper's rule du = w / (10 k_p) (0.1 mm coarse, 0.025 mm "
+          "refined, 0.00625 mm for a = 2.5 cm, 0.0016 mm for a = 1.25 cm) and in cm. The finer lattices keep the "
+          "refined lattice's f_tol / w (f_tol = 0.025 N and 0.00625 N). FIRE's du only caps its per-step move.",
+          "", _md(show), ""]
     t += ["### What resolution buys", "",
           "Per lattice: the capped variant's equilibrium at the paper's du (`capped` columns) and the range of "
           "each measure over all converged runs of the sweep (`range`: other update rules and step lengths end "
@@ -469,7 +472,8 @@ def report_section(errors, fire_ratio, fire_grid, stability_map, cases, study_co
     t += _advice(err, rec)
     # FIRE
     t += ["### FIRE: force evaluations to f_tol", "",
-          f"Each step evaluates the forces once. FIRE's own parameters were tuned over du (move cap) x dt_max "
+          f"Each step evaluates the forces once (plus one evaluation at the start of every 1000-step chunk, "
+          f"not counted). FIRE's own parameters were tuned over du (move cap) x dt_max "
           f"({len(grid)} runs, `results/study/fire_tuning.csv`); the issue asks for at least "
           f"{study['fire_tuning']['required_ratio']:g}x fewer evaluations than the paper's update.", "",
           _md(fr.drop(columns=["required_ratio"])), ""]
@@ -496,11 +500,15 @@ def report_section(errors, fire_ratio, fire_grid, stability_map, cases, study_co
         t += [f"**{var}**", "", _status_grid(smap, var), ""]
     t += ["Boundaries found:", "", map_boundaries(smap), ""]
     # cases
+    cs["height_ratio"] = (cs["top_cm"] - cs["floor_cm"]) / (cs["top0_cm"] - cs["floor_cm"])
     cols = ["case", "variant", "particles", "status", "outcome_detail", "steps", "wall_time_s", "max_force_N",
-            "level_cm", "top_cm", "wall_use", "pair_use"] + [c for c in cs.columns if c.startswith("particles_")]
+            "level_cm", "top_cm", "height_ratio", "wall_use", "pair_use"] + [c for c in cs.columns
+                                                                           if c.startswith("particles_")]
     t += ["### Extreme cases", "",
           "`wall_use` / `pair_use`: largest wall / pair force over its law's R_u (1 = the law is exhausted: a "
-          "particle on a wall, or two coincident particles); `particles_<vessel>`: final count per vessel.", "",
+          "particle on a wall, or two coincident particles); `height_ratio`: final over initial height of the "
+          "highest particle above the floor (a measure of compaction); `particles_<vessel>`: final count "
+          "per vessel.", "",
           _md(cs[["case", "note"]].drop_duplicates()), "", _md(cs[cols]), "", "Messages:", ""]
     t += [f"- `{r['run']}`: {r['status']}: {r['message']}" for _, r in cs.iterrows()]
     t.append("")
