@@ -155,6 +155,17 @@ def plan(study):
     return out
 
 
+def run_files(runs, group, **match):
+    """Run files results/study/runs/{id}.nc of one plan group whose entries match the given fields."""
+    return [f"results/study/runs/{sid}.nc" for sid, m in runs.items()
+            if m["group"] == group and all(m.get(k) == v for k, v in match.items())]
+
+
+def cli_overrides(runs, sid):
+    """The --set arguments of one planned run, quoted for the shell."""
+    return " ".join(f"--set '{s}'" for s in runs[sid]["set"])
+
+
 def meta(runs):
     """Plan entries without the scene overrides (what the tables need)."""
     return {k: {kk: vv for kk, vv in v.items() if kk != "set"} for k, v in runs.items()}
@@ -324,30 +335,32 @@ def recommend(table, targets):
 
     table: error_table DataFrame; targets: {measure: [values]}.  Only runs that
     reached their own stopping criterion (status converged) count.  The final
-    state depends on the relaxation path (update rule, du), so one lattice's
-    converged runs spread in every measure; a lattice is *robust* for a target
-    when all its converged runs meet it.  Returns one row per target: the
-    fastest converged run on a robust lattice (``run``; 'none' if no lattice is
-    robust), the spread ``lattice_worst`` of its lattice, and the fastest
-    converged run meeting the target at all (``by_chance``: on a non-robust
-    lattice another path may miss it).
+    state depends on the relaxation path, so the converged runs of one lattice
+    and update rule spread over du; a (lattice, variant) family is *robust* for
+    a target when all its converged runs meet it.  Returns one row per target:
+    the fastest converged run of a robust family (``run``; 'none' if no family
+    is robust) with that family's worst error (``family_worst``), and the
+    fastest converged run meeting the target at all (``by_chance``: another du
+    of the same family may miss it).
     """
     ok = table[table["status"] == "converged"]
     rows = []
     for measure, values in targets.items():
-        worst = ok.groupby("lattice")[measure].apply(lambda s: s.abs().max())
+        worst = ok.groupby(["lattice", "variant"])[measure].apply(lambda s: s.abs().max())
         for t in values:
-            robust = ok[ok["lattice"].isin(worst[worst <= t].index)]
+            fams = worst[worst <= t].index
+            robust = ok[[(la, va) in fams for la, va in zip(ok["lattice"], ok["variant"])]]
             anyhit = ok[ok[measure].abs() <= t]
-            row = dict(measure=measure, target=t, robust_lattices=", ".join(worst[worst <= t].index) or "none")
+            row = dict(measure=measure, target=t,
+                       robust_families=", ".join(f"{la}/{va}" for la, va in fams) or "none")
             if len(robust):
                 b = robust.loc[robust["wall_time_s"].idxmin()]
                 row.update(run=b["run"], lattice=b["lattice"], variant=b["variant"], du_mm=10 * b["du_cm"],
-                           error=b[measure], lattice_worst=worst[b["lattice"]], wall_time_s=b["wall_time_s"],
-                           steps=int(b["steps"]))
+                           error=b[measure], family_worst=worst[b["lattice"], b["variant"]],
+                           wall_time_s=b["wall_time_s"], steps=int(b["steps"]))
             else:
                 row.update(run="none", lattice="", variant="", du_mm=np.nan, error=np.nan,
-                           lattice_worst=worst.min() if len(worst) else np.nan, wall_time_s=np.nan, steps=np.nan)
+                           family_worst=worst.min() if len(worst) else np.nan, wall_time_s=np.nan, steps=np.nan)
             row["by_chance"] = anyhit.loc[anyhit["wall_time_s"].idxmin(), "run"] if len(anyhit) else "none"
             rows.append(row)
     return pd.DataFrame(rows)
@@ -464,11 +477,11 @@ def report_section(errors, fire_ratio, fire_grid, stability_map, cases, study_co
           "in other equilibria of the same lattice):", "", _md(resolution_table(err)), ""]
     rec = recommend(err, targets)
     t += ["### Which configuration to pick", "",
-          "For each error target: the fastest run that reached f_tol (status converged) on a lattice whose "
-          "converged runs *all* meet the target (`robust_lattices`; `lattice_worst` is that lattice's largest "
-          "error), and the fastest converged run that meets it at all (`by_chance`: on a lattice where another "
-          "update rule or du misses it). `none`: no lattice in the sweep meets the target robustly.", "",
-          _md(rec), ""]
+          "For each error target: the fastest run that reached f_tol (status converged) among the "
+          "(lattice, update rule) families whose converged runs meet the target at *every* du of the sweep "
+          "(`robust_families`; `family_worst` is the chosen family's largest error), and the fastest converged "
+          "run that meets it at all (`by_chance`: another du of its family misses it). `none`: no family meets "
+          "the target at every du.", "", _md(rec), ""]
     t += _advice(err, rec)
     # FIRE
     t += ["### FIRE: force evaluations to f_tol", "",
@@ -522,11 +535,11 @@ def _advice(err, rec):
     for _, r in rec.iterrows():
         if r["run"] != "none":
             out.append(f"- `{r['measure']}` within {r['target']:g}: pick `{r['run']}` ({r['lattice']} lattice, "
-                       f"{r['variant']}, du = {r['du_mm']:.3g} mm), {r['wall_time_s']:.3g} s; every converged run "
-                       f"of that lattice stays within {r['lattice_worst']:.3g}.")
+                       f"{r['variant']}, du = {r['du_mm']:.3g} mm), {r['wall_time_s']:.3g} s; every converged "
+                       f"{r['lattice']}/{r['variant']} run stays within {r['family_worst']:.3g}.")
         else:
-            out.append(f"- `{r['measure']}` within {r['target']:g}: no lattice guarantees it (smallest worst case "
-                       f"{r['lattice_worst']:.3g}); `{r['by_chance']}` meets it on one relaxation path only.")
+            out.append(f"- `{r['measure']}` within {r['target']:g}: no configuration guarantees it (smallest worst "
+                       f"case {r['family_worst']:.3g}); `{r['by_chance']}` meets it at its du only.")
     conv = err[err["status"] == "converged"]
     ref = conv[(conv["variant"] == "capped") & (conv["du_factor"] == 1)]
     if len(ref):

@@ -11,19 +11,6 @@ STUDY_RUNS = S.plan(STUDY)
 STUDY_META = S.meta(STUDY_RUNS)
 
 
-def study_files(group, **match):
-    """Run files of one plan group whose entries match the given fields."""
-    return [
-        f"results/study/runs/{sid}.nc"
-        for sid, m in STUDY_RUNS.items()
-        if m["group"] == group and all(m.get(k) == v for k, v in match.items())
-    ]
-
-
-def study_overrides(wc):
-    return " ".join(f"--set '{s}'" for s in STUDY_RUNS[wc.sid]["set"])
-
-
 STUDY_FIG_CODE = code("figures/__init__", "figures/style", "figures/study", "study")
 
 
@@ -34,7 +21,7 @@ rule study_run:
     output:
         "results/study/runs/{sid}.nc",
     params:
-        overrides=study_overrides,
+        overrides=lambda wc: S.cli_overrides(STUDY_RUNS, wc.sid),
     log:
         "logs/study/run/{sid}.log",
     benchmark:
@@ -47,7 +34,7 @@ rule study_run:
 
 rule study_error_table:
     input:
-        runs=study_files("error_runtime"),
+        runs=S.run_files(STUDY_RUNS, "error_runtime"),
         code=code("study", "metrics", "theory"),
     output:
         "figures/error_vs_runtime.csv",
@@ -62,12 +49,12 @@ rule study_error_table:
 
 rule study_fire_tables:
     input:
-        tuning=study_files("fire_tuning"),
+        tuning=S.run_files(STUDY_RUNS, "fire_tuning"),
         references=[
             f
             for lat in STUDY["fire_tuning"]["lattices"]
             for var in ("capped", "paper")
-            for f in study_files("error_runtime", lattice=lat, variant=var, du_factor=1)
+            for f in S.run_files(STUDY_RUNS, "error_runtime", lattice=lat, variant=var, du_factor=1)
         ],
         code=code("study", "metrics", "theory"),
     output:
@@ -88,7 +75,7 @@ rule study_fire_tables:
 
 rule study_map_table:
     input:
-        runs=study_files("stability_map"),
+        runs=S.run_files(STUDY_RUNS, "stability_map"),
         code=code("study", "metrics", "theory"),
     output:
         "results/study/stability_map.csv",
@@ -103,7 +90,7 @@ rule study_map_table:
 
 rule study_cases_table:
     input:
-        runs=study_files("cases"),
+        runs=S.run_files(STUDY_RUNS, "cases"),
         code=code("study", "metrics", "theory"),
     output:
         "figures/stability_cases.csv",
