@@ -142,14 +142,20 @@ def test_particles_exactly_on_walls_are_pushed_into_the_liquid(tmp_path):
     check_honest(ds)
 
 
-@pytest.mark.xfail(strict=True, reason="kernel: crossed_wall tests s0 * s1 < 0, so a move that ends exactly "
-                                       "on a wall, and the next one from there, are never flagged")
-def test_landing_exactly_on_an_interior_wall_then_crossing_is_reported():
+def test_landing_exactly_on_an_interior_wall_is_reported():
     # a shelf across the box at y = 10; a particle far heavier than R_bu at y = 10.25 with du = 0.25
-    # lands exactly on the shelf (10.25 - 0.25 = 10.0), then steps through it
+    # would land exactly on the shelf (10.25 - 0.25 = 10.0): refused at step 0, nothing moves
     walls = np.array([[0, 20, 0, 0], [0, 0, 20, 0], [20, 0, 20, 20], [0, 10, 20, 10]], float)
     pos = np.array([[10.0, 10.25]])
     f = np.zeros_like(pos)
     steps, status, info = K.relax(pos, np.zeros_like(pos), np.array([1.0e6]), walls, np.array([0, 0, 20, 20.0]),
                                   5.0, 1.0e4, 7.07, 3535.0, K.PAPER, 0.25, 1.0, 1.0, 0.1, 3, 1.0, f, np.zeros(3))
-    assert status == K.CROSSED or pos[0, 1] >= 10.0
+    assert (steps, status, info) == (0, K.CROSSED, 0 * 4 + 3)  # particle 0, wall 3 (the shelf)
+    assert pos[0, 1] == 10.25
+
+
+def test_leaving_a_wall_to_its_back_side_is_refused():
+    floor = np.array([[0, 0, 20, 0]], float)
+    assert K.crossed_wall(5.0, 0.0, 5.0, -0.1, floor) == 0  # on the floor, moving below it
+    assert K.crossed_wall(5.0, 0.0, 5.0, 0.1, floor) == -1  # on the floor, moving into the liquid
+    assert K.crossed_wall(25.0, 0.1, 25.0, 0.0, floor) == -1  # landing on the floor's line beyond its end

@@ -1,0 +1,61 @@
+# Speed benchmarks (benchmarks/, reported in files; never timed tests).
+# The step-cost benchmark takes both cores so other jobs do not perturb it.
+
+
+rule bench_step:
+    input:
+        script="benchmarks/bench_step.py",
+        reference="benchmarks/numpy_reference.py",
+        code=code("kernels", "scene"),
+    output:
+        "benchmarks/results/step_cost.csv",
+        "benchmarks/results/compile.csv",
+        "benchmarks/results/memory.csv",
+        "benchmarks/results/summary.txt",
+        "benchmarks/results/machine.txt",
+        "benchmarks/results/step_cost.png",
+    threads: workflow.cores
+    log:
+        "logs/benchmarks/bench_step.log",
+    shell:
+        "python {input.script} > {log} 2>&1"
+
+
+
+
+
+rule bench_output:
+    input:
+        script="benchmarks/bench_output.py",
+        scene="config/scenes/single_refined.yaml",
+        code=SOLVER_CODE,
+    output:
+        "benchmarks/results/output_cost.csv",
+    threads: workflow.cores
+    log:
+        "logs/benchmarks/bench_output.log",
+    shell:
+        "python {input.script} > {log} 2>&1"
+
+
+rule report_speed:
+    input:
+        step_cost="benchmarks/results/step_cost.csv",
+        compile="benchmarks/results/compile.csv",
+        memory="benchmarks/results/memory.csv",
+        machine="benchmarks/results/machine.txt",
+        output_cost="benchmarks/results/output_cost.csv",
+        table1="figures/table1.csv",
+        code=code("report"),
+    output:
+        "results/report/40_speed.md",
+    params:
+        func="speed_section",
+    log:
+        "logs/report/speed.log",
+    script:
+        "../scripts/report.py"
+
+
+REPORT_PARTS += ["results/report/40_speed.md"]
+ALL_TARGETS += ["benchmarks/results/output_cost.csv"]
