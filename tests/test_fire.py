@@ -1,4 +1,4 @@
-"""FIRE 2.0 (kernels.relax, variant FIRE) on the paper's coarse single vessel: it reaches
+"""FIRE (kernels.relax, variant FIRE) on the paper's coarse single vessel: it reaches
 the same equilibrium criterion as the capped update in far fewer force evaluations.
 Units cm, N."""
 
@@ -27,6 +27,7 @@ def test_fire_reaches_the_capped_equilibrium_in_far_fewer_steps(tmp_path):
     level = metrics.load_errors(fire)["level"]
     assert abs(level - metrics.load_errors(capped)["level"]) < 2.5
     # every step is one force evaluation.  Bound: 1/20 of the capped update's steps
-    # (9,964 -> 498), a margin below the issue's 50x that FIRE 2.0 does not reach here
-    # (278 steps, 36x); Bitzek et al.'s FIRE took 298, the paper update never converges.
+    # (9,964 -> 498), a margin below the issue's 50x that FIRE does not reach here
+    # (298 steps, 33x; FIRE 2.0 was tried: 278 coarse but 805 refined, so not kept);
+    # the paper's update never converges.
     assert int(fire["steps"]) < int(capped["steps"]) / 20

@@ -20,21 +20,6 @@ PAPER, CAPPED, FIRE = 0, 1, 2
 # status codes returned by :func:`relax`
 RUNNING, CONVERGED, NONFINITE, CROSSED = 0, 1, 2, 3
 
-# FIRE 2.0 constants (Guenole et al., Comput. Mater. Sci. 175, 109584 (2020),
-# Algorithm 2 and Table 1; the same defaults as LAMMPS' min_style fire):
-# dt starts at dt_max / 10 (their dt_max = 10 dt_MD) and never shrinks below
-# dt_min = 0.02 dt_MD; dt grows by F_INC (and alpha shrinks by F_ALPHA) only
-# after more than N_DELAY consecutive steps with P = F.v > 0; on P <= 0 dt
-# shrinks by F_DEC and alpha restarts at ALPHA_START, except during the first
-# N_DELAY steps ("initial delay").
-FIRE_DT_START = 0.1     # dt_start / dt_max
-FIRE_DT_MIN = 0.002     # dt_min / dt_max (= 0.02 dt_start)
-FIRE_N_DELAY = 20
-FIRE_F_INC = 1.1
-FIRE_F_DEC = 0.5
-FIRE_ALPHA_START = 0.25
-FIRE_F_ALPHA = 0.99
-
 
 @njit(**JIT)
 def segment_closest(px, py, x0, y0, x1, y1):
@@ -451,10 +436,9 @@ def relax(pos, vel, weight, walls, box, wl_u, wr_u, pl_u, pr_u, variant, du, f_r
     variant PAPER  : x += du * F / max|F|                      (paper §3.3)
     variant CAPPED : x += du * F / max(max|F|, f_ref)          (step stops
                      growing in force units once max|F| < f_ref)
-    variant FIRE   : FIRE 2.0 (Guenole et al. 2020; Bitzek et al. 2006) with
-                     unit masses; dt_max is its largest pseudo time step,
-                     capped so no particle moves more than du per step
-                     (largest component); vel (N, 2) carries its velocities.
+    variant FIRE   : FIRE (Bitzek et al. 2006) with unit masses; dt_max is its
+                     largest pseudo time step, capped so no particle moves
+                     more than du per step; vel (N, 2) carries its velocities.
     f (N, 2) receives the final out-of-balance forces [N]; fmax_hist[k] the
     max|F| [N] *before* step k.  A neighbour list with cutoff pl_u + skin is
     rebuilt whenever particles may have moved skin / 2 since the last build.
@@ -490,12 +474,10 @@ def relax(pos, vel, weight, walls, box, wl_u, wr_u, pl_u, pr_u, variant, du, f_r
     moved = 0.0
     _move_init(ps, fs, 0.0, False, ws, walls, wl_u, wr_u, ci, cw, fs)
     fmax = _pair_pass(ps, pl_u, pr_u, start, nbr, fs)
-    # FIRE 2.0 state (constants FIRE_* above)
-    dt = FIRE_DT_START * dt_max
-    alpha = FIRE_ALPHA_START
+    # FIRE state (Bitzek et al. 2006 default constants)
+    dt = 0.1 * dt_max
+    alpha = 0.1
     n_pos = 0
-    last = 0.0  # the last step moved each particle by last * its current velocity
-    ds = np.empty((n, 2))  # FIRE: displacement of a step with a half step back
     status = RUNNING
     info = -1
     done = n_steps
@@ -510,70 +492,40 @@ def relax(pos, vel, weight, walls, box, wl_u, wr_u, pl_u, pr_u, variant, du, f_r
             done = step
             break
         if variant == FIRE:
-            # FIRE 2.0 (Guenole et al. 2020, Algorithm 2) with unit masses.
-            # P = F.v in the caller's particle order, as in the plain loop
+            # sums in the caller's particle order, as in the plain loop
             p = 0.0
+            vn = 0.0
             fn = 0.0
             for i in range(n):
                 q = inv[i]
                 p += vs[q, 0] * fs[q, 0] + vs[q, 1] * fs[q, 1]
+                vn += vs[q, 0] ** 2 + vs[q, 1] ** 2
                 fn += fs[q, 0] ** 2 + fs[q, 1] ** 2
-            back = 0.0
             if p > 0.0:
+                c = alpha * np.sqrt(vn / fn)
+                for q in range(n):
+                    vs[q, 0] = (1.0 - alpha) * vs[q, 0] + c * fs[q, 0]
+                    vs[q, 1] = (1.0 - alpha) * vs[q, 1] + c * fs[q, 1]
                 n_pos += 1
-                if n_pos > FIRE_N_DELAY:
-                    dt = min(FIRE_F_INC * dt, dt_max)
-                    alpha *= FIRE_F_ALPHA
+                if n_pos > 5:
+                    dt = min(1.1 * dt, dt_max)
+                    alpha *= 0.99
             else:
                 n_pos = 0
-                if step >= FIRE_N_DELAY:  # no dt / alpha change during the initial delay
-                    if FIRE_F_DEC * dt >= FIRE_DT_MIN * dt_max:
-                        dt *= FIRE_F_DEC
-                    alpha = FIRE_ALPHA_START
-                # inertia correction: half a step back along v, never more than the
-                # last move itself (so it retraces part of it), then v = 0
-                back = min(0.5 * dt, last)
-                for q in range(n):
-                    ds[q, 0] = -back * vs[q, 0]
-                    ds[q, 1] = -back * vs[q, 1]
-                    vs[q, 0] = 0.0
-                    vs[q, 1] = 0.0
-            # semi-implicit Euler: v += dt F, then mix v towards F (FIRE 2.0 order)
-            vn = 0.0
-            for i in range(n):
-                q = inv[i]
-                vs[q, 0] += dt * fs[q, 0]
-                vs[q, 1] += dt * fs[q, 1]
-                vn += vs[q, 0] ** 2 + vs[q, 1] ** 2
-            c = alpha * np.sqrt(vn / fn) if fn > 0.0 else 0.0
+                dt *= 0.5
+                alpha = 0.1
+                vs[:, :] = 0.0
+            # semi-implicit Euler with the step capped at du
             vmax = 0.0
             for q in range(n):
-                vs[q, 0] = (1.0 - alpha) * vs[q, 0] + c * fs[q, 0]
-                vs[q, 1] = (1.0 - alpha) * vs[q, 1] + c * fs[q, 1]
+                vs[q, 0] += dt * fs[q, 0]
+                vs[q, 1] += dt * fs[q, 1]
                 vmax = max(vmax, abs(vs[q, 0]), abs(vs[q, 1]))
-            # x += dt v, with the move capped at du (largest component, as for du above)
-            if back == 0.0:
-                scale = dt
-                if vmax * dt > du:
-                    scale = du / vmax
-                last = scale
-                gs = vs
-            else:
-                dmax = 0.0
-                for q in range(n):
-                    ds[q, 0] += dt * vs[q, 0]
-                    ds[q, 1] += dt * vs[q, 1]
-                    dmax = max(dmax, abs(ds[q, 0]), abs(ds[q, 1]))
-                scale = 1.0
-                if dmax > du:
-                    scale = du / dmax
-                last = scale * dt
-                gs = ds
-            # actual largest move this step
-            inc = 0.0
-            for q in range(n):
-                inc = max(inc, gs[q, 0] ** 2 + gs[q, 1] ** 2)
-            inc = scale * np.sqrt(inc)
+            scale = dt
+            if vmax * dt > du:
+                scale = du / vmax
+            gs = vs
+            inc = np.sqrt(2.0) * scale * vmax  # largest move this step
         else:
             scale = du / fmax if variant == PAPER else du / max(fmax, f_ref)
             gs = fs

@@ -18,20 +18,15 @@ VARIANTS = {"paper": K.PAPER, "capped": K.CAPPED, "fire": K.FIRE}
 VARIANT_LABELS = {
     "paper": "paper: x += du F / max|F| (section 3.3, literal)",
     "capped": "capped: x += du F / max(max|F|, f_ref) (variant, not in paper)",
-    "fire": "fire: FIRE 2.0 relaxation, Guenole et al. 2020 (variant, not in paper)",
+    "fire": "fire: FIRE relaxation, Bitzek et al. 2006 (variant, not in paper)",
 }
 # capped default f_ref = du (k_b + 6 k_p): du / 2 times the Gershgorin bound
 # lambda_max <= 2 k_b + 12 k_p (two walls, six neighbours) of the stiffness
 # matrix, so the capped update is linearly stable; it equals w for both of the
 # paper's lattices (50 N, 12.5 N).
 PAIR_NEIGHBOURS = 6
-# fire default dt_max = 1.5 / sqrt(2 k_b + 12 k_p) (unit masses): below the
+# fire default dt_max = 1 / sqrt(2 k_b + 12 k_p) (unit masses): below the
 # explicit-integration limit 2 / sqrt(lambda_max) for the Gershgorin bound.
-# 1.5 (was 1) because FIRE 2.0 (kernels.FIRE_*) converges fastest near it on
-# both paper lattices: 283 / 805-926 steps (coarse, du = 1 cm / refined, du =
-# 0.25 cm; the refined count moves with the last bit of dt_max) against
-# 324 / 1752 at factor 1; at 2 the coarse lattice takes 278, the refined 908.
-FIRE_DT_FACTOR = 1.5
 
 
 @dataclass
@@ -104,7 +99,7 @@ def solver_params(scene):
         f_tol=float(s["f_tol"]),
         max_steps=int(s["max_steps"]),
         f_ref=float(s.get("f_ref", s["du"] * (kb + PAIR_NEIGHBOURS * kp))),
-        dt_max=float(s.get("dt_max", FIRE_DT_FACTOR / np.sqrt(2 * kb + 2 * PAIR_NEIGHBOURS * kp))),
+        dt_max=float(s.get("dt_max", 1.0 / np.sqrt(2 * kb + 2 * PAIR_NEIGHBOURS * kp))),
         skin=float(s.get("skin", 0.3 * pl_u)),
         chunk=int(s["chunk"]),
         wl_u=wl_u, wr_u=wr_u, pl_u=pl_u, pr_u=pr_u,
