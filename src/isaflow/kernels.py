@@ -74,6 +74,14 @@ def pair_push(dx, dy, l_u, r_u):
     return r_u, 0.0
 
 
+@njit(inline="always", **JIT)
+def track_max(fx, fy, fmax, finite):
+    """Running max|F| = max(|Fx|, |Fy|) [N] and all-finite flag after one particle."""
+    a = abs(fx)
+    b = abs(fy)
+    return max(fmax, a, b), finite & (a < np.inf) & (b < np.inf)  # False for NaN and inf
+
+
 @njit(**JIT)
 def build_pairs(pos, box, rc):
     """Half neighbour list of all pairs closer than ``rc`` via a cell list.
@@ -169,13 +177,7 @@ def forces(pos, weight, walls, wl_u, wr_u, pl_u, pr_u, pi, pj, m, f):
     fmax = 0.0
     finite = True
     for i in range(n):
-        a = abs(f[i, 0])
-        b = abs(f[i, 1])
-        finite &= (a < np.inf) & (b < np.inf)  # False for NaN and inf
-        if a > fmax:
-            fmax = a
-        if b > fmax:
-            fmax = b
+        fmax, finite = track_max(f[i, 0], f[i, 1], fmax, finite)
     if not finite:
         return np.nan
     return fmax
@@ -369,13 +371,7 @@ def _pair_pass(ps, pl_u, pr_u, start, nbr, fs):
             fs[j, 1] -= gy
         fs[q, 0] = fx
         fs[q, 1] = fy
-        a = abs(fx)
-        b = abs(fy)
-        finite &= (a < np.inf) & (b < np.inf)
-        if a > fmax:
-            fmax = a
-        if b > fmax:
-            fmax = b
+        fmax, finite = track_max(fx, fy, fmax, finite)
     if not finite:
         return np.nan
     return fmax
