@@ -83,6 +83,21 @@ def track_max(fx, fy, fmax, finite):
 
 
 @njit(**JIT)
+def push_pair(a, b, m, x, y):
+    """Store (x, y) at index m of the int32 arrays (a, b), doubling them when full.
+    Returns the (possibly new) arrays."""
+    if m == a.shape[0]:
+        a2 = np.empty(2 * m + 16, np.int32)
+        b2 = np.empty(2 * m + 16, np.int32)
+        a2[:m] = a[:m]
+        b2[:m] = b[:m]
+        a, b = a2, b2
+    a[m] = x
+    b[m] = y
+    return a, b
+
+
+@njit(**JIT)
 def build_pairs(pos, box, rc):
     """Half neighbour list of all pairs closer than ``rc`` via a cell list.
 
@@ -130,16 +145,7 @@ def build_pairs(pos, box, rc):
                         dx = xi - pos[j, 0]
                         dy = yi - pos[j, 1]
                         if dx * dx + dy * dy < rc2:
-                            if m == cap:
-                                cap *= 2
-                                pi2 = np.empty(cap, np.int32)
-                                pj2 = np.empty(cap, np.int32)
-                                pi2[:m] = pi[:m]
-                                pj2[:m] = pj[:m]
-                                pi = pi2
-                                pj = pj2
-                            pi[m] = i
-                            pj[m] = j
+                            pi, pj = push_pair(pi, pj, m, i, j)
                             m += 1
                         j = nxt[j]
                 i = nxt[i]
@@ -304,15 +310,7 @@ def _wall_candidates(pos, walls, reach):
             dx = pos[i, 0] - cx
             dy = pos[i, 1] - cy
             if dx * dx + dy * dy < r2:
-                if c == ci.shape[0]:
-                    ci2 = np.empty(2 * c, np.int32)
-                    cw2 = np.empty(2 * c, np.int32)
-                    ci2[:c] = ci[:c]
-                    cw2[:c] = cw[:c]
-                    ci = ci2
-                    cw = cw2
-                ci[c] = i
-                cw[c] = w
+                ci, cw = push_pair(ci, cw, c, i, w)
                 c += 1
     return ci[:c], cw[:c]
 
