@@ -125,6 +125,8 @@ def run_row(ds, vessel=None):
         variant=ds.attrs["variant"],
         particles=int(ds.sizes["particle"]),
         du_cm=float(ds.attrs["du"]),
+        lattice_a_cm=float(ds.attrs["lattice_a"]),
+        f_tol_N=float(ds.attrs["f_tol"]),
         steps=int(ds["steps"]),
         wall_time_s=float(ds["wall_time"]),
         status=ds.attrs["status"],
@@ -180,6 +182,8 @@ def flow_measures(ds):
         x = ds["pos"].values[:, 0]
         out[f"particles_{name}"] = int(np.count_nonzero((x >= x0) & (x < x1)))
     out["particles_left"] = out[f"particles_{names[0]}"]
+    x0, x1 = ds["vessel_x"].sel(vessel=names[0]).values
+    out["first_width_cm"] = float(x1 - x0)
     out["sum_fx_N"] = float(ds["wall_resultant"].sel(xy="x").sum())
     if "hist_vessel_count" in ds:
         out["mass_conserved"] = bool((ds["hist_vessel_count"].sum("vessel") == ds.sizes["particle"]).all())
@@ -216,7 +220,7 @@ def calibration_table(paths):
         kp = ds.attrs["pair_r_u"] / ds.attrs["pair_l_u"]
         e = load_errors(ds)
         rows.append(dict(run=Path(p).stem.rsplit("_kb", 1)[0], scene=ds.attrs["scene"], variant=ds.attrs["variant"], k_wall=kb, ratio=round(kp / kb, 6),
-                         level=e["level"], level_max=e["level_max"], level_implied=e["level_implied"],
+                         lattice_a=float(ds.attrs["lattice_a"]), level=e["level"], level_max=e["level_max"], level_implied=e["level_implied"],
                          status=ds.attrs["status"], steps=int(ds["steps"]), max_force=float(ds["max_force"])))
     return pd.DataFrame(rows).sort_values(["run", "k_wall", "ratio"])
 
