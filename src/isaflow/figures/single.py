@@ -47,7 +47,7 @@ def inputs_figure(inputs, outputs):
     axb.text(c[0] + 0.18 * a, 0.5 * (floor_y + c[1] - a / 2), f"{c[1] - a / 2 - floor_y:.3g} cm to wall\n"
              f"($l_{{bu}}$ = {wl:.3g} cm)", va="center")
     axb.text(c[0], c[1] + 0.04 * a, f"a = {a:g} cm", ha="center", va="bottom")
-    axb.text(c[0] + 0.3 * a, c[1] + 0.3 * a, f"a/√2 = {a / np.sqrt(2):.3g} cm", rotation=-45, ha="center",
+    axb.text(c[0] + 0.36 * a, c[1] + 0.36 * a, f"a/√2 = {a / np.sqrt(2):.3g} cm", rotation=-45, ha="center",
              va="center")
     axb.set_aspect("equal")
     axb.set_xlim(-0.8 * a, 0.8 * a)
