@@ -49,6 +49,17 @@ def vessel_view(ds, vessel=None):
 
 def load_errors(ds, vessel=None):
     """Level and wall-load error measures of a vessel (see module docstring)."""
+    return contact_loads(ds, vessel)[0]
+
+
+def contact_loads(ds, vessel=None):
+    """Error measures and per-contact loads of a vessel.
+
+    Returns (load_errors dict, (wall, point, computed, theory)): wall (C,) the
+    contact's wall index, -1 for contacts of other vessels' particles (a
+    dividing wall has two sides); point (C, 2) cm; computed (C,) N, |R_b|;
+    theory (C,) N from theory.contact_theory, NaN where not this vessel's.
+    """
     v = vessel_view(ds, vessel)
     pos = ds["pos"].values
     a = float(ds.attrs["lattice_a"])
@@ -87,7 +98,7 @@ def load_errors(ds, vessel=None):
     wet = np.isfinite(th)
     unit = gamma * h * a
     out["contact_rms"] = float(np.sqrt(np.mean(((mag[wet] - th[wet]) / unit) ** 2))) if wet.any() else np.nan
-    return out
+    return out, (cw, cp, mag, th)
 
 
 def stress_ratio(ds, vessel=None):
@@ -257,15 +268,9 @@ def contact_errors(ds, vessel=None):
     vessel's own particles (theory from theory.contact_theory, gamma and h as
     load_errors); (C,) array, empty if the vessel has no wetted contact.
     """
-    v = vessel_view(ds, vessel)
-    e = load_errors(ds, vessel)
-    walls = ds["wall_segment"].values
-    mine = v["inside"][ds["contact_particle"].values]
-    cw = np.where(mine, ds["contact_wall"].values, -1)
-    mag = np.hypot(*ds["contact_force"].values.T)
-    th = theory.contact_theory(walls, cw, ds["contact_point"].values, e["gamma"], e["level"], v["wall_in"])
+    e, (_, _, mag, th) = contact_loads(ds, vessel)
     wet = np.isfinite(th)
-    unit = e["gamma"] * (e["level"] - v["floor_y"]) * float(ds.attrs["lattice_a"])
+    unit = e["gamma"] * e["depth"] * float(ds.attrs["lattice_a"])
     return (mag[wet] - th[wet]) / unit
 
 

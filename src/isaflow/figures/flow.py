@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from .. import metrics, theory
+from .. import metrics
 from ..runfile import read
 from .single import _contact_bars
 from .style import COMPUTED, PAPER, THEORY, draw_walls, plt, run_caption, save
@@ -63,14 +63,8 @@ def flow_complete_figure(inputs, outputs, paper=None):
     fig, ax = plt.subplots(figsize=(12, 6))
     fm = _state_axes(ax, ds)
     second = str(ds["vessel"].values[-1])
-    e = metrics.load_errors(ds, second)
+    e, (_, _, mag, th) = metrics.contact_loads(ds, second)
     v = metrics.vessel_view(ds, second)
-    walls = ds["wall_segment"].values
-    mine = v["inside"][ds["contact_particle"].values]
-    cw = np.where(mine, ds["contact_wall"].values, -1)
-    th = theory.contact_theory(walls, cw, ds["contact_point"].values, e["gamma"], e["level"], v["wall_in"])
-    th[~mine] = np.nan
-    mag = np.hypot(*ds["contact_force"].values.T)
     _contact_bars(ax, ds, th, 15.0 / np.nanmax(np.concatenate([mag, th])))
     x0, x1 = v["x_range"]
     fy = v["floor_y"]

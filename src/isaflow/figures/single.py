@@ -83,10 +83,9 @@ def _contact_bars(ax, ds, th, scale):
 def single_vessel_figure(inputs, outputs, paper_level=None):
     """Paper Figs. 6 / 8: final state, level, wall reactions vs hydrostatic theory."""
     ds = read(inputs[0])
-    e = metrics.load_errors(ds)
+    e, (_, _, _, th) = metrics.contact_loads(ds)
     pos = ds["pos"].values
     walls = ds["wall_segment"].values
-    th = theory.contact_theory(walls, ds["contact_wall"].values, ds["contact_point"].values, e["gamma"], e["level"])
     fig, (ax, axp) = plt.subplots(1, 2, figsize=(12, 6.2), gridspec_kw={"width_ratios": [1.15, 1]})
     draw_walls(ax, ds)
     ax.plot(pos[:, 0], pos[:, 1], "o", ms=3 if len(pos) < 300 else 1.6, color="k")
