@@ -1,6 +1,9 @@
 # Replication of Papadopoulos, Koutitas & Lazaridis (2016).
 #   snakemake -c2                                   everything
 #   snakemake -c1 figures/fig06_single_coarse.png   one figure and what it needs
+import glob
+
+
 configfile: "config/config.yaml"
 configfile: "config/study.yaml"  # error against run time, stability study
 
@@ -14,7 +17,14 @@ include: "workflow/rules/benchmarks.smk"
 include: "workflow/rules/report.smk"
 
 
+# one rules file per additional method (SPH, MPS, 1D SPH, solid), each
+# registering its own targets, report fragment and claims
+for _rules in sorted(glob.glob("workflow/rules/methods/*.smk")):
+
+    include: _rules
+
+
 rule all:
     input:
-        ALL_TARGETS,
+        lambda wc: TARGETS["targets"],
     default_target: True

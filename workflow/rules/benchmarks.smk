@@ -57,5 +57,5 @@ rule report_speed:
         "../scripts/report.py"
 
 
-REPORT_PARTS += ["results/report/40_speed.md"]
-ALL_TARGETS += ["benchmarks/results/output_cost.csv"]
+register(report=["results/report/40_speed.md"])
+register(targets=["benchmarks/results/output_cost.csv"])

@@ -4,7 +4,20 @@ from snakemake.utils import validate
 validate(config, "../schemas/config.schema.yaml")
 
 RUNS = config["runs"]
-ALL_TARGETS = []
+
+# What each rules file contributes, read lazily by `rule all` and the report
+# (input functions run after every file is included, so include order does
+# not matter).  register(targets=[...]) adds files to the full target;
+# register(report=[...]) adds report fragments results/report/NN_name.md
+# (assembled in NN order); register(claims=[...]) adds claims-table CSVs
+# (columns: paper, section, claim, measured, verdict, evidence).
+TARGETS = {"targets": [], "report": [], "claims": []}
+
+
+def register(targets=(), report=(), claims=()):
+    TARGETS["targets"].extend(targets)
+    TARGETS["report"].extend(report)
+    TARGETS["claims"].extend(claims)
 
 
 def code(*modules):
@@ -49,9 +62,8 @@ def scene_law(scene_path, which):
     return law["l_u"], law["r_u"]
 
 
-# runs whose metrics go into results/metrics.csv (rule files append to it)
+# runs whose metrics go into results/metrics.csv
 METRIC_RUNS = list(RUNS)
-REPORT_PARTS = []
 
 
 CAL = config["calibration"]

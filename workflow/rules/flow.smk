@@ -67,6 +67,6 @@ rule report_flow:
         "../scripts/report.py"
 
 
-REPORT_PARTS += ["results/report/20_flow.md"]
-ALL_TARGETS += figure("fig09_flow_incomplete") + figure("fig10_flow_complete") + figure("flow_history")
-ALL_TARGETS += ["figures/table1.csv", "figures/table1.md"]
+register(report=["results/report/20_flow.md"])
+register(targets=figure("fig09_flow_incomplete") + figure("fig10_flow_complete") + figure("flow_history"))
+register(targets=["figures/table1.csv", "figures/table1.md"])

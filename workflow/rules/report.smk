@@ -1,5 +1,5 @@
 # Metrics table and docs/replication.md, regenerated from the run files.
-# Each part writes a fragment results/report/NN_part.md (REPORT_PARTS).
+# Each part writes a fragment results/report/NN_part.md (register(report=...)).
 
 
 rule metrics:
@@ -45,12 +45,12 @@ rule report_inferred:
         report.inferred_section(input.inferred, input.scenes, output[0])
 
 
-REPORT_PARTS += ["results/report/10_single.md", "results/report/90_inferred.md"]
+register(report=["results/report/10_single.md", "results/report/90_inferred.md"])
 
 
 rule replication_report:
     input:
-        parts=REPORT_PARTS,
+        parts=lambda wc: sorted(TARGETS["report"], key=lambda p: p.rsplit("/", 1)[-1]),
         code=code("report"),
     output:
         "docs/replication.md",
@@ -62,4 +62,4 @@ rule replication_report:
         report.assemble(input.parts, output[0])
 
 
-ALL_TARGETS += ["results/metrics.csv", "docs/replication.md"]
+register(targets=["results/metrics.csv", "docs/replication.md"])

@@ -100,6 +100,6 @@ rule fig_convergence:
         "../scripts/plot.py"
 
 
-ALL_TARGETS += figure("fig05_inputs_coarse") + figure("fig06_single_coarse")
-ALL_TARGETS += figure("fig07_inputs_refined") + figure("fig08_single_refined")
-ALL_TARGETS += figure("calibration_free_surface") + figure("convergence_single")
+register(targets=figure("fig05_inputs_coarse") + figure("fig06_single_coarse"))
+register(targets=figure("fig07_inputs_refined") + figure("fig08_single_refined"))
+register(targets=figure("calibration_free_surface") + figure("convergence_single"))

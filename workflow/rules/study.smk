@@ -150,6 +150,6 @@ rule report_study:
         "../scripts/study.py"
 
 
-REPORT_PARTS += ["results/report/30_study.md"]
-ALL_TARGETS += figure("error_vs_runtime") + figure("stability_map")
-ALL_TARGETS += ["figures/error_vs_runtime.csv", "figures/stability_cases.csv", "results/study/fire_ratio.csv"]
+register(report=["results/report/30_study.md"])
+register(targets=figure("error_vs_runtime") + figure("stability_map"))
+register(targets=["figures/error_vs_runtime.csv", "figures/stability_cases.csv", "results/study/fire_ratio.csv"])

@@ -1,0 +1,70 @@
+"""The method contract: what every method's solver returns.
+
+Every method is ``solve(...) -> Result``; ``runfile.to_dataset`` turns any
+Result into the same run-file fields, so metrics, figures and the report
+never branch on the method (only labels do).  Units: cm, N, s (core.units).
+
+Wall loads are *contacts*: (wall index, point on the wall, force of the wall
+on the liquid).  A point-particle method reports one contact per particle in
+range of a wall; a continuum method (SPH, MPS) integrates its wall pressure
+over panels of the wall (core.panels) and reports one contact per panel, at
+the panel's centre.  The same hydrostatic theory (theory.contact_theory) then
+judges both.
+"""
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+# The shared outcome list (run-file attribute ``status``).
+OUTCOMES = {
+    "converged": "stop criterion met: static equilibrium (max|F| < f_tol) or liquid at rest (kinetic-energy criterion)",
+    "cycle": "the iteration repeats with a fixed period and can never converge (detected)",
+    "step_limit": "step or time limit reached while still out of balance or moving",
+    "escaped": "a particle would cross a wall, or left the walls' bounding box",
+    "nonfinite": "a position, velocity or force became NaN or infinite",
+    "solver_failed": "an implicit (pressure) solve did not reach its tolerance",
+}
+
+
+@dataclass
+class Result:
+    """Outcome of one run of any method (arrays in cm, N, s).
+
+    history / fields map a run-file variable name to (dims, array, units,
+    long_name); history dims are ("record",) (per record) or ("sample", ...)
+    (per diagnostic sample), fields dims start with "particle".
+    """
+
+    method: str  # registry name, e.g. "isa", "sph", "mps"
+    variant: str  # registry variant name, e.g. "paper"
+    pos0: np.ndarray  # (N, 2) initial positions, cm
+    pos: np.ndarray  # (N, 2) final positions, cm
+    weight: np.ndarray  # (N,) particle weight m g, N
+    contact_wall: np.ndarray  # (C,) int wall index of each contact / panel
+    contact_point: np.ndarray  # (C, 2) point on the wall, cm
+    contact_force: np.ndarray  # (C, 2) force of the wall on the liquid, N
+    status: str  # one of OUTCOMES
+    message: str  # one line: why it stopped, with the step
+    steps: int  # total steps at the end, counted from the start of the chain
+    start_step: int  # steps already taken by the runs this one continues
+    wall_time: float  # s, solver only (compilation excluded)
+    force_evals: int  # force (or pressure-solve) evaluations in this run
+    residual: float  # final value of the method's convergence measure
+    residual_name: str  # e.g. "max|F|" or "kinetic energy"
+    residual_units: str
+    sim_time: float = float("nan")  # s of physical time simulated (dynamic methods)
+    history: dict = field(default_factory=dict)
+    fields: dict = field(default_factory=dict)
+    params: dict = field(default_factory=dict)  # scalar settings, written as attributes
+
+    def __post_init__(self):
+        if self.status not in OUTCOMES:
+            raise ValueError(f"unknown outcome '{self.status}'")
+
+
+def wall_resultants(contact_wall, contact_force, n_walls):
+    """(W, 2) resultant force [N] of each wall on the liquid, summed over its contacts."""
+    out = np.zeros((n_walls, 2))
+    np.add.at(out, np.asarray(contact_wall, int), np.asarray(contact_force, float))
+    return out

@@ -1,0 +1,5 @@
+"""Shared numerical core of every method: units, wall geometry, neighbour lists, smoothing kernels.
+
+Everything here is method-agnostic.  Kernels are ``numba.njit`` functions over
+plain arrays (no config, no I/O, no globals beyond constants).
+"""

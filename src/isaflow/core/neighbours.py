@@ -1,0 +1,163 @@
+"""Neighbour lists shared by every method: one cell-list builder (numba).
+
+``build_pairs`` returns a half list (each pair once) of all pairs closer than
+a cutoff; ``cell_rows`` the same pairs in the same order, stored by rows of a
+cell-sorted particle order (for cache-friendly force passes).  Both bin the
+particles the same way (:func:`cell_grid`, :func:`cell_of`).
+"""
+
+import numpy as np
+from numba import njit
+
+JIT = dict(cache=True, nogil=True)
+
+
+@njit(inline="always", **JIT)
+def cell_grid(box, rc):
+    """(ncx, ncy, csx, csy): cell counts and sizes [cm] of a grid over box with cells >= rc."""
+    ncx = max(1, int((box[2] - box[0]) / rc))
+    ncy = max(1, int((box[3] - box[1]) / rc))
+    return ncx, ncy, (box[2] - box[0]) / ncx, (box[3] - box[1]) / ncy
+
+
+@njit(inline="always", **JIT)
+def cell_of(x, y, box, ncx, ncy, csx, csy):
+    """Flat cell index of point (x, y); points outside the box are clamped into edge cells."""
+    cx = min(ncx - 1, max(0, int((x - box[0]) / csx)))
+    cy = min(ncy - 1, max(0, int((y - box[1]) / csy)))
+    return cy * ncx + cx
+
+
+@njit(**JIT)
+def push_pair(a, b, m, x, y):
+    """Store (x, y) at index m of the int32 arrays (a, b), doubling them when full.
+    Returns the (possibly new) arrays."""
+    if m == a.shape[0]:
+        a2 = np.empty(2 * m + 16, np.int32)
+        b2 = np.empty(2 * m + 16, np.int32)
+        a2[:m] = a[:m]
+        b2[:m] = b[:m]
+        a, b = a2, b2
+    a[m] = x
+    b[m] = y
+    return a, b
+
+
+@njit(**JIT)
+def build_pairs(pos, box, rc):
+    """Half neighbour list of all pairs closer than ``rc`` via a cell list.
+
+    box: (4,) ``xmin, ymin, xmax, ymax`` [cm] of the cell grid (particles
+    outside are clamped into edge cells, which stays correct, only slower).
+    Returns (pi, pj, m): int32 arrays whose first m entries are the pairs.
+    O(N) for bounded density.
+    """
+    n = pos.shape[0]
+    ncx, ncy, csx, csy = cell_grid(box, rc)
+    head = np.full(ncx * ncy, -1, np.int64)
+    nxt = np.empty(n, np.int64)
+    for i in range(n - 1, -1, -1):
+        c = cell_of(pos[i, 0], pos[i, 1], box, ncx, ncy, csx, csy)
+        nxt[i] = head[c]
+        head[c] = i
+    cap = 8 * n + 16
+    pi = np.empty(cap, np.int32)
+    pj = np.empty(cap, np.int32)
+    rc2 = rc * rc
+    m = 0
+    for cy in range(ncy):
+        for cx in range(ncx):
+            i = head[cy * ncx + cx]
+            while i >= 0:
+                xi = pos[i, 0]
+                yi = pos[i, 1]
+                # half stencil: own cell (later entries), E, NW, N, NE
+                for k in range(5):
+                    if k == 0:
+                        j = nxt[i]
+                    else:
+                        ox = (1, -1, 0, 1)[k - 1]
+                        nx_ = cx + ox
+                        ny_ = cy + (0, 1, 1, 1)[k - 1]
+                        if nx_ < 0 or nx_ >= ncx or ny_ >= ncy:
+                            continue
+                        j = head[ny_ * ncx + nx_]
+                    while j >= 0:
+                        dx = xi - pos[j, 0]
+                        dy = yi - pos[j, 1]
+                        if dx * dx + dy * dy < rc2:
+                            pi, pj = push_pair(pi, pj, m, i, j)
+                            m += 1
+                        j = nxt[j]
+                i = nxt[i]
+    return pi, pj, m
+
+
+@njit(**JIT)
+def cell_rows(pos, box, rc, cpart, cstart, start, nbr):
+    """The pair list of :func:`build_pairs`, in the same order, stored by rows.
+
+    The particles are counting-sorted into the same cells; cpart (N,) int32
+    receives them cell by cell (ascending within a cell, i.e. the order in
+    which :func:`build_pairs` visits them), cstart (ncx ncy + 1,) int32 the
+    cell boundaries in cpart.  Row q holds the pairs (cpart[q], nbr[k]) for
+    start[q] <= k < start[q + 1], in :func:`build_pairs`' order.  nbr (cap,)
+    int32 is reused and returned (grown when full); cstart is returned too
+    (reallocated if the grid changed size).
+    """
+    n = pos.shape[0]
+    ncx, ncy, csx, csy = cell_grid(box, rc)
+    nc = ncx * ncy
+    if cstart.shape[0] != nc + 1:
+        cstart = np.empty(nc + 1, np.int32)
+    cstart[:] = 0
+    cell = start[:n]  # scratch: start is rewritten below, after the cells are used
+    for i in range(n):
+        c = cell_of(pos[i, 0], pos[i, 1], box, ncx, ncy, csx, csy)
+        cell[i] = c
+        cstart[c + 1] += 1
+    for c in range(nc):
+        cstart[c + 1] += cstart[c]
+    # stable fill: ascending particles within each cell
+    for i in range(n):
+        c = cell[i]
+        cpart[cstart[c]] = i
+        cstart[c] += 1
+    for c in range(nc, 0, -1):
+        cstart[c] = cstart[c - 1]
+    cstart[0] = 0
+    rc2 = rc * rc
+    m = 0
+    for cy in range(ncy):
+        for cx in range(ncx):
+            c = cy * ncx + cx
+            for q in range(cstart[c], cstart[c + 1]):
+                i = cpart[q]
+                start[q] = m
+                xi = pos[i, 0]
+                yi = pos[i, 1]
+                # half stencil: own cell (later entries), E, NW, N, NE
+                for k in range(5):
+                    if k == 0:
+                        a = q + 1
+                        b = cstart[c + 1]
+                    else:
+                        nx_ = cx + (1, -1, 0, 1)[k - 1]
+                        ny_ = cy + (0, 1, 1, 1)[k - 1]
+                        if nx_ < 0 or nx_ >= ncx or ny_ >= ncy:
+                            continue
+                        a = cstart[ny_ * ncx + nx_]
+                        b = cstart[ny_ * ncx + nx_ + 1]
+                    for r in range(a, b):
+                        j = cpart[r]
+                        dx = xi - pos[j, 0]
+                        dy = yi - pos[j, 1]
+                        if dx * dx + dy * dy < rc2:
+                            if m == nbr.shape[0]:
+                                grown = np.empty(2 * m + 16, np.int32)
+                                grown[:m] = nbr[:m]
+                                nbr = grown
+                            nbr[m] = j
+                            m += 1
+    start[n] = m
+    return nbr, cstart
