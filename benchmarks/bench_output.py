@@ -8,7 +8,7 @@ steps to f_tol) relaxed in one process with two output settings, alternating, ea
   end, 20 state snapshots.
 Both relax the same scene from the same start, so they take the same steps.
 
-Measured per repetition: solver wall-clock time (isaflow.solver.Run.wall_time, the
+Measured per repetition: solver wall-clock time (contract.Result.wall_time, the
 compiled loop plus the Python bookkeeping between chunks) and the time to build and
 write the netCDF run file.  Units: s.
 
@@ -25,7 +25,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from isaflow import cli, runfile, scene, solver
+from isaflow import runfile, scene
+from isaflow.methods.isa import solver
 
 # Parameters
 ROOT = Path(__file__).resolve().parents[1]
@@ -40,16 +41,15 @@ COMMON = ["solver.variant=capped", "solver.accept=[converged,cycle,step_limit]"]
 def one_run(scene_path, overrides, tmp):
     """(steps, status, solver s, file s, file bytes) of one relaxation and its run file."""
     sc = scene.load(scene_path, COMMON + overrides)
-    pos0, weight, start, a = cli.initial_state(sc)
+    pos0, weight, start, a = scene.initial_state(sc)
     started = runfile.now()
     run = solver.solve(sc, pos0, weight, start_step=start)
     t0 = time.perf_counter()
-    ds = runfile.to_dataset(sc, run, weight, started, runfile.now(), runfile.provenance(sc))
-    ds.attrs["lattice_a"] = a
+    ds = runfile.to_dataset(run, sc, runfile.provenance({"scene": scene_path}), started, runfile.now(), a)
     path = Path(tmp) / "run.nc"
     runfile.write(ds, path)
     t_file = time.perf_counter() - t0
-    return run.step, run.status, run.wall_time, t_file, path.stat().st_size
+    return run.steps, run.status, run.wall_time, t_file, path.stat().st_size
 
 
 def main(argv=None):

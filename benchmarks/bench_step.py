@@ -1,4 +1,4 @@
-"""Cost of one step of the paper's algorithm (compiled ``kernels.relax``, variant PAPER) vs N.
+"""Cost of one step of the paper's algorithm (compiled ``methods.isa.relax.relax``, variant PAPER) vs N.
 
 Run: ``python benchmarks/bench_step.py [--quick]`` (a plain script, not a test).
 
@@ -18,8 +18,8 @@ their initial lattice x, so every tile holds whole lattice columns).
 
 Outputs (benchmarks/results/, or results/quick/ with --quick): step_cost[_TAG].csv, compile[_TAG].csv,
 memory[_TAG].csv, summary[_TAG].txt, machine.txt, step_cost.png.
-``--kernels FILE --tag before`` times another copy of kernels.py (e.g. the
-version before optimisation, ``git show REV:src/isaflow/kernels.py``).
+``--kernels FILE --tag before`` times another single-file copy of the kernels (e.g. the
+version before optimisation, ``git show 09b8875:src/isaflow/kernels.py``).
 """
 
 import argparse
@@ -59,9 +59,15 @@ QUICK_N = [180, 684, 3000, 10_000, 30_000]
 
 
 def load_kernels(path):
+    """The kernels to time: isaflow's (relax loop, force evaluation, neighbour list as one
+    namespace) or another copy of a single kernels file (an older version)."""
     if path is None:
-        from isaflow import kernels
-        return kernels
+        from types import SimpleNamespace
+
+        from isaflow.core import neighbours
+        from isaflow.methods.isa import forces, relax
+        return SimpleNamespace(relax=relax.relax, PAPER=relax.PAPER, RUNNING=relax.RUNNING,
+                               forces=forces.forces, build_pairs=neighbours.build_pairs)
     path = Path(path).resolve()  # imported by name so numba's cache can find it again
     sys.path.insert(0, str(path.parent))
     return importlib.import_module(path.stem)
@@ -299,7 +305,7 @@ def read_csv(path):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--quick", action="store_true", help="reduced N list (< 60 s)")
-    ap.add_argument("--kernels", help="time this copy of kernels.py instead of isaflow.kernels")
+    ap.add_argument("--kernels", help="time this copy of kernels.py instead of isaflow.methods.isa.relax")
     ap.add_argument("--tag", default="", help="suffix of the output files, e.g. 'before'")
     ap.add_argument("--no-numpy", action="store_true", help="skip the NumPy reference")
     ap.add_argument("--out", help="output folder (default benchmarks/results, or benchmarks/results/quick with --quick)")
@@ -396,7 +402,7 @@ def main():
 
     nb = [r for r in rows if r["impl"] == "numba"]
     expo = fit_exponent([r["N"] for r in nb], [r["s_per_step"] for r in nb])
-    lines = [f"kernels: {kpath or 'isaflow.kernels'}", f"mode: {'quick' if args.quick else 'full'}",
+    lines = [f"kernels: {kpath or "isaflow.methods.isa.relax"}", f"mode: {'quick' if args.quick else 'full'}",
              f"compile (cold cache) first call: {comp[0]['first_call_s']:.3f} s; "
              f"cache load (warm cache) first call: {comp[1]['first_call_s']:.3f} s "
              f"(hits {comp[1]['cache_hits']}, misses {comp[1]['cache_misses']})",

@@ -5,7 +5,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from isaflow import cli, runfile, scene, solver
+from isaflow import cli, runfile, scene
+from isaflow.methods.isa import solver
 
 ROOT = Path(__file__).resolve().parents[1]
 SCENES = ROOT / "config" / "scenes"
@@ -14,7 +15,7 @@ SCENES = ROOT / "config" / "scenes"
 def solve_scene(path, overrides=()):
     """Solve a scene file in memory; returns (Scene, Run)."""
     sc = scene.load(path, overrides)
-    pos0, weight, start, _ = cli.initial_state(sc)
+    pos0, weight, start, _ = scene.initial_state(sc)
     return sc, solver.solve(sc, pos0, weight, start_step=start)
 
 

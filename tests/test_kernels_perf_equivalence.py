@@ -8,8 +8,11 @@ computes exactly what the straightforward algorithm computes.  Units cm, N.
 import numpy as np
 import pytest
 
-from isaflow import kernels as K
 from isaflow.scene import rhombic_lattice
+from isaflow.methods.isa import forces as F
+from isaflow.core import geometry as GEO
+from isaflow.core import neighbours as NB
+from isaflow.methods.isa import relax as R
 
 A = 10.0
 L_P, R_P = A / np.sqrt(2.0), 500.0 * A / np.sqrt(2.0)  # pair law: cm, N
@@ -75,9 +78,9 @@ def relax_forces(pos, weight, walls, skin, wl_u=L_B, wr_u=R_B, pl_u=L_P, pr_u=R_
     f = np.zeros_like(pos)
     hist = np.zeros(1)
     p = pos.copy()
-    steps, status, _ = K.relax(p, np.zeros_like(p), weight, walls, BOX, wl_u, wr_u, pl_u, pr_u, K.PAPER,
+    steps, status, _ = R.relax(p, np.zeros_like(p), weight, walls, BOX, wl_u, wr_u, pl_u, pr_u, R.PAPER,
                                0.01, 1.0, 0.1, np.inf, 1, skin, f, hist)
-    assert (steps, status) == (0, K.CONVERGED)
+    assert (steps, status) == (0, R.CONVERGED)
     np.testing.assert_array_equal(p, pos)
     return f, hist[0]
 
@@ -93,9 +96,9 @@ def test_relax_forces_equal_brute_force(seed, skin):
     np.testing.assert_allclose(f, ref, rtol=1e-9, atol=1e-9 * scale)
     assert fmax == pytest.approx(scale, rel=1e-12)
     # the public forces() with build_pairs' list agrees too
-    pi, pj, m = K.build_pairs(pos, BOX, L_P + skin)
+    pi, pj, m = NB.build_pairs(pos, BOX, L_P + skin)
     f2 = np.zeros_like(pos)
-    K.forces(pos, weight, WALLS, L_B, R_B, L_P, R_P, pi, pj, m, f2)
+    F.forces(pos, weight, WALLS, L_B, R_B, L_P, R_P, pi, pj, m, f2)
     np.testing.assert_array_equal(f, f2)
 
 
@@ -113,16 +116,16 @@ def test_relax_history_equals_fresh_full_pair_list_each_step():
     pos = pos0.copy()
     f = np.zeros_like(pos)
     hist = np.zeros(n_steps)
-    steps, status, _ = K.relax(pos, np.zeros_like(pos), weight, walls, box, L_B, R_B, L_P, R_P, K.PAPER, du,
+    steps, status, _ = R.relax(pos, np.zeros_like(pos), weight, walls, box, L_B, R_B, L_P, R_P, R.PAPER, du,
                                1.0, 0.1, 1e-30, n_steps, 0.3 * L_P, f, hist)
-    assert (steps, status) == (n_steps, K.RUNNING)
+    assert (steps, status) == (n_steps, R.RUNNING)
     # reference: every pair i < j, rebuilt from scratch before every force evaluation
     p = pos0.copy()
     g = np.zeros_like(p)
     ref = np.zeros(n_steps)
     for k in range(n_steps + 1):
         pi, pj = (a.astype(np.int32) for a in np.triu_indices(n, 1))
-        fmax = K.forces(p, weight, walls, L_B, R_B, L_P, R_P, pi, pj, len(pi), g)
+        fmax = F.forces(p, weight, walls, L_B, R_B, L_P, R_P, pi, pj, len(pi), g)
         if k == n_steps:
             break
         ref[k] = fmax
@@ -137,31 +140,31 @@ def plain_relax(pos, weight, walls, box, variant, du, f_ref, n_steps, skin):
     pos = pos.copy()
     f = np.zeros_like(pos)
     rc = L_P + skin
-    pi, pj, m = K.build_pairs(pos, box, rc)
+    pi, pj, m = NB.build_pairs(pos, box, rc)
     moved = 0.0
-    fmax = K.forces(pos, weight, walls, L_B, R_B, L_P, R_P, pi, pj, m, f)
+    fmax = F.forces(pos, weight, walls, L_B, R_B, L_P, R_P, pi, pj, m, f)
     hist = []
     for step in range(n_steps):
         hist.append(fmax)
-        scale = du / fmax if variant == K.PAPER else du / max(fmax, f_ref)
+        scale = du / fmax if variant == R.PAPER else du / max(fmax, f_ref)
         for i in range(len(pos)):
             x1, y1 = pos[i, 0] + scale * f[i, 0], pos[i, 1] + scale * f[i, 1]
-            w = K.crossed_wall(pos[i, 0], pos[i, 1], x1, y1, walls)
+            w = GEO.crossed_wall(pos[i, 0], pos[i, 1], x1, y1, walls)
             if w >= 0:
                 for k in range(i):
                     pos[k, 0] -= scale * f[k, 0]
                     pos[k, 1] -= scale * f[k, 1]
-                return pos, f, np.array(hist), (step, K.CROSSED, i * len(walls) + w)
+                return pos, f, np.array(hist), (step, R.CROSSED, i * len(walls) + w)
             pos[i] = x1, y1
         moved += np.sqrt(2.0) * (scale * fmax)
         if moved > 0.5 * skin:
-            pi, pj, m = K.build_pairs(pos, box, rc)
+            pi, pj, m = NB.build_pairs(pos, box, rc)
             moved = 0.0
-        fmax = K.forces(pos, weight, walls, L_B, R_B, L_P, R_P, pi, pj, m, f)
-    return pos, f, np.array(hist), (n_steps, K.RUNNING, -1)
+        fmax = F.forces(pos, weight, walls, L_B, R_B, L_P, R_P, pi, pj, m, f)
+    return pos, f, np.array(hist), (n_steps, R.RUNNING, -1)
 
 
-@pytest.mark.parametrize("variant", [K.PAPER, K.CAPPED])
+@pytest.mark.parametrize("variant", [R.PAPER, R.CAPPED])
 def test_relax_is_bit_identical_to_the_plain_loop(variant):
     pos0, walls, box = small_lattice()
     weight = np.full(len(pos0), 50.0)
@@ -170,7 +173,7 @@ def test_relax_is_bit_identical_to_the_plain_loop(variant):
     pos = pos0.copy()
     f = np.zeros_like(pos)
     hist = np.zeros(n_steps)
-    ret = K.relax(pos, np.zeros_like(pos), weight, walls, box, L_B, R_B, L_P, R_P, variant, 0.01, 50.0, 0.1,
+    ret = R.relax(pos, np.zeros_like(pos), weight, walls, box, L_B, R_B, L_P, R_P, variant, 0.01, 50.0, 0.1,
                   1e-30, n_steps, skin, f, hist)
     assert tuple(ret) == ref_ret
     np.testing.assert_array_equal(hist, ref_hist)
@@ -185,10 +188,10 @@ def test_far_particle_with_a_huge_step_is_still_caught_crossing():
     walls = np.array([[0, 0, 60, 0]], float)
     weight = np.array([1.0, 1.0, 1e4, 1.0])  # particle 2 carries max|F|: it moves du straight down
     box = np.array([0.0, -30.0, 60.0, 60.0])
-    ref = plain_relax(pos, weight, walls, box, K.PAPER, 25.0, 1.0, 3, 1.0)
+    ref = plain_relax(pos, weight, walls, box, R.PAPER, 25.0, 1.0, 3, 1.0)
     p = pos.copy()
     f = np.zeros_like(p)
-    ret = K.relax(p, np.zeros_like(p), weight, walls, box, L_B, R_B, L_P, R_P, K.PAPER, 25.0, 1.0, 0.1, 1e-30, 3,
+    ret = R.relax(p, np.zeros_like(p), weight, walls, box, L_B, R_B, L_P, R_P, R.PAPER, 25.0, 1.0, 0.1, 1e-30, 3,
                   1.0, f, np.zeros(3))
-    assert tuple(ret) == ref[3] == (0, K.CROSSED, 2)
+    assert tuple(ret) == ref[3] == (0, R.CROSSED, 2)
     np.testing.assert_array_equal(p, ref[0])  # particles 0, 1 moved and moved back exactly as in the plain loop

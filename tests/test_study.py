@@ -13,6 +13,7 @@ import xarray as xr
 import yaml
 
 from isaflow import metrics, scene, study, theory
+from isaflow.methods.isa.settings import fire_dt_max, settings
 
 from conftest import ROOT
 
@@ -45,9 +46,9 @@ def hydrostatic_run(h=60.0, a=10.0, width=100.0, w=50.0):
          "wall_segment": (("wall", "end"), walls), "contact_wall": (("contact",), cw[keep]),
          "contact_particle": (("contact",), owner),
          "contact_point": (("contact", "xy"), cp[keep]),
-         "contact_force": (("contact", "xy"), normal[keep] * mag[keep, None]), "max_force": ((), 0.05)},
+         "contact_force": (("contact", "xy"), normal[keep] * mag[keep, None]), "residual": ((), 0.05)},
         coords={"wall": ["left", "floor", "right"], "xy": ["x", "y"]})
-    ds.attrs.update(lattice_a=a, wall_l_u=5.0, wall_r_u=10000.0, pair_l_u=a / np.sqrt(2), pair_r_u=500 * a / np.sqrt(2))
+    ds.attrs.update(spacing=a, wall_l_u=5.0, wall_r_u=10000.0, pair_l_u=a / np.sqrt(2), pair_r_u=500 * a / np.sqrt(2))
     return ds
 
 
@@ -60,7 +61,7 @@ def test_hydrostatic_loads_have_zero_error():
     for key in ("wall_err_left", "wall_err_floor", "wall_err_right", "wall_err_max", "side_err", "floor_err",
                 "contact_rms", "contact_max", "level_err_hydro_cm"):
         assert e[key] == pytest.approx(0.0, abs=1e-9), key
-    assert e["residual_N"] == 0.05
+    assert e["residual"] == 0.05
     # side contacts a/2 apart: the resultant of the tributary loads sits within a/4 of h/3
     assert abs(e["side_height_err_cm"]) < 10.0 / 4
 
@@ -119,10 +120,10 @@ def test_plan_covers_the_issue(plan):
 def test_every_planned_run_is_a_valid_scene_with_its_du(plan):
     for sid, m in plan.items():
         sc = scene.load(m["scene"], m["set"])  # raises SceneError naming the field otherwise
-        s = sc.solver
+        s = settings(sc)
         assert s["variant"] == m["variant"] and s["history"] == {} and set(s["accept"]) == set(study.OUTCOMES), sid
         if m["group"] != "cases":
-            base = scene.load(m["scene"]).solver["du"]
+            base = settings(scene.load(m["scene"]))["du"]
             assert s["du"] == pytest.approx(m["du_factor"] * base, rel=1e-7), sid
         if m["variant"] == "fire":
             k = 2 * sc.stiffness("wall") + 12 * sc.stiffness("pair")
@@ -131,7 +132,7 @@ def test_every_planned_run_is_a_valid_scene_with_its_du(plan):
 
 def test_fire_dt_max_of_the_paper_stiffness():
     # 2 / sqrt(2 x 2000 + 12 x 500) = 2 / 100 s
-    assert study.fire_dt_max(2000.0, 500.0, 2.0) == pytest.approx(0.02)
+    assert fire_dt_max(2000.0, 500.0, 2.0) == pytest.approx(0.02)
 
 
 @pytest.mark.parametrize("x", [1e-5, 0.01, 3535.5339, 1e8, 1e308, 2.5e-300])
@@ -186,7 +187,7 @@ def test_reduced_study_builds_both_figures_and_the_report_fragment(tmp_path):
     # physics: the capped update reaches f_tol at the paper's level (tolerance a/4 = 2.5 cm);
     # the literal update ends in its period-2 cycle
     cap = err.loc["er_coarse_capped_du1"]
-    assert cap["status"] == "converged" and cap["residual_N"] < 0.1 and abs(cap["level_err_paper_cm"]) <= 2.5
+    assert cap["status"] == "converged" and cap["residual"] < 0.1 and abs(cap["level_err_paper_cm"]) <= 2.5
     assert err.loc["er_coarse_paper_du1", "status"] == "cycle" and err.loc["er_coarse_paper_du1", "paper_config"]
     cases = pd.read_csv(tmp_path / "figures" / "stability_cases.csv").set_index("run")
     big = cases.loc["sc_du_large_paper"]

@@ -3,10 +3,13 @@
 import numpy as np
 import pytest
 
-from isaflow import solver, theory
+from isaflow import theory
+from isaflow.methods.isa import solver
 from isaflow.scene import rhombic_lattice
 
 from conftest import box_walls
+from isaflow.methods.isa import forces as F
+from isaflow.core import neighbours as NB
 
 
 def test_wall_totals_are_the_hydrostatic_integrals():
@@ -75,11 +78,10 @@ def test_stiffness_matrix_is_the_force_jacobian():
     H = theory.stiffness_matrix(pos, *args)
 
     def force(p):
-        from isaflow import kernels as K
-
+        
         f = np.zeros_like(p)
-        pi, pj, m = K.build_pairs(p, np.array([0, 0, 40.0, 40.0]), 8.0)
-        K.forces(p, np.zeros(len(p)), walls, *args[1:], pi, pj, m, f)
+        pi, pj, m = NB.build_pairs(p, np.array([0, 0, 40.0, 40.0]), 8.0)
+        F.forces(p, np.zeros(len(p)), walls, *args[1:], pi, pj, m, f)
         return f.ravel()
 
     eps = 1e-6

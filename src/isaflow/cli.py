@@ -6,37 +6,17 @@ accept (no output written); 2 bad input (scene or start file).
 
 import argparse
 import sys
-from pathlib import Path
 
-import numpy as np
-
-from . import runfile, scene as scenes, solver
-
-
-def initial_state(scene):
-    """(pos0 (N, 2) cm, weight (N,) N, start_step, lattice a cm) of a scene."""
-    part = scene.spec["particles"]
-    if "from_run" in part:
-        src = part["from_run"]
-        if not Path(src).is_file():
-            raise scenes.SceneError(f"{scene.path}: field 'particles.from_run': no such file '{src}'")
-        ds = runfile.read(src)
-        if ds.attrs.get("status") == "escaped" or not np.isfinite(ds["pos"].values).all():
-            raise scenes.SceneError(f"{scene.path}: field 'particles.from_run': '{src}' holds no valid state")
-        pos = ds["pos"].values
-        lo, hi = scene.walls.reshape(-1, 2).min(0), scene.walls.reshape(-1, 2).max(0)
-        if ((pos < lo) | (pos > hi)).any():
-            raise scenes.SceneError(f"{scene.path}: field 'particles.from_run': particles of '{src}' lie outside the walls")
-        return pos, ds["weight"].values, int(ds["steps"]), float(ds.attrs["lattice_a"])
-    pos = scenes.initial_positions(scene)
-    return pos, np.full(len(pos), float(part["weight"])), 0, scene.spacing or np.nan
+from . import runfile, scene as scenes
+from .methods.isa import solver
+from .methods.isa.settings import settings
 
 
 def run(scene_path, out, overrides=(), config=None, quiet=False):
     """Load, solve and write one run; returns the exit code."""
     try:
         scene = scenes.load(scene_path, overrides)
-        pos0, weight, start, a = initial_state(scene)
+        pos0, weight, start, spacing = scenes.initial_state(scene)
     except scenes.SceneError as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
@@ -47,14 +27,17 @@ def run(scene_path, out, overrides=(), config=None, quiet=False):
             print(f"{scene.name}: step {step:>9d}  max|F| = {fmax:.4g} N", file=sys.stderr, flush=True)
 
     result = solver.solve(scene, pos0, weight, start_step=start, progress=progress)
-    accepted = scene.solver["accept"]
+    accepted = settings(scene)["accept"]
     print(f"{scene.name}: {result.status}: {result.message} ({result.wall_time:.3f} s)", file=sys.stderr)
     if result.status not in accepted:
         print(f"error: {scene.path}: field 'solver.accept': outcome '{result.status}' is not accepted "
               f"({', '.join(accepted)}); no output written", file=sys.stderr)
         return 1
-    ds = runfile.to_dataset(scene, result, weight, started, runfile.now(), runfile.provenance(scene, config))
-    ds.attrs["lattice_a"] = a
+    inputs = {"scene": scene.path, "config": config, "start": scene.spec["particles"].get("from_run")}
+    prov = runfile.provenance(inputs)
+    prov.update(scene_yaml=scene.text, scene_overrides="; ".join(scene.overrides) or "none",
+                scene_resolved_sha256=scene.digest)
+    ds = runfile.to_dataset(result, scene, prov, started, runfile.now(), spacing)
     runfile.write(ds, out)
     return 0
 

@@ -18,6 +18,7 @@ theory built from the weight the vessel holds and its measured level
 import numpy as np
 
 from . import theory
+from .core import neighbours as NB
 
 
 def vessel_view(ds, vessel=None):
@@ -62,15 +63,14 @@ def contact_loads(ds, vessel=None):
     """
     v = vessel_view(ds, vessel)
     pos = ds["pos"].values
-    a = float(ds.attrs["lattice_a"])
+    a = float(ds.attrs["spacing"])
     weight = float(ds["weight"].values[v["inside"]].sum())
     level = theory.free_surface_level(pos, a, v["x_range"])
     h = level - v["floor_y"]
     gamma = theory.specific_weight(weight, v["width"], level, v["floor_y"])
     walls = ds["wall_segment"].values
-    # contacts of this vessel's particles only (a dividing wall has two sides)
-    mine = v["inside"][ds["contact_particle"].values]
-    cw = np.where(mine, ds["contact_wall"].values, -1)
+    # contacts of this vessel's liquid only (a dividing wall has two sides)
+    cw = np.where(contact_in_vessel(ds, v["x_range"]), ds["contact_wall"].values, -1)
     cp = ds["contact_point"].values
     mag = np.hypot(*ds["contact_force"].values.T)
     th = theory.contact_theory(walls, cw, cp, gamma, level, v["wall_in"])
@@ -96,9 +96,33 @@ def contact_loads(ds, vessel=None):
     out["side_height_err"] = float(np.mean(side_h_err)) if side_h_err else np.nan
     out["level_implied"] = float(np.mean(implied)) if implied else np.nan
     wet = np.isfinite(th)
-    unit = gamma * h * a
-    out["contact_rms"] = float(np.sqrt(np.mean(((mag[wet] - th[wet]) / unit) ** 2))) if wet.any() else np.nan
+    c = (mag[wet] - th[wet]) / (gamma * h * panel_length(ds))
+    out["contact_rms"] = float(np.sqrt(np.mean(c**2))) if len(c) else np.nan
+    out["contact_max"] = float(np.abs(c).max()) if len(c) else np.nan
     return out, (cw, cp, mag, th)
+
+
+def contact_in_vessel(ds, x_range):
+    """(C,) bool: the contact loads liquid of the vessel [xmin, xmax).
+
+    With a ``contact_particle`` variable (point-particle methods) the contact
+    belongs to its particle's vessel; otherwise (wall panels) to the vessel on
+    the liquid side (left) of its wall, a hair off the contact point.
+    """
+    if "contact_particle" in ds:
+        x = ds["pos"].values[ds["contact_particle"].values, 0]
+    else:
+        seg = ds["wall_segment"].values[ds["contact_wall"].values]
+        e = seg[:, 2:] - seg[:, :2]
+        left_nx = -e[:, 1] / np.hypot(e[:, 0], e[:, 1])
+        x = ds["contact_point"].values[:, 0] + 1e-6 * left_nx
+    return (x >= x_range[0]) & (x < x_range[1])
+
+
+def panel_length(ds):
+    """Wall length [cm] one contact stands for: the panel length of continuum methods,
+    the particle spacing a of point-particle methods (the unit of per-contact errors)."""
+    return float(ds.attrs.get("panel_length", ds.attrs["spacing"]))
 
 
 def stress_ratio(ds, vessel=None):
@@ -109,15 +133,14 @@ def stress_ratio(ds, vessel=None):
     walls and surface.  A fluid has K = 1; the hydrostatic side-wall loads
     scale with K, so 1 - K is the side-wall deficit a solid-like lattice shows.
     """
-    from . import kernels as K
 
     v = vessel_view(ds, vessel)
     pos = ds["pos"].values
     a = ds.attrs
     (x0, x1), y0 = v["x_range"], v["floor_y"]
-    h = theory.free_surface_level(pos, float(a["lattice_a"]), v["x_range"]) - y0
+    h = theory.free_surface_level(pos, float(a["spacing"]), v["x_range"]) - y0
     box = np.array([pos[:, 0].min(), pos[:, 1].min(), pos[:, 0].max() + 1e-9, pos[:, 1].max() + 1e-9])
-    pi, pj, m = K.build_pairs(pos, box, float(a["pair_l_u"]))
+    pi, pj, m = NB.build_pairs(pos, box, float(a["pair_l_u"]))
     d = pos[pi[:m]] - pos[pj[:m]]
     mid = 0.5 * (pos[pi[:m]] + pos[pj[:m]])
     sel = ((mid[:, 0] > x0 + 0.2 * (x1 - x0)) & (mid[:, 0] < x1 - 0.2 * (x1 - x0))
@@ -136,13 +159,13 @@ def run_row(ds, vessel=None):
         variant=ds.attrs["variant"],
         particles=int(ds.sizes["particle"]),
         du_cm=float(ds.attrs["du"]),
-        lattice_a_cm=float(ds.attrs["lattice_a"]),
+        spacing_cm=float(ds.attrs["spacing"]),
         f_tol_N=float(ds.attrs["f_tol"]),
         steps=int(ds["steps"]),
         wall_time_s=float(ds["wall_time"]),
         status=ds.attrs["status"],
         converged=bool(int(ds["converged"])),
-        max_force_N=float(ds["max_force"]),
+        residual=float(ds["residual"]),
     )
     total = ds["wall_resultant"].values.sum(0)
     W = float(ds["weight"].values.sum())
@@ -231,8 +254,8 @@ def calibration_table(paths):
         kp = ds.attrs["pair_r_u"] / ds.attrs["pair_l_u"]
         e = load_errors(ds)
         rows.append(dict(run=Path(p).stem.rsplit("_kb", 1)[0], scene=ds.attrs["scene"], variant=ds.attrs["variant"], k_wall=kb, ratio=round(kp / kb, 6),
-                         lattice_a=float(ds.attrs["lattice_a"]), level=e["level"], level_max=e["level_max"], level_implied=e["level_implied"],
-                         status=ds.attrs["status"], steps=int(ds["steps"]), max_force=float(ds["max_force"])))
+                         spacing=float(ds.attrs["spacing"]), level=e["level"], level_max=e["level_max"], level_implied=e["level_implied"],
+                         status=ds.attrs["status"], steps=int(ds["steps"]), residual=float(ds["residual"])))
     return pd.DataFrame(rows).sort_values(["run", "k_wall", "ratio"])
 
 
@@ -249,7 +272,7 @@ def tolerances(row, a, n_particles, f_tol):
     - side_height: a / 4 cm.  Side contacts sit a / 2 apart.
     """
     h = row["level"]
-    resid = max(row["max_force_N"], f_tol) * n_particles
+    resid = max(row["residual"], f_tol) * n_particles
     return {
         "level": (a / 4, "half a row pitch a/2: the level is a layer of particles"),
         "floor": (resid / row["weight"], "N max|F| / W: global vertical equilibrium up to the residuals"),
@@ -259,19 +282,6 @@ def tolerances(row, a, n_particles, f_tol):
 
 
 # --- single-vessel error measures of the error-vs-run-time study --------------
-
-
-def contact_errors(ds, vessel=None):
-    """Per-contact wall-load errors of a vessel, in units of one floor-contact load.
-
-    (computed - theoretical) / (gamma h a) for every wetted contact of the
-    vessel's own particles (theory from theory.contact_theory, gamma and h as
-    load_errors); (C,) array, empty if the vessel has no wetted contact.
-    """
-    e, (_, _, mag, th) = contact_loads(ds, vessel)
-    wet = np.isfinite(th)
-    unit = e["gamma"] * e["depth"] * float(ds.attrs["lattice_a"])
-    return (mag[wet] - th[wet]) / unit
 
 
 def hydrostatic_errors(ds, paper_level=None, vessel=None):
@@ -287,10 +297,11 @@ def hydrostatic_errors(ds, paper_level=None, vessel=None):
     - wall_err_<wall>: (computed total - theory) / theory of every wall the
       liquid wets (theory.wall_total); wall_err_max: the largest |wall_err_*|;
     - floor_err, side_err: as load_errors (floor; mean over the side walls);
-    - contact_rms, contact_max: RMS and largest |contact_errors| (units of one
-      floor-contact load gamma h a);
+    - contact_rms, contact_max: RMS and largest per-contact error (computed -
+      theory) / (gamma h a) over the wetted contacts (units of one floor-contact
+      load; a = metrics.panel_length);
     - side_height_err_cm: height of the side-wall resultant minus h / 3;
-    - residual_N: final max|F|, the solver's own convergence measure.
+    - residual: the solver's own final convergence measure (ISA: max|F|, N).
     """
     e = load_errors(ds, vessel)
     v = vessel_view(ds, vessel)
@@ -306,11 +317,10 @@ def hydrostatic_errors(ds, paper_level=None, vessel=None):
     out["wall_err_max"] = max(errs) if errs else np.nan
     out["floor_err"] = e.get("floor_err", np.nan)
     out["side_err"] = e["side_err"]
-    c = contact_errors(ds, vessel)
-    out["contact_rms"] = float(np.sqrt(np.mean(c**2))) if len(c) else np.nan
-    out["contact_max"] = float(np.abs(c).max()) if len(c) else np.nan
+    out["contact_rms"] = e["contact_rms"]
+    out["contact_max"] = e["contact_max"]
     out["side_height_err_cm"] = e["side_height_err"]
-    out["residual_N"] = float(ds["max_force"])
+    out["residual"] = float(ds["residual"])
     return out
 
 
@@ -322,7 +332,6 @@ def law_usage(ds):
     coincide); min_pair_cm: smallest inter-particle distance (NaN without a
     pair in range).  All NaN when positions are not finite.
     """
-    from . import kernels as K
 
     pos = ds["pos"].values
     a = ds.attrs
@@ -333,7 +342,7 @@ def law_usage(ds):
     out["wall_use"] = float(mag.max() / a["wall_r_u"]) if len(mag) else 0.0
     l_u = float(a["pair_l_u"])
     box = np.array([pos[:, 0].min(), pos[:, 1].min(), pos[:, 0].max() + 1e-9, pos[:, 1].max() + 1e-9])
-    pi, pj, m = K.build_pairs(pos, box, l_u)
+    pi, pj, m = NB.build_pairs(pos, box, l_u)
     if m:
         d = np.hypot(*(pos[pi[:m]] - pos[pj[:m]]).T)
         out["min_pair_cm"] = float(d.min())

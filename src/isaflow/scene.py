@@ -16,9 +16,6 @@ import yaml
 
 SCHEMA = json.loads(resources.files("isaflow").joinpath("scene.schema.json").read_text())
 
-DEFAULTS = {"chunk": 1000, "stop_on_cycle": True, "accept": ["converged"], "history": {}}
-
-
 class SceneError(ValueError):
     """Invalid scene: message names the file and the offending field."""
 
@@ -37,10 +34,6 @@ class Scene:
         return self.spec["name"]
 
     @property
-    def solver(self):
-        return {**DEFAULTS, **self.spec["solver"]}
-
-    @property
     def walls(self):
         """(W, 4) float64 wall segments x0, y0, x1, y1 [cm]."""
         return np.array([w["from"] + w["to"] for w in self.spec["walls"]], float)
@@ -48,6 +41,11 @@ class Scene:
     @property
     def wall_names(self):
         return [w["name"] for w in self.spec["walls"]]
+
+    @property
+    def vessels(self):
+        """[(name, (xmin, xmax) cm)] of the scene's vessels (empty if it names none)."""
+        return [(v["name"], tuple(float(c) for c in v["x"])) for v in self.spec.get("vessels", [])]
 
     @property
     def spacing(self):
@@ -151,6 +149,30 @@ def _check_geometry(scene):
         )
 
 
+def initial_state(scene):
+    """(pos0 (N, 2) cm, weight (N,) N, start_step, spacing cm) of a scene.
+
+    A ``from_run`` scene continues the final state of that run file.
+    """
+    part = scene.spec["particles"]
+    if "from_run" in part:
+        from . import runfile
+
+        src = part["from_run"]
+        if not Path(src).is_file():
+            raise SceneError(f"{scene.path}: field 'particles.from_run': no such file '{src}'")
+        ds = runfile.read(src)
+        if ds.attrs.get("status") == "escaped" or not np.isfinite(ds["pos"].values).all():
+            raise SceneError(f"{scene.path}: field 'particles.from_run': '{src}' holds no valid state")
+        pos = ds["pos"].values
+        lo, hi = scene.walls.reshape(-1, 2).min(0), scene.walls.reshape(-1, 2).max(0)
+        if ((pos < lo) | (pos > hi)).any():
+            raise SceneError(f"{scene.path}: field 'particles.from_run': particles of '{src}' lie outside the walls")
+        return pos, ds["weight"].values, int(ds["steps"]), float(ds.attrs["spacing"])
+    pos = initial_positions(scene)
+    return pos, np.full(len(pos), float(part["weight"])), 0, scene.spacing or np.nan
+
+
 def initial_positions(scene):
     """(N, 2) initial positions [cm] of a lattice or points scene."""
     part = scene.spec["particles"]
@@ -160,3 +182,51 @@ def initial_positions(scene):
     if "points" in part:
         return np.array(part["points"], float).reshape(-1, 2)
     raise SceneError(f"{scene.path}: field 'particles.from_run': positions come from a run file")
+
+
+TANK_SCHEMA = json.loads(resources.files("isaflow").joinpath("tank.schema.json").read_text())
+
+
+@dataclass
+class Tank:
+    """A validated tank (config/tanks/*.yaml): walls, vessels and the liquid's weight and depth."""
+
+    path: str
+    spec: dict
+    text: str
+
+    name = property(lambda self: self.spec["name"])
+    walls = Scene.walls
+    wall_names = Scene.wall_names
+    digest = Scene.digest
+
+    vessels = Scene.vessels
+
+    @property
+    def weight(self):
+        """Total liquid weight W [N] per unit thickness."""
+        return float(self.spec["liquid"]["weight"])
+
+    @property
+    def depth(self):
+        """Hydrostatic depth [cm] of the liquid in the first vessel."""
+        return float(self.spec["liquid"]["depth"])
+
+
+def load_tank(path):
+    """Read and validate a tank file; raises SceneError naming the file and field."""
+    path = str(path)
+    try:
+        text = Path(path).read_text()
+        spec = yaml.safe_load(text)
+    except (OSError, UnicodeDecodeError, yaml.YAMLError) as err:
+        raise SceneError(f"{path}: cannot read tank: {err}") from None
+    errors = sorted(jsonschema.Draft202012Validator(TANK_SCHEMA).iter_errors(spec), key=lambda e: list(e.path))
+    if errors:
+        e = errors[0]
+        where = ".".join(str(p) for p in e.absolute_path) or "(top level)"
+        raise SceneError(f"{path}: field '{where}': {e.message}")
+    tank = Tank(path, spec, text)
+    if not np.isfinite(tank.walls).all():
+        raise SceneError(f"{path}: field 'walls': coordinates must be finite")
+    return tank

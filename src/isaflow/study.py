@@ -20,7 +20,7 @@ import pandas as pd
 from . import metrics, theory
 from . import scene as scenes
 from .runfile import read
-from .solver import PAIR_NEIGHBOURS
+from .methods.isa.settings import fire_dt_max, settings
 
 VARIANTS = ("paper", "capped", "fire")
 
@@ -76,15 +76,10 @@ def _num(x):
 def scene_values(path, overrides=()):
     """du [cm], max_steps, k_b, k_p [N/cm], r_u of both laws [N], lattice a [cm] and w [N] of a scene."""
     sc = scenes.load(path, overrides)
-    s = sc.solver
+    s = settings(sc)
     return dict(du=float(s["du"]), max_steps=int(s["max_steps"]), kb=sc.stiffness("wall"), kp=sc.stiffness("pair"),
                 wall_r_u=sc.law("wall")[1], pair_r_u=sc.law("pair")[1], a=sc.spacing,
                 w=float(sc.spec["particles"]["weight"]))
-
-
-def fire_dt_max(kb, kp, factor):
-    """FIRE's dt_max [s] = factor / sqrt(2 k_b + 12 k_p) (unit masses; Gershgorin bound of lambda_max)."""
-    return factor / math.hypot(math.sqrt(2 * kb), math.sqrt(2 * PAIR_NEIGHBOURS * kp))  # no overflow at 1e308
 
 
 def solver_sets(variant, du, max_steps, kb, kp, dt_factor, accept):
@@ -179,7 +174,7 @@ def _base_row(sid, ds):
     return dict(run=sid, scene=a["scene"], variant=a["variant"], particles=int(ds.sizes["particle"]),
                 du_cm=float(a["du"]), f_tol_N=float(a["f_tol"]), steps=int(ds["steps"]),
                 wall_time_s=float(ds["wall_time"]), status=a["status"],
-                outcome_detail=outcome_detail(a["status"], a["status_message"]), max_force_N=float(ds["max_force"]))
+                outcome_detail=outcome_detail(a["status"], a["status_message"]), residual=float(ds["residual"]))
 
 
 def _write(df, out):
@@ -202,7 +197,7 @@ def error_table(runs, outputs, meta, paper):
         ds = read(p)
         ref = paper.get(m.get("paper") or "", {})
         row = _base_row(sid, ds)
-        row.update(lattice=m["lattice"], a_cm=float(ds.attrs["lattice_a"]), du_factor=m["du_factor"],
+        row.update(lattice=m["lattice"], a_cm=float(ds.attrs["spacing"]), du_factor=m["du_factor"],
                    paper_config=bool(ref) and m["variant"] == "paper" and m["du_factor"] == 1,
                    paper_level_cm=ref.get("level", np.nan), paper_steps=ref.get("steps", np.nan),
                    paper_time_s=ref.get("time_s", np.nan))
@@ -239,8 +234,8 @@ def fire_tables(tuning, references, outputs, meta, paper, required_ratio):
         ds = read(p)
         row = _base_row(sid, ds)
         row.update(lattice=m["lattice"], du_factor=m["du_factor"], dt_factor=m["dt_factor"],
-                   dt_max_s=float(ds.attrs["dt_max"]), a_cm=float(ds.attrs["lattice_a"]),
-                   level_cm=theory.free_surface_level(ds["pos"].values, float(ds.attrs["lattice_a"]),
+                   dt_max_s=float(ds.attrs["dt_max"]), a_cm=float(ds.attrs["spacing"]),
+                   level_cm=theory.free_surface_level(ds["pos"].values, float(ds.attrs["spacing"]),
                                                       _x_range(ds)))
         grid.append(row)
     grid = pd.DataFrame(grid).sort_values(["lattice", "du_factor", "dt_factor"], key=_lattice_key)
@@ -250,7 +245,7 @@ def fire_tables(tuning, references, outputs, meta, paper, required_ratio):
         ds = read(p)
         refs[m["lattice"], m["variant"]] = dict(steps=int(ds["steps"]), status=ds.attrs["status"],
                                                 level=theory.free_surface_level(ds["pos"].values,
-                                                                                float(ds.attrs["lattice_a"]),
+                                                                                float(ds.attrs["spacing"]),
                                                                                 _x_range(ds)))
     ratio = []
     for lattice, g in grid.groupby("lattice", sort=False):
@@ -291,7 +286,7 @@ def stability_row(sid, ds, m):
     row = _base_row(sid, ds)
     kb = a["wall_r_u"] / a["wall_l_u"]
     w = float(ds["weight"].values.max())
-    lat_a = float(a["lattice_a"])
+    lat_a = float(a["spacing"])
     pos = ds["pos"].values
     finite = bool(np.isfinite(pos).all())
     row.update(variant_label=a["variant_label"], message=a["status_message"], max_steps=int(a["max_steps"]), k_wall=kb,
@@ -460,11 +455,11 @@ def report_section(errors, fire_ratio, fire_grid, stability_map, cases, study_co
          "- `wall_err_<wall>`, `wall_err_max`, `side_err`: (computed - hydrostatic) / hydrostatic wall totals; "
          "`contact_rms`, `contact_max`: per-contact errors in units of one floor-contact load gamma h a; "
          "`side_height_err_cm`: height of the side-wall resultant minus h/3;",
-         "- `residual_N`: final max|F|.", ""]
+         "- `residual`: final max|F|.", ""]
     # per-configuration summary
     show = err[["lattice", "variant", "du_factor", "du_cm", "particles", "status", "steps", "wall_time_s",
                 "level_err_paper_cm", "level_err_hydro_cm", "side_err", "contact_rms", "side_height_err_cm",
-                "residual_N"]].copy()
+                "residual"]].copy()
     show.insert(0, "paper's config", np.where(err["paper_config"], "yes", ""))
     show["du_cm"] = show["du_cm"].map(lambda x: f"{x:.3g}")
     t += ["### Sweep", "", "du is given as a factor of the paper's rule du = w / (10 k_p) (0.1 mm coarse, 0.025 mm "
@@ -514,7 +509,7 @@ def report_section(errors, fire_ratio, fire_grid, stability_map, cases, study_co
     t += ["Boundaries found:", "", map_boundaries(smap), ""]
     # cases
     cs["height_ratio"] = (cs["top_cm"] - cs["floor_cm"]) / (cs["top0_cm"] - cs["floor_cm"])
-    cols = ["case", "variant", "particles", "status", "outcome_detail", "steps", "wall_time_s", "max_force_N",
+    cols = ["case", "variant", "particles", "status", "outcome_detail", "steps", "wall_time_s", "residual",
             "level_cm", "top_cm", "height_ratio", "wall_use", "pair_use"] + [c for c in cs.columns
                                                                            if c.startswith("particles_")]
     t += ["### Extreme cases", "",
@@ -551,5 +546,5 @@ def _advice(err, rec):
     if len(pap):
         out.append(f"- The paper's literal update reached f_tol in {(pap['status'] == 'converged').sum()} of "
                    f"{len(pap)} sweep runs; its final states carry a residual max|F| of "
-                   f"{pap['residual_N'].min():.3g}-{pap['residual_N'].max():.3g} N.")
+                   f"{pap['residual'].min():.3g}-{pap['residual'].max():.3g} N.")
     return out + [""]

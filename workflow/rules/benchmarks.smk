@@ -6,7 +6,7 @@ rule bench_step:
     input:
         script="benchmarks/bench_step.py",
         reference="benchmarks/numpy_reference.py",
-        code=code("kernels", "scene"),
+        code=code("core/*", "methods/isa/*", "scene"),
     output:
         "benchmarks/results/step_cost.csv",
         "benchmarks/results/compile.csv",

@@ -1,4 +1,6 @@
 # Config validation and input functions shared by all rules.
+import glob
+
 from snakemake.utils import validate
 
 validate(config, "../schemas/config.schema.yaml")
@@ -20,12 +22,15 @@ def register(targets=(), report=(), claims=()):
     TARGETS["claims"].extend(claims)
 
 
-def code(*modules):
-    """Package source files a rule depends on, so editing them reruns the rule."""
-    return [f"src/isaflow/{m}.py" for m in modules]
+def code(*patterns):
+    """Package source files a rule depends on (globs under src/isaflow, without .py),
+    so editing them reruns the rule."""
+    return sorted({f for p in patterns for f in glob.glob(f"src/isaflow/{p}.py")})
 
 
-SOLVER_CODE = code("kernels", "solver", "scene", "runfile", "cli")
+# what an ISA run executes
+SOLVER_CODE = code("core/*", "methods/__init__", "methods/isa/*", "contract", "scene", "runfile", "cli")
+FIGURE_CODE = code("figures/*", "metrics", "theory", "methods/__init__", "methods/isa/__init__")
 
 
 def figure(name):

@@ -6,7 +6,7 @@ TABLE1_RUNS = sorted({run for row in config["table1"] for run in row["chain"]})
 rule fig_flow:
     input:
         runs=lambda wc: [run_file(FIGS[wc.name])],
-        code=code("figures/__init__", "figures/style", "figures/single", "figures/flow", "metrics", "theory"),
+        code=FIGURE_CODE,
     output:
         figure("{name}"),
     params:
@@ -23,7 +23,7 @@ rule fig_flow:
 rule fig_flow_history:
     input:
         runs=sorted({run_file(r) for chain in FLOW["chains"].values() for r in chain}),
-        code=code("figures/__init__", "figures/style", "figures/single", "figures/flow", "metrics", "theory"),
+        code=FIGURE_CODE,
     output:
         figure("flow_history"),
     params:

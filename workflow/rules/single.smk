@@ -41,7 +41,7 @@ FIGS = config["figures"]
 rule fig_inputs:
     input:
         runs=lambda wc: [run_file(FIGS[wc.name])],
-        code=code("figures/__init__", "figures/style", "figures/single", "figures/flow", "metrics", "theory"),
+        code=FIGURE_CODE,
     output:
         figure("{name}"),
     params:
@@ -57,7 +57,7 @@ rule fig_inputs:
 rule fig_single:
     input:
         runs=lambda wc: [run_file(FIGS[wc.name])],
-        code=code("figures/__init__", "figures/style", "figures/single", "figures/flow", "metrics", "theory"),
+        code=FIGURE_CODE,
     output:
         figure("{name}"),
     params:
@@ -74,7 +74,7 @@ rule fig_single:
 rule fig_calibration:
     input:
         runs=CAL_FILES,
-        code=code("figures/__init__", "figures/style", "figures/single", "figures/flow", "metrics", "theory"),
+        code=FIGURE_CODE,
     output:
         figure("calibration_free_surface"),
     params:
@@ -89,7 +89,7 @@ rule fig_calibration:
 rule fig_convergence:
     input:
         runs=[run_file(r) for r in ["single_coarse", "single_coarse_capped", "single_refined", "single_refined_capped"]],
-        code=code("figures/__init__", "figures/style", "figures/single", "figures/flow", "metrics", "theory"),
+        code=FIGURE_CODE,
     output:
         figure("convergence_single"),
     params:

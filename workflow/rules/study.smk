@@ -11,7 +11,7 @@ STUDY_RUNS = S.plan(STUDY)
 STUDY_META = S.meta(STUDY_RUNS)
 
 
-STUDY_FIG_CODE = code("figures/__init__", "figures/style", "figures/study", "study")
+STUDY_FIG_CODE = code("figures/*", "study", "methods/__init__", "methods/isa/__init__")
 
 
 rule study_run:

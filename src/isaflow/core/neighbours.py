@@ -94,14 +94,14 @@ def build_pairs(pos, box, rc):
 
 
 @njit(**JIT)
-def cell_rows(pos, box, rc, cpart, cstart, start, nbr):
+def cell_rows(pos, box, rc, order, cstart, row_start, nbr):
     """The pair list of :func:`build_pairs`, in the same order, stored by rows.
 
-    The particles are counting-sorted into the same cells; cpart (N,) int32
+    The particles are counting-sorted into the same cells; order (N,) int32
     receives them cell by cell (ascending within a cell, i.e. the order in
     which :func:`build_pairs` visits them), cstart (ncx ncy + 1,) int32 the
-    cell boundaries in cpart.  Row q holds the pairs (cpart[q], nbr[k]) for
-    start[q] <= k < start[q + 1], in :func:`build_pairs`' order.  nbr (cap,)
+    cell boundaries in order.  Row q holds the pairs (order[q], nbr[k]) for
+    row_start[q] <= k < row_start[q + 1], in :func:`build_pairs`' order.  nbr (cap,)
     int32 is reused and returned (grown when full); cstart is returned too
     (reallocated if the grid changed size).
     """
@@ -111,7 +111,7 @@ def cell_rows(pos, box, rc, cpart, cstart, start, nbr):
     if cstart.shape[0] != nc + 1:
         cstart = np.empty(nc + 1, np.int32)
     cstart[:] = 0
-    cell = start[:n]  # scratch: start is rewritten below, after the cells are used
+    cell = row_start[:n]  # scratch: row_start is rewritten below, after the cells are used
     for i in range(n):
         c = cell_of(pos[i, 0], pos[i, 1], box, ncx, ncy, csx, csy)
         cell[i] = c
@@ -121,7 +121,7 @@ def cell_rows(pos, box, rc, cpart, cstart, start, nbr):
     # stable fill: ascending particles within each cell
     for i in range(n):
         c = cell[i]
-        cpart[cstart[c]] = i
+        order[cstart[c]] = i
         cstart[c] += 1
     for c in range(nc, 0, -1):
         cstart[c] = cstart[c - 1]
@@ -132,8 +132,8 @@ def cell_rows(pos, box, rc, cpart, cstart, start, nbr):
         for cx in range(ncx):
             c = cy * ncx + cx
             for q in range(cstart[c], cstart[c + 1]):
-                i = cpart[q]
-                start[q] = m
+                i = order[q]
+                row_start[q] = m
                 xi = pos[i, 0]
                 yi = pos[i, 1]
                 # half stencil: own cell (later entries), E, NW, N, NE
@@ -149,7 +149,7 @@ def cell_rows(pos, box, rc, cpart, cstart, start, nbr):
                         a = cstart[ny_ * ncx + nx_]
                         b = cstart[ny_ * ncx + nx_ + 1]
                     for r in range(a, b):
-                        j = cpart[r]
+                        j = order[r]
                         dx = xi - pos[j, 0]
                         dy = yi - pos[j, 1]
                         if dx * dx + dy * dy < rc2:
@@ -159,5 +159,5 @@ def cell_rows(pos, box, rc, cpart, cstart, start, nbr):
                                 nbr = grown
                             nbr[m] = j
                             m += 1
-    start[n] = m
+    row_start[n] = m
     return nbr, cstart

@@ -46,7 +46,7 @@ def flow_incomplete_figure(inputs, outputs, paper=None):
     _contact_bars(ax, ds, np.full(len(mag), np.nan), 12.0 / max(mag.max(), 1.0))
     sfx = fm["sum_fx_N"]
     ax.set_title(f"(Fig. 9) step {int(ds['steps']):,}: sum of horizontal wall reactions ΣF_x = {sfx:+.0f} N "
-                 f"(paper: ΣF_x >> 0, to the right); max|F| = {float(ds['max_force']):.3g} N; "
+                 f"(paper: ΣF_x >> 0, to the right); max|F| = {float(ds['residual']):.3g} N; "
                  f"{fm['particles_second']} of {ds.sizes['particle']} particles transferred")
     ax.plot([], [], color=COMPUTED, lw=2.2, label="contact reactions $R_b$ (bars) and wall resultants (arrows)")
     ax.legend(loc="upper right", fontsize=8)

@@ -23,7 +23,7 @@ def _law_axes(ax, l_u, r_u, sym, title):
 def inputs_figure(inputs, outputs):
     """Paper Figs. 5 / 7: initial lattice, rhombic element, both force laws."""
     ds = read(inputs[0])
-    a = float(ds.attrs["lattice_a"])
+    a = float(ds.attrs["spacing"])
     pos = ds["pos0"].values
     fig, ax = plt.subplots(2, 2, figsize=(9, 8.5))
     ax0 = ax[0, 0]

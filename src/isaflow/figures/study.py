@@ -20,7 +20,7 @@ PANELS = [
      "(b) level against hydrostatic consistency (2 B F_side / W)"),
     ("side_err", "|side-wall total / hydrostatic - 1| (-)", "(c) side-wall loads against hydrostatics"),
     ("contact_rms", "RMS contact error (floor-contact loads γha)", "(d) per-contact wall loads against hydrostatics"),
-    ("residual_N", "residual max|F| (N)", "(e) residual out-of-balance force"),
+    ("residual", "residual max|F| (N)", "(e) residual out-of-balance force"),
 ]
 
 
@@ -49,7 +49,7 @@ def error_vs_runtime_figure(inputs, outputs):
                 ax.annotate(f"paper's config\n({r['lattice']}, du {10 * r['du_cm']:g} mm)",
                             (r["wall_time_s"], max(abs(r[col]), FLOOR)), xytext=((-80, -34), (14, 18))[k % 2],
                             textcoords="offset points", fontsize=7, arrowprops=dict(arrowstyle="->", lw=0.6))
-        if col == "residual_N":
+        if col == "residual":
             for ft in sorted(set(tab["f_tol_N"])):
                 ax.axhline(ft, color="gray", ls=":", lw=0.8)
             ax.text(0.02, 0.02, "dotted: f_tol of each lattice", transform=ax.transAxes, fontsize=7, color="gray")

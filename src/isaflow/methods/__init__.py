@@ -28,23 +28,28 @@ class Method:
     solver: str = ""  # "module:function" of its solve()
 
 
+def get(method):
+    """The Method of one registered package (KeyError naming the choices)."""
+    if method not in PACKAGES:
+        raise KeyError(f"unknown method '{method}' (choose from {', '.join(PACKAGES)})")
+    return importlib.import_module(f"isaflow.methods.{method}").METHOD
+
+
 def registry():
-    """{method name: Method} of every sub-package that exists."""
+    """{method name: Method} of every registered sub-package that exists."""
     out = {}
     for pkg in PACKAGES:
         try:
-            mod = importlib.import_module(f"isaflow.methods.{pkg}")
+            out[pkg] = get(pkg)
         except ModuleNotFoundError as err:
             if err.name != f"isaflow.methods.{pkg}":
                 raise
-            continue
-        out[mod.METHOD.name] = mod.METHOD
     return out
 
 
 def variant(method, name):
     """The registry's Variant of method/name (KeyError naming the choices)."""
-    m = registry()[method]
+    m = get(method)
     if name not in m.variants:
         raise KeyError(f"method '{method}' has no variant '{name}' (choose from {', '.join(m.variants)})")
     return m.variants[name]

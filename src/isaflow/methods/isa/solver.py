@@ -1,0 +1,208 @@
+"""Drive the compiled relaxation in chunks: progress, history, outcome -> contract.Result.
+
+Outcomes (contract.OUTCOMES): ``converged`` (max|F| < f_tol), ``cycle``
+(max|F| repeats with a fixed period: a limit cycle that can never converge),
+``step_limit``, ``escaped`` (a step would carry a particle across a wall, or
+a particle left the walls' bounding box), ``nonfinite``.
+"""
+
+import time
+
+import numpy as np
+
+from ...contract import Result, wall_resultants
+from ...core.geometry import bounding_box, outside_box
+from . import forces as F
+from . import relax as R
+from .settings import RULES, settings
+
+CYCLE_WINDOW, CYCLE_MAX_PERIOD, CYCLE_RTOL = 400, 50, 1e-6
+
+
+def detect_cycle(h, window=CYCLE_WINDOW, max_period=CYCLE_MAX_PERIOD, rtol=CYCLE_RTOL):
+    """Smallest period 2 <= p <= max_period with h[k] == h[k - p] (to rtol)
+    over the last ``window`` entries of the max|F| series h; 0 if none.
+
+    Period 1 (a constant max|F|) is not a cycle of any update here: a fixed
+    point has F = 0, and a constant max|F| is e.g. a free fall.
+    """
+    if len(h) < window + max_period:
+        return 0
+    tail = h[-(window + max_period):]
+    scale = tail.max()
+    if np.abs(tail[1:] - tail[:-1]).max() <= rtol * scale:
+        return 0  # constant
+    for p in range(2, max_period + 1):
+        if np.abs(tail[p:] - tail[:-p]).max() <= rtol * scale:
+            return p
+    return 0
+
+
+def contacts(pos, walls, s):
+    """(particle, wall, point, force) wall contacts of positions under settings s."""
+    return F.wall_contacts(pos, walls, s["wall_l_u"], s["wall_r_u"])
+
+
+def vessel_counts(pos, vessels):
+    """(V,) particles whose x lies in each vessel's [xmin, xmax) range."""
+    return np.array([np.count_nonzero((pos[:, 0] >= a) & (pos[:, 0] < b)) for _, (a, b) in vessels])
+
+
+def warm_up():
+    """Compile (or load from numba's cache) the kernels so timings exclude it."""
+    pos = np.array([[1.0, 1.0], [1.5, 1.0]])
+    walls = np.array([[0.0, 2.0, 0.0, 0.0], [0.0, 0.0, 2.0, 0.0], [2.0, 0.0, 2.0, 2.0]])
+    box = np.array([0.0, 0.0, 2.0, 2.0])
+    for rule in RULES.values():
+        R.relax(pos.copy(), np.zeros_like(pos), np.ones(2), walls, box, 0.5, 1.0, 0.7, 1.0, rule,
+                1e-3, 1.0, 0.1, 0.1, 2, 0.1, np.zeros_like(pos), np.zeros(2))
+    F.wall_contacts(pos, walls, 0.5, 1.0)
+
+
+class _History:
+    """Records of max|F| (every ``every`` steps), wall resultants and vessel counts
+    (every chunk) and position snapshots, under their run-file names."""
+
+    def __init__(self, hist, n_walls, vessels):
+        self.every = hist.get("every", 0)
+        self.walls = hist.get("walls", False)
+        self.vessels = vessels if hist.get("vessels") and vessels else None
+        self.n_snap = hist.get("snapshots", 0)
+        self.n_walls = n_walls
+        self.rec = {k: [] for k in ("hist_step", "hist_fmax", "hist_fmax_lo", "hist_fmax_hi",
+                                    "sample_step", "hist_wall_resultant", "hist_vessel_count", "snap_step", "snap_pos")}
+
+    def steps(self, step, h):
+        for k0 in range(0, len(h), self.every):
+            seg = h[k0:k0 + self.every]
+            self.rec["hist_step"].append(step + k0)
+            self.rec["hist_fmax"].append(seg[0])
+            self.rec["hist_fmax_lo"].append(seg.min())
+            self.rec["hist_fmax_hi"].append(seg.max())
+
+    def chunk(self, step, pos, s, walls, snap):
+        if self.walls:
+            part, wall, point, force = contacts(pos, walls, s)
+            self.rec["hist_wall_resultant"].append(wall_resultants(wall, force, self.n_walls))
+        if self.vessels is not None:
+            self.rec["hist_vessel_count"].append(vessel_counts(pos, self.vessels))
+        if self.walls or self.vessels is not None:
+            self.rec["sample_step"].append(step)
+        if snap:
+            self.rec["snap_pos"].append(pos.copy())
+            self.rec["snap_step"].append(step)
+
+    def variables(self, n):
+        """{name: (dims, array, units, long_name)} of the non-empty records."""
+        r = self.rec
+        spec = {
+            "hist_step": (("record",), np.int64, "1", "algorithm step of max|F| record"),
+            "hist_fmax": (("record",), float, "N", "max|F| at hist_step"),
+            "hist_fmax_lo": (("record",), float, "N", "smallest max|F| over the record stride"),
+            "hist_fmax_hi": (("record",), float, "N", "largest max|F| over the record stride"),
+            "sample_step": (("sample",), np.int64, "1", "algorithm step of diagnostic sample"),
+            "hist_wall_resultant": (("sample", "wall", "xy"), float, "N", "resultant force of wall on liquid over the run"),
+            "hist_vessel_count": (("sample", "vessel"), np.int64, "1", "particles per vessel"),
+            "snap_step": (("snapshot",), np.int64, "1", "algorithm step of snapshot"),
+            "snap_pos": (("snapshot", "particle", "xy"), float, "cm", "particle positions at snapshot"),
+        }
+        out = {k: (d, np.array(r[k], t), u, ln) for k, (d, t, u, ln) in spec.items() if r[k]}
+        if "hist_wall_resultant" in out:
+            out["hist_sum_fx"] = (("sample",), out["hist_wall_resultant"][1][:, :, 0].sum(1), "N",
+                                  "horizontal resultant of all wall reactions (0 in equilibrium)")
+        return out
+
+
+def solve(scene, pos0, weight, start_step=0, progress=None):
+    """Relax ``pos0`` (N, 2) cm with per-particle ``weight`` (N,) N under an ISA scene.
+
+    start_step: steps already taken (a continued run counts from there up to
+    solver.max_steps).  progress(step, fmax) is called after each chunk.
+    Returns a contract.Result (method 'isa', variant = the update rule).
+    """
+    s = settings(scene)
+    walls = scene.walls
+    box = bounding_box(walls)
+    vessels = [(v["name"], v["x"]) for v in scene.spec.get("vessels", [])]
+    pos = np.array(pos0, float, copy=True)
+    weight = np.asarray(weight, float)
+    vel = np.zeros_like(pos)
+    force = np.zeros_like(pos)
+    chunk = s["chunk"]
+    buf = np.zeros(chunk)
+    hist = _History(s["history"], len(walls), vessels)
+    snap_every = max(1, round((s["max_steps"] - start_step) / max(hist.n_snap, 1) / chunk))
+    recent = np.zeros(0)
+    warm_up()
+    step = start_step
+    status, message, period = "step_limit", "", 0
+    evals = 0
+    t0 = time.perf_counter()
+    n_chunk = 0
+    while step < s["max_steps"]:
+        # chunks end on multiples of `chunk` counted from the chain's start, so
+        # a run continued from a state file repeats an uninterrupted run exactly
+        n = min(chunk - step % chunk, s["max_steps"] - step)
+        chunk_start = pos.copy()
+        done, code, crossing = R.relax(
+            pos, vel, weight, walls, box, s["wall_l_u"], s["wall_r_u"], s["pair_l_u"], s["pair_r_u"],
+            RULES[s["variant"]], s["du"], s["f_ref"], s["dt_max"], s["f_tol"], n, s["skin"], force, buf,
+        )
+        evals += done + 1  # one evaluation per step taken, plus the chunk's initial one
+        h = buf[:done]
+        if hist.every:
+            hist.steps(step, h)
+        step += done
+        n_chunk += 1
+        recent = np.concatenate([recent, h])[-2000:]
+        hist.chunk(step, pos, s, walls, hist.n_snap and n_chunk % snap_every == 0)
+        if progress:
+            progress(step, float(h[-1]) if done else np.nan)
+        if code == R.CONVERGED:
+            status = "converged"
+            break
+        if code == R.NONFINITE:
+            status, message = "nonfinite", f"non-finite forces at step {step}"
+            break
+        if code == R.CROSSED:
+            i, w = divmod(crossing, walls.shape[0])
+            status = "escaped"
+            message = (f"particle {i} at ({pos[i, 0]:.4g}, {pos[i, 1]:.4g}) cm would cross wall "
+                       f"'{scene.wall_names[w]}' at step {step}; step refused, run stopped")
+            break
+        out = outside_box(pos, box)
+        if out.any():
+            status = "escaped"
+            message = f"{out.sum()} particle(s) left the walls' bounding box by step {step}"
+            break
+        if s["stop_on_cycle"]:
+            period = detect_cycle(recent)
+            # a cycle returns to its states: the net move over the chunk stays
+            # within a few du, unlike a slow drift with a periodic max|F|
+            if period and np.abs(pos - chunk_start).max() > 2 * period * s["du"]:
+                period = 0
+            if period:
+                tail = recent[-CYCLE_WINDOW:]
+                status = "cycle"
+                message = (f"max|F| repeats with period {period} steps between {tail.min():.4g} and "
+                           f"{tail.max():.4g} N (f_tol {s['f_tol']:g} N) by step {step}")
+                break
+    wall_time = time.perf_counter() - t0
+    fmax = float(np.abs(force).max()) if len(force) else 0.0
+    if status == "step_limit":
+        message = f"max|F| = {fmax:.4g} N >= f_tol = {s['f_tol']:g} N after {step} steps"
+    elif status == "converged":
+        message = f"max|F| = {fmax:.4g} N < f_tol = {s['f_tol']:g} N after {step} steps"
+    part, wall, point, cforce = contacts(pos, walls, s)
+    params = {k: v for k, v in s.items() if k not in ("accept", "history", "variant", "stop_on_cycle")}
+    params.update(cycle_period=int(period), stop_on_cycle=int(s["stop_on_cycle"]))
+    return Result(
+        method="isa", variant=s["variant"], pos0=np.array(pos0, float), pos=pos, weight=weight,
+        contact_wall=wall, contact_point=point, contact_force=cforce, status=status, message=message,
+        steps=step, start_step=start_step, wall_time=wall_time, force_evals=evals, residual=fmax,
+        residual_name="max|F|", residual_units="N",
+        history=hist.variables(len(pos)),
+        fields={"force": (("particle", "xy"), force, "N", "final out-of-balance force on particle"),
+                "contact_particle": (("contact",), part.astype(np.int32), "1", "particle index of wall contact")},
+        params=params,
+    )
