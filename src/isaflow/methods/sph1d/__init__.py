@@ -1,0 +1,32 @@
+"""The truncated SPH hydrostatic problem in 1D as a linear system (issue 12).
+
+Merino-Alonso, Macia & Souto-Iglesias (2020), abstract only: a liquid column
+at rest, the SPH momentum balance grad p = -rho g at every particle, the kernel
+truncated at the free surface; A p = b is solved directly (no time stepping).
+Modules: ``system`` (assembly, banded), ``column`` (one solve), ``closed_form``
+(one neighbour per side), ``sweep`` (N x h/dx x kernel), ``figures``,
+``report``.  A 1D static study: it writes its own tables, not the 2D contract.
+"""
+
+from isaflow.methods import Method, Variant
+
+METHOD = Method(
+    name="sph1d",
+    label="truncated SPH hydrostatic column (1D, static linear system)",
+    paper="merino_alonso2020_sph_hydrostatic_abstract.txt",
+    variants={
+        "symmetric_hydrostatic": Variant(
+            "symmetric_hydrostatic",
+            "symmetric gradient (p_i + p_j), mirror floor ghosts with hydrostatic pressure (our reading; not stated)",
+            "tab:blue", "o"),
+        "plain_hydrostatic": Variant(
+            "plain_hydrostatic",
+            "plain gradient (p_j), mirror floor ghosts with hydrostatic pressure (alternative reading)",
+            "tab:green", "s"),
+        "symmetric_equal": Variant(
+            "symmetric_equal",
+            "symmetric gradient (p_i + p_j), mirror floor ghosts with equal pressure (alternative reading)",
+            "tab:purple", "^"),
+    },
+    solver="isaflow.methods.sph1d.sweep:run_sweep",
+)

@@ -1,0 +1,131 @@
+"""1D truncated SPH hydrostatic column (issue 12): closed form, limits, conditioning, settings.
+
+Tolerances: A is assembled and solved in double precision; the relative
+round-off of a banded LU solve is about eps cond(A) with eps = 2.2e-16 and
+cond_1(A) <= 2 N for one neighbour per side (measured by dgbcon, asserted
+below), so 1e-10 bounds it for N <= 1000 with a margin of 100.
+"""
+
+import numpy as np
+import pytest
+
+from isaflow.methods.sph1d import closed_form, column, settings, sweep, system
+from isaflow.scene import SceneError
+
+KERNELS = ("cubic_spline", "wendland_c2", "wendland_c4", "wendland_c6")
+FLOORS = ("mirror_hydrostatic", "mirror_equal")
+ROUND_OFF = 1e-10
+
+
+@pytest.mark.parametrize("kernel", KERNELS)
+@pytest.mark.parametrize("floor", FLOORS)
+@pytest.mark.parametrize("n", [9, 10, 101])
+def test_one_neighbour_closed_form_matches_solver(kernel, floor, n):
+    for ratio in (0.55, 0.8, 1.0):
+        sol = column.solve_column(n, ratio, kernel, "symmetric", floor, height=100.0, rho_g=9.81e-3)
+        p = closed_form.pressure(n, ratio, kernel, floor, 100.0, 9.81e-3)
+        assert sol.cond <= 2 * n + 1e-9  # the round-off bound above
+        assert np.max(np.abs(sol.p - p)) <= ROUND_OFF * np.max(np.abs(p))
+        assert sol.error == pytest.approx(float(closed_form.error(n, ratio, kernel, floor)), rel=ROUND_OFF, abs=1e-12)
+
+
+def test_one_neighbour_residue_is_the_limit():
+    # E^2 = (kappa-1)^2 + O(1/N^2): at N = 2048 the error is |kappa - 1| to within 1e-5 relative
+    for kernel in KERNELS:
+        for ratio in (0.6, 0.75, 0.9):
+            e = column.solve_column(2048, ratio, kernel).error
+            assert e == pytest.approx(float(closed_form.residue(kernel, ratio)), rel=1e-5)
+
+
+def test_kappa_one_gives_the_exact_solution():
+    # cubic spline at h = dx: |dW/dr(dx)| = (2/3)(3/4)/dx^2 = 1/(2 dx^2), so kappa = 1 exactly
+    assert float(closed_form.kappa("cubic_spline", 1.0)) == pytest.approx(1.0, abs=1e-14)
+    sol = column.solve_column(64, 1.0, "cubic_spline", "symmetric", "mirror_hydrostatic")
+    assert sol.error < ROUND_OFF
+
+
+def test_kappa_by_hand_wendland_c2():
+    # C2 (core.smoothing): f = (1-s)^4 (1+4s), s = q/2, W = sigma f / h in 1D.
+    # dW/dr at r = h (q = 1, s = 1/2): sigma/h^2 * 0.5 * (-20 s (1-s)^3) = -sigma * 0.625 / h^2.
+    from isaflow.core.smoothing import NORM, WC2
+    expected = 1.0 / (2 * NORM[WC2, 1] * 0.625)
+    assert float(closed_form.kappa("wendland_c2", 1.0)) == pytest.approx(expected, rel=1e-14)
+
+
+def test_three_neighbours_error_settles_to_a_small_nonzero_limit():
+    # Abstract: with two and three neighbours the error tends to a small limiting value,
+    # different from zero.  Our discretisation: the interior slope factor (discrete first
+    # moment of dW) differs from 1 at fixed h/dx, giving a non-zero limit E_inf.  The end rows
+    # add an absolute error O(rho g dx) in a layer of a fixed number of particles, O(dx^3) in
+    # E^2, and at most an O(dx) checkerboard over the column, O(dx^2) in E^2; so
+    # E(N) - E_inf = O(N^-2) to O(N^-3) and Richardson's order from three N lies in [2, 3]
+    # (margin 0.2).  (A first reading predicted order 1, counting the layer as O(dx) in E^2;
+    # this test failed with order 2.8 and the derivation above replaced it.)
+    ns = [64, 128, 256, 512, 1024]
+    e = np.array([column.solve_column(n, 1.75, "wendland_c4").error for n in ns])
+    d = np.abs(np.diff(e))
+    order = np.log2(d[:-1] / d[1:])
+    assert np.all((order > 1.8) & (order < 3.2)), order
+    limit = e[-1] - d[-1] / (2.0 ** order[-1] - 1.0)  # Richardson extrapolation
+    assert 1e-4 < limit < 0.1
+
+
+def test_ill_conditioned_case_condition_number_grows_exponentially():
+    # Cubic spline, h/dx = 2 (three neighbours): regular cases have cond_1 ~ c N (x2 per doubling);
+    # here cond grows by more than 10 per doubling and the error does not decrease with N.
+    ns = [32, 64, 128, 256]
+    sols = [column.solve_column(n, 2.0, "cubic_spline") for n in ns]
+    cond = np.array([s.cond for s in sols])
+    err = np.array([s.error for s in sols])
+    assert np.all(cond[1:] / cond[:-1] > 10.0), cond
+    assert np.all(np.diff(err) > 0), err
+    regular = [column.solve_column(n, 1.75, "wendland_c2").cond for n in ns]
+    assert np.all(np.array(regular[1:]) / regular[:-1] < 2.5)
+
+
+@pytest.mark.xfail(strict=True, reason="claim 3 not reproduced with our reading (docs/sph1d.md): "
+                   "Wendland C2 with two neighbours per side gives no divergent ratio")
+def test_wendland_c2_two_neighbours_has_divergent_ratios():
+    s = {"classify": {"window": 4, "settle_factor": 1.25}}
+    found = []
+    for ratio in np.round(np.arange(1.01, 1.501, 0.01), 2):
+        e = [column.solve_column(n, ratio, "wendland_c2").error for n in (256, 512, 1024, 2048)]
+        found.append(sweep.behaviour(e, s["classify"]["settle_factor"]) == "divergent")
+    assert any(found)
+
+
+def test_truncated_floor_is_singular():
+    # No floor ghosts and the symmetric form: one neighbour gives p_1 + p_2 = -2 rho g dx kappa at the
+    # floor and p_N + p_N-1 = +2 rho g dx kappa at the surface, incompatible: A is singular.
+    sol = column.solve_column(20, 0.8, "wendland_c2", "symmetric", "truncated")
+    assert sol.status == "solver_failed" or sol.cond > 1e14
+
+
+def test_condition_estimate_against_dense():
+    # dgbcon is a lower-bound estimate of cond_1; Higham's estimator is rarely off by more than ~3
+    for kernel, ratio in (("wendland_c2", 1.3), ("cubic_spline", 2.0), ("wendland_c6", 2.7)):
+        ab, b, kl = system.assemble(48, 100.0, ratio, KERNELS.index(kernel))
+        exact = np.linalg.cond(system.dense(ab, kl), 1)
+        est = column.solve_column(48, ratio, kernel).cond
+        assert exact / 10 <= est <= exact * (1 + 1e-9)
+
+
+def test_neighbours_per_side():
+    assert list(system.neighbours_per_side([0.51, 1.0, 1.01, 1.5, 1.51, 2.0, 3.0])) == [1, 1, 2, 2, 3, 3, 5]
+
+
+def test_settings_reject_unknown_keys(tmp_path):
+    good = settings.load("config/methods/sph1d.yaml")
+    assert good["ratios"][0] == 0.51 and good["ratios"][-1] == 3.0
+    text = open("config/methods/sph1d.yaml").read().replace("classify:", "classify:\n  bogus: {value: 1, source: 'x'}")
+    bad = tmp_path / "bad.yaml"
+    bad.write_text(text)
+    with pytest.raises(SceneError, match=r"bad.yaml: classify"):
+        settings.load(bad)
+
+
+def test_behaviour_classes():
+    assert sweep.behaviour([0.1, 0.1, 0.1, 0.1], 1.25) == "settled"
+    assert sweep.behaviour([0.4, 0.2, 0.1, 0.05], 1.25) == "decreasing"
+    assert sweep.behaviour([0.1, 0.3, 0.1, 0.5], 1.25) == "divergent"
+    assert sweep.behaviour([1e-14, 3e-13, 1e-15, 2e-14], 1.25) == "settled"
