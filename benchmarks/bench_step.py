@@ -252,7 +252,7 @@ def machine_info():
     except Exception:  # pragma: no cover
         host = "?"
     lines = [f"cpu model (/proc/cpuinfo): {model}", f"llvm host cpu: {host}",
-             f"logical cores: {os.cpu_count()}", f"numba threads used: 1 (kernels are not parallel)",
+             f"logical cores: {os.cpu_count()}", "numba threads used: 1 (kernels are not parallel)",
              f"python: {platform.python_version()} ({platform.python_implementation()})",
              f"numba: {numba.__version__}", f"numpy: {np.__version__}", f"platform: {platform.platform()}"]
     try:
@@ -402,7 +402,7 @@ def main():
 
     nb = [r for r in rows if r["impl"] == "numba"]
     expo = fit_exponent([r["N"] for r in nb], [r["s_per_step"] for r in nb])
-    lines = [f"kernels: {kpath or "isaflow.methods.isa.relax"}", f"mode: {'quick' if args.quick else 'full'}",
+    lines = [f"kernels: {kpath or 'isaflow.methods.isa.relax'}", f"mode: {'quick' if args.quick else 'full'}",
              f"compile (cold cache) first call: {comp[0]['first_call_s']:.3f} s; "
              f"cache load (warm cache) first call: {comp[1]['first_call_s']:.3f} s "
              f"(hits {comp[1]['cache_hits']}, misses {comp[1]['cache_misses']})",

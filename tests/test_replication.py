@@ -15,20 +15,28 @@ A = {"single_coarse": 10.0, "single_refined": 5.0}
 CASES = [(s, v) for s in PAPER_LEVEL for v in ("paper", "capped")]
 
 
-def row_and_tol(single_runs, name, variant):
-    ds = single_runs[name, variant]
-    row = metrics.run_row(ds)
-    return row, metrics.tolerances(row, A[name], row["particles"], 0.1)
+@pytest.fixture(scope="module")
+def rows(single_runs):
+    """metrics.run_row of every case, computed once for the module."""
+    return {c: metrics.run_row(single_runs[c]) for c in CASES}
+
+
+@pytest.fixture
+def row_and_tol(rows):
+    def get(_, name, variant):
+        row = rows[name, variant]
+        return row, metrics.tolerances(row, A[name], row["particles"], 0.1)
+    return get
 
 
 @pytest.mark.parametrize("name,variant", CASES)
-def test_free_surface_level_matches_the_paper(single_runs, name, variant):
+def test_free_surface_level_matches_the_paper(single_runs, row_and_tol, name, variant):
     row, tol = row_and_tol(single_runs, name, variant)
     assert abs(row["level"] - PAPER_LEVEL[name]) <= tol["level"][0]
 
 
 @pytest.mark.parametrize("name,variant", CASES)
-def test_floor_carries_the_weight(single_runs, name, variant):
+def test_floor_carries_the_weight(single_runs, row_and_tol, name, variant):
     row, tol = row_and_tol(single_runs, name, variant)
     assert abs(row["floor_err"]) <= tol["floor"][0]
 
@@ -41,13 +49,13 @@ SIDE_DEFICIT = pytest.mark.xfail(
 
 
 @pytest.mark.parametrize("name,variant", [pytest.param(*c, marks=SIDE_DEFICIT) for c in CASES])
-def test_side_wall_totals_match_hydrostatics(single_runs, name, variant):
+def test_side_wall_totals_match_hydrostatics(single_runs, row_and_tol, name, variant):
     row, tol = row_and_tol(single_runs, name, variant)
     assert abs(row["side_err"]) <= tol["side"][0]
 
 
 @pytest.mark.parametrize("name,variant", CASES)
-def test_side_wall_deficit_is_bounded(single_runs, name, variant):
+def test_side_wall_deficit_is_bounded(single_runs, row_and_tol, name, variant):
     """The documented deficit itself: side walls carry 75-100 % of hydrostatics, never more."""
     row, _ = row_and_tol(single_runs, name, variant)
     assert -0.25 <= row["side_err"] <= 0.0
@@ -63,7 +71,7 @@ REFINED_HEIGHT = pytest.mark.xfail(strict=True, reason="refined side resultant s
     pytest.param("single_refined", "paper", marks=REFINED_HEIGHT),
     pytest.param("single_refined", "capped", marks=REFINED_HEIGHT),
 ])
-def test_side_resultant_acts_at_a_third_of_the_depth(single_runs, name, variant):
+def test_side_resultant_acts_at_a_third_of_the_depth(single_runs, row_and_tol, name, variant):
     row, tol = row_and_tol(single_runs, name, variant)
     assert abs(row["side_height_err"]) <= tol["side_height"][0]
 
@@ -86,8 +94,8 @@ def test_literal_update_settles_in_a_cycle_at_the_stability_floor(single_runs, n
 
 
 @pytest.mark.parametrize("name", PAPER_LEVEL)
-def test_capped_variant_converges_to_the_same_state(single_runs, name):
-    p, c = single_runs[name, "paper"], single_runs[name, "capped"]
+def test_capped_variant_converges_to_the_same_state(single_runs, rows, name):
+    c = single_runs[name, "capped"]
     assert c.attrs["status"] == "converged" and float(c["residual"]) < 0.1
-    rp, rc = metrics.run_row(p), metrics.run_row(c)
+    rp, rc = rows[name, "paper"], rows[name, "capped"]
     assert rc["level"] == pytest.approx(rp["level"], abs=0.5)

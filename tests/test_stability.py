@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 import yaml
 
-from isaflow import cli, runfile, study
+from isaflow import cli, runfile, tables
 from isaflow.core import geometry as GEO
 from isaflow.methods.isa import relax as R
 
@@ -92,7 +92,7 @@ def test_escaped_across_a_wall_is_refused_and_reported(tmp_path):
     assert ds.attrs["status_message"] == ("particle 0 at (10, 5.5) cm would cross wall 'floor' at step 0; "
                                           "step refused, run stopped")
     np.testing.assert_array_equal(ds["pos"].values, ds["pos0"].values)  # the step was not taken
-    assert study.outcome_detail("escaped", ds.attrs["status_message"]) == "crossed a wall (step refused)"
+    assert tables.outcome_detail("escaped", ds.attrs["status_message"]) == "crossed a wall (step refused)"
 
 
 def test_escaped_through_a_gap_leaves_the_bounding_box(tmp_path):
@@ -104,7 +104,7 @@ def test_escaped_through_a_gap_leaves_the_bounding_box(tmp_path):
     assert ds.attrs["status"] == "escaped"
     assert ds.attrs["status_message"].startswith("1 particle(s) left the walls' bounding box by step ")
     assert ds["pos"].values[0, 1] < 0.0  # below the floor, not silently inside
-    assert study.outcome_detail("escaped", ds.attrs["status_message"]) == "left the walls' bounding box"
+    assert tables.outcome_detail("escaped", ds.attrs["status_message"]) == "left the walls' bounding box"
 
 
 def test_nonfinite_forces_stop_the_run(tmp_path):

@@ -12,7 +12,9 @@ import pytest
 import xarray as xr
 import yaml
 
-from isaflow import metrics, scene, study, theory
+from isaflow import metrics, scene, tables, theory
+from isaflow import plan as plans
+from isaflow.methods.isa.solver import DETECTED_BY
 from isaflow.methods.isa.settings import fire_dt_max, settings
 
 from conftest import ROOT
@@ -95,7 +97,7 @@ def test_law_usage_by_hand():
 
 @pytest.fixture(scope="module")
 def plan():
-    return study.plan(STUDY)
+    return plans.plan(STUDY)
 
 
 def test_plan_covers_the_issue(plan):
@@ -121,7 +123,7 @@ def test_every_planned_run_is_a_valid_scene_with_its_du(plan):
     for sid, m in plan.items():
         sc = scene.load(m["scene"], m["set"])  # raises SceneError naming the field otherwise
         s = settings(sc)
-        assert s["variant"] == m["variant"] and s["history"] == {} and set(s["accept"]) == set(study.OUTCOMES), sid
+        assert s["variant"] == m["variant"] and s["history"] == {} and set(s["accept"]) == set(DETECTED_BY), sid
         if m["group"] != "cases":
             base = settings(scene.load(m["scene"]))["du"]
             assert s["du"] == pytest.approx(m["du_factor"] * base, rel=1e-7), sid
@@ -137,16 +139,16 @@ def test_fire_dt_max_of_the_paper_stiffness():
 
 @pytest.mark.parametrize("x", [1e-5, 0.01, 3535.5339, 1e8, 1e308, 2.5e-300])
 def test_override_numbers_read_back_as_floats(x):
-    y = yaml.safe_load(study._num(x))
+    y = yaml.safe_load(plans._num(x))
     assert isinstance(y, float) and y == pytest.approx(x, rel=1e-7)
 
 
 def test_outcome_detail_separates_the_two_escapes():
-    assert study.outcome_detail("escaped", "particle 3 at (1, 2) cm would cross wall 'floor' at step 0; step refused, "
+    assert tables.outcome_detail("escaped", "particle 3 at (1, 2) cm would cross wall 'floor' at step 0; step refused, "
                                            "run stopped") == "crossed a wall (step refused)"
-    assert study.outcome_detail("escaped", "2 particle(s) left the walls' bounding box by step 1000") == \
+    assert tables.outcome_detail("escaped", "2 particle(s) left the walls' bounding box by step 1000") == \
         "left the walls' bounding box"
-    assert study.outcome_detail("step_limit", "") == "step limit"
+    assert tables.outcome_detail("step_limit", "") == "step limit"
 
 
 def test_recommend_takes_the_fastest_converged_run_of_a_robust_family():
@@ -155,7 +157,7 @@ def test_recommend_takes_the_fastest_converged_run_of_a_robust_family():
             ("e", "refined", "capped", "converged", 0.02, 0.02), ("f", "refined", "capped", "converged", 0.3, 0.04)]
     tab = pd.DataFrame([dict(run=r, lattice=la, variant=v, du_cm=0.01, status=s, side_err=e, wall_time_s=ts, steps=100)
                         for r, la, v, s, e, ts in rows])
-    rec = study.recommend(tab, {"side_err": [0.5, 0.05, 0.035, 0.01]}).set_index("target")
+    rec = tables.recommend(tab, {"side_err": [0.5, 0.05, 0.035, 0.01]}).set_index("target")
     # every family stays within 0.5: the fastest converged run of all ('a' never converged)
     assert rec.loc[0.5, "run"] == "e"
     # refined/capped misses 0.05 at one du ('f'), so its fast 'e' meets it by chance only
@@ -194,7 +196,7 @@ def test_reduced_study_builds_both_figures_and_the_report_fragment(tmp_path):
     assert big["status"] == "escaped" and "would cross wall 'floor' at step 0" in big["message"]
     assert (cases.loc[["sc_on_wall_paper", "sc_on_wall_fire"], "positions_finite"]).all()
     smap = pd.read_csv(tmp_path / "results" / "study" / "stability_map.csv")
-    assert len(smap) == 8 and set(smap["status"]) <= set(study.OUTCOMES)
+    assert len(smap) == 8 and set(smap["status"]) <= set(DETECTED_BY)
     # FIRE needs fewer force evaluations than the capped update and than the paper's reported 2000 steps
     ratio = pd.read_csv(tmp_path / "results" / "study" / "fire_ratio.csv").iloc[0]
     assert ratio["ratio_vs_capped"] > 1 and ratio["ratio_vs_paper_reported"] > 1

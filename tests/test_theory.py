@@ -75,7 +75,7 @@ def test_stiffness_matrix_is_the_force_jacobian():
     pos = rhombic_lattice(10.0, 5, [3, 4], 20.0, 4.0) + np.random.default_rng(1).normal(0, 0.3, (17, 2))
     walls = box_walls(40.0, 40.0)
     args = (walls, 5.0, 10000.0, 7.0710678, 3535.5339)
-    H = theory.stiffness_matrix(pos, *args)
+    H = theory.stiffness_matrix(pos, *args).toarray()
 
     def force(p):
         

@@ -48,6 +48,11 @@ def vessel_view(ds, vessel=None):
     return dict(x_range=(x0, x1), width=x1 - x0, floor_y=floor_y, wall_in=wall_in, horizontal=horiz, inside=inside)
 
 
+def level(ds, vessel=None):
+    """Free-surface level [cm] of a vessel (None: the whole scene) of a run Dataset."""
+    return theory.free_surface_level(ds["pos"].values, float(ds.attrs["spacing"]), vessel_view(ds, vessel)["x_range"])
+
+
 def load_errors(ds, vessel=None):
     """Level and wall-load error measures of a vessel (see module docstring)."""
     return contact_loads(ds, vessel)[0]
@@ -182,16 +187,16 @@ def run_row(ds, vessel=None):
     return row
 
 
-DENSE_LIMIT = 1000  # particles: largest run whose stiffness matrix is diagonalised
+EIGEN_LIMIT = 5000  # particles: largest run whose stiffest mode is computed (sparse Lanczos, < 1 s)
 
 
 def convergence_measures(ds):
     """lambda_max [N/cm] of the final state's stiffness matrix and the literal
-    update's stability floor lambda_max du / 2 [N] (theory.step_floor; NaN above
-    DENSE_LIMIT particles), and the max|F| band [N] of the last records."""
+    update's stability floor lambda_max du / 2 [N] (theory.step_floor; ISA runs
+    only, up to EIGEN_LIMIT particles; NaN otherwise), and the max|F| band [N] of the last records."""
     a = ds.attrs
     out = {"lambda_max": np.nan, "stability_floor_N": np.nan, "band_lo_N": np.nan, "band_hi_N": np.nan}
-    if ds.sizes["particle"] <= DENSE_LIMIT:
+    if a.get("method") == "isa" and ds.sizes["particle"] <= EIGEN_LIMIT and np.isfinite(ds["pos"].values).all():
         lam, floor = theory.step_floor(ds["pos"].values, ds["wall_segment"].values, a["wall_l_u"], a["wall_r_u"],
                                        a["pair_l_u"], a["pair_r_u"], a["du"])
         out.update(lambda_max=lam, stability_floor_N=floor)
@@ -224,39 +229,8 @@ def flow_measures(ds):
     return out
 
 
-def table(paths, vessel=None):
-    """DataFrame with one run_row per run file; 'run' is the file stem."""
-    import pandas as pd
-    from pathlib import Path
-
-    from .runfile import read
-
-    rows = []
-    for p in paths:
-        ds = read(p)
-        rows.append({"run": Path(p).stem, **run_row(ds, vessel), "variant_label": ds.attrs["variant_label"]})
-    return pd.DataFrame(rows)
 
 
-def calibration_table(paths):
-    """DataFrame of calibration runs {run}_kb{k}_r{ratio}.nc: run, k_b [N/cm],
-    k_p / k_b, levels [cm], outcome."""
-    from pathlib import Path
-
-    import pandas as pd
-
-    from .runfile import read
-
-    rows = []
-    for p in paths:
-        ds = read(p)
-        kb = ds.attrs["wall_r_u"] / ds.attrs["wall_l_u"]
-        kp = ds.attrs["pair_r_u"] / ds.attrs["pair_l_u"]
-        e = load_errors(ds)
-        rows.append(dict(run=Path(p).stem.rsplit("_kb", 1)[0], scene=ds.attrs["scene"], variant=ds.attrs["variant"], k_wall=kb, ratio=round(kp / kb, 6),
-                         spacing=float(ds.attrs["spacing"]), level=e["level"], level_max=e["level_max"], level_implied=e["level_implied"],
-                         status=ds.attrs["status"], steps=int(ds["steps"]), residual=float(ds["residual"])))
-    return pd.DataFrame(rows).sort_values(["run", "k_wall", "ratio"])
 
 
 def tolerances(row, a, n_particles, f_tol):

@@ -88,16 +88,27 @@ def implied_level(side_load, total_weight, width):
     return 2.0 * width * side_load / total_weight
 
 
-def stiffness_matrix(pos, walls, wl_u, wr_u, pl_u, pr_u):
-    """Hessian (2N, 2N) [N/cm] of the potential energy of the linear force laws.
+def stiffness_matrix(pos, walls, wall_l_u, wall_r_u, pair_l_u, pair_r_u):
+    """Hessian (2N, 2N) [N/cm] of the potential energy of the linear force laws, sparse (CSR).
 
     Pair/wall-end terms: k n n^T - (R / l)(I - n n^T) with k = r_u / l_u; a
-    wall's interior contributes k n n^T.  Dense: meant for N up to a few
-    thousand (stability diagnostics of the single-vessel runs).
+    wall's interior contributes k n n^T.  Pairs come from the shared cell list.
     """
+    from scipy import sparse
+
+    from .core.neighbours import build_pairs
+
+    pos = np.asarray(pos, float)
     n = len(pos)
-    H = np.zeros((2 * n, 2 * n))
     eye = np.eye(2)
+    rows, cols, vals = [], [], []
+
+    def add(i, j, b):
+        for a in range(2):
+            for c in range(2):
+                rows.append(2 * i + a)
+                cols.append(2 * j + c)
+                vals.append(b[a, c])
 
     def block(d, l_u, r_u, line=False):
         l = np.hypot(*d)
@@ -107,30 +118,36 @@ def stiffness_matrix(pos, walls, wl_u, wr_u, pl_u, pr_u):
             b -= r_u * (1.0 - l / l_u) / l * (eye - nn)
         return b
 
-    diff = pos[:, None, :] - pos[None, :, :]
-    dist = np.hypot(diff[..., 0], diff[..., 1])
-    for i, j in zip(*np.nonzero(np.triu(dist < pl_u, 1))):
-        b = block(diff[i, j], pl_u, pr_u)
-        si, sj = slice(2 * i, 2 * i + 2), slice(2 * j, 2 * j + 2)
-        H[si, si] += b
-        H[sj, sj] += b
-        H[si, sj] -= b
-        H[sj, si] -= b
+    lo, hi = pos.min(0), pos.max(0) + 1e-9
+    pi, pj, m = build_pairs(pos, np.array([lo[0], lo[1], hi[0], hi[1]]), pair_l_u)
+    for i, j in zip(pi[:m], pj[:m]):
+        b = block(pos[i] - pos[j], pair_l_u, pair_r_u)
+        add(i, i, b)
+        add(j, j, b)
+        add(i, j, -b)
+        add(j, i, -b)
     for x0, y0, x1, y1 in walls:
         e = np.array([x1 - x0, y1 - y0])
         L2 = e @ e
         t = ((pos - [x0, y0]) @ e) / L2
         c = np.array([x0, y0]) + np.clip(t, 0, 1)[:, None] * e
         d = pos - c
-        for i in np.flatnonzero(np.hypot(d[:, 0], d[:, 1]) < wl_u):
-            H[2 * i:2 * i + 2, 2 * i:2 * i + 2] += block(d[i], wl_u, wr_u, line=0 < t[i] < 1)
-    return H
+        for i in np.flatnonzero(np.hypot(d[:, 0], d[:, 1]) < wall_l_u):
+            add(i, i, block(d[i], wall_l_u, wall_r_u, line=0 < t[i] < 1))
+    return sparse.coo_matrix((vals, (rows, cols)), shape=(2 * n, 2 * n)).tocsr()
 
 
-def step_floor(pos, walls, wl_u, wr_u, pl_u, pr_u, du):
+def step_floor(pos, walls, wall_l_u, wall_r_u, pair_l_u, pair_r_u, du):
     """Smallest max|F| [N] at which the paper's update x += du F / max|F| is
     still linearly stable: gradient descent with gain du / max|F| diverges
     along the stiffest mode once du / max|F| > 2 / lambda_max.  Returns
-    (lambda_max N/cm, floor = lambda_max du / 2 N)."""
-    lam = float(np.linalg.eigvalsh(stiffness_matrix(pos, walls, wl_u, wr_u, pl_u, pr_u))[-1])
+    (lambda_max N/cm, floor = lambda_max du / 2 N); lambda_max by Lanczos
+    (scipy.sparse.linalg.eigsh, relative accuracy 1e-10)."""
+    from scipy.sparse.linalg import eigsh
+
+    H = stiffness_matrix(pos, walls, wall_l_u, wall_r_u, pair_l_u, pair_r_u)
+    if H.shape[0] <= 8:
+        lam = float(np.linalg.eigvalsh(H.toarray())[-1])
+    else:
+        lam = float(eigsh(H, k=1, which="LA", tol=1e-10, v0=np.ones(H.shape[0]), return_eigenvectors=False)[0])
     return lam, 0.5 * lam * du

@@ -21,9 +21,6 @@ rule bench_step:
         "python {input.script} > {log} 2>&1"
 
 
-
-
-
 rule bench_output:
     input:
         script="benchmarks/bench_output.py",
@@ -46,15 +43,15 @@ rule report_speed:
         machine="benchmarks/results/machine.txt",
         output_cost="benchmarks/results/output_cost.csv",
         table1="figures/table1.csv",
-        code=code("report"),
+        code=code("report/__init__", "report/speed"),
     output:
         "results/report/40_speed.md",
     params:
-        func="speed_section",
+        func="report.speed.speed_section",
     log:
         "logs/report/speed.log",
     script:
-        "../scripts/report.py"
+        "../scripts/call.py"
 
 
 register(report=["results/report/40_speed.md"])

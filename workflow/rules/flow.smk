@@ -5,50 +5,54 @@ TABLE1_RUNS = sorted({run for row in config["table1"] for run in row["chain"]})
 
 rule fig_flow:
     input:
-        runs=lambda wc: [run_file(FIGS[wc.name])],
+        inputs=lambda wc: [run_file(FIGS[wc.name])],
         code=FIGURE_CODE,
     output:
         figure("{name}"),
     params:
-        func=lambda wc: {"fig09_flow_incomplete": "flow_incomplete_figure", "fig10_flow_complete": "flow_complete_figure"}[wc.name],
+        func=lambda wc: {
+            "fig09_flow_incomplete": "figures.flow.flow_incomplete_figure",
+            "fig10_flow_complete": "figures.flow.flow_complete_figure",
+        }[wc.name],
         kw={"paper": FLOW["paper"]},
     log:
         "logs/figures/{name}.log",
     wildcard_constraints:
         name="fig09_flow_incomplete|fig10_flow_complete",
     script:
-        "../scripts/plot.py"
+        "../scripts/call.py"
 
 
 rule fig_flow_history:
     input:
-        runs=sorted({run_file(r) for chain in FLOW["chains"].values() for r in chain}),
+        inputs=sorted({run_file(r) for chain in FLOW["chains"].values() for r in chain}),
         code=FIGURE_CODE,
     output:
         figure("flow_history"),
     params:
-        func="flow_history_figure",
+        func="figures.flow.flow_history_figure",
         kw={"chains": FLOW["chains"]},
     log:
         "logs/figures/flow_history.log",
     script:
-        "../scripts/plot.py"
+        "../scripts/call.py"
 
 
 rule table1:
     input:
         runs=[run_file(r) for r in TABLE1_RUNS],
         benchmarks=[f"results/benchmarks/run/{r}.tsv" for r in TABLE1_RUNS],
-        code=code("tables", "report"),
+        code=code("tables", "report/__init__"),
     output:
-        csv="figures/table1.csv",
-        md="figures/table1.md",
+        "figures/table1.csv",
+        "figures/table1.md",
     log:
         "logs/table1.log",
     params:
-        rows=config["table1"],
+        func="tables.write_table1",
+        kw={"rows": config["table1"]},
     script:
-        "../scripts/table1.py"
+        "../scripts/call.py"
 
 
 rule report_flow:
@@ -56,15 +60,15 @@ rule report_flow:
         metrics="results/metrics.csv",
         table1="figures/table1.csv",
         config="config/config.yaml",
-        code=code("report", "metrics"),
+        code=code("report/__init__", "report/flow"),
     output:
         "results/report/20_flow.md",
     params:
-        func="flow_section",
+        func="report.flow.flow_section",
     log:
         "logs/report/flow.log",
     script:
-        "../scripts/report.py"
+        "../scripts/call.py"
 
 
 register(report=["results/report/20_flow.md"])

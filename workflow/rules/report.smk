@@ -5,13 +5,15 @@
 rule metrics:
     input:
         runs=[run_file(r) for r in METRIC_RUNS],
-        code=code("metrics", "theory"),
+        code=code("tables", "metrics", "theory"),
     output:
         "results/metrics.csv",
+    params:
+        func="tables.metrics_table",
     log:
         "logs/metrics.log",
     script:
-        "../scripts/metrics.py"
+        "../scripts/call.py"
 
 
 rule report_single:
@@ -19,30 +21,30 @@ rule report_single:
         metrics="results/metrics.csv",
         calibration="results/calibration.csv",
         config="config/config.yaml",
-        code=code("report", "metrics"),
+        code=code("report/__init__", "report/single", "metrics"),
     output:
         "results/report/10_single.md",
     params:
-        func="single_section",
+        func="report.single.single_section",
     log:
         "logs/report/single.log",
     script:
-        "../scripts/report.py"
+        "../scripts/call.py"
 
 
 rule report_inferred:
     input:
         inferred="config/inferred.yaml",
         scenes=sorted({r["scene"] for r in RUNS.values()}),
-        code=code("report"),
+        code=code("report/__init__", "report/inferred"),
     output:
         "results/report/90_inferred.md",
+    params:
+        func="report.inferred.inferred_section",
     log:
         "logs/report/inferred.log",
-    run:
-        from isaflow import report
-
-        report.inferred_section(input.inferred, input.scenes, output[0])
+    script:
+        "../scripts/call.py"
 
 
 register(report=["results/report/10_single.md", "results/report/90_inferred.md"])
@@ -51,15 +53,15 @@ register(report=["results/report/10_single.md", "results/report/90_inferred.md"]
 rule replication_report:
     input:
         parts=lambda wc: sorted(TARGETS["report"], key=lambda p: p.rsplit("/", 1)[-1]),
-        code=code("report"),
+        code=code("report/__init__"),
     output:
         "docs/replication.md",
+    params:
+        func="report.assemble",
     log:
         "logs/report/assemble.log",
-    run:
-        from isaflow import report
-
-        report.assemble(input.parts, output[0])
+    script:
+        "../scripts/call.py"
 
 
 register(targets=["results/metrics.csv", "docs/replication.md"])

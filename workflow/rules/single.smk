@@ -26,13 +26,15 @@ rule calibration_run:
 rule calibration_table:
     input:
         runs=CAL_FILES,
-        code=code("metrics", "theory"),
+        code=code("tables", "metrics", "theory"),
     output:
         "results/calibration.csv",
+    params:
+        func="tables.calibration_table",
     log:
         "logs/calibration_table.log",
     script:
-        "../scripts/calibration_table.py"
+        "../scripts/call.py"
 
 
 FIGS = config["figures"]
@@ -40,64 +42,64 @@ FIGS = config["figures"]
 
 rule fig_inputs:
     input:
-        runs=lambda wc: [run_file(FIGS[wc.name])],
+        inputs=lambda wc: [run_file(FIGS[wc.name])],
         code=FIGURE_CODE,
     output:
         figure("{name}"),
     params:
-        func="inputs_figure",
+        func="figures.single.inputs_figure",
     log:
         "logs/figures/{name}.log",
     wildcard_constraints:
         name="fig05_inputs_coarse|fig07_inputs_refined",
     script:
-        "../scripts/plot.py"
+        "../scripts/call.py"
 
 
 rule fig_single:
     input:
-        runs=lambda wc: [run_file(FIGS[wc.name])],
+        inputs=lambda wc: [run_file(FIGS[wc.name])],
         code=FIGURE_CODE,
     output:
         figure("{name}"),
     params:
-        func="single_vessel_figure",
+        func="figures.single.single_vessel_figure",
         kw=lambda wc: {"paper_level": config["paper"][FIGS[wc.name].removesuffix("_capped")]["level"]},
     log:
         "logs/figures/{name}.log",
     wildcard_constraints:
         name="fig06_single_coarse|fig08_single_refined",
     script:
-        "../scripts/plot.py"
+        "../scripts/call.py"
 
 
 rule fig_calibration:
     input:
-        runs=CAL_FILES,
+        inputs=CAL_FILES,
         code=FIGURE_CODE,
     output:
         figure("calibration_free_surface"),
     params:
-        func="calibration_figure",
+        func="figures.single.calibration_figure",
         kw={"paper_levels": {k: v["level"] for k, v in config["paper"].items()}, "adopted": CAL["adopted"]},
     log:
         "logs/figures/calibration_free_surface.log",
     script:
-        "../scripts/plot.py"
+        "../scripts/call.py"
 
 
 rule fig_convergence:
     input:
-        runs=[run_file(r) for r in ["single_coarse", "single_coarse_capped", "single_refined", "single_refined_capped"]],
+        inputs=[run_file(r) for r in ["single_coarse", "single_coarse_capped", "single_refined", "single_refined_capped"]],
         code=FIGURE_CODE,
     output:
         figure("convergence_single"),
     params:
-        func="convergence_figure",
+        func="figures.single.convergence_figure",
     log:
         "logs/figures/convergence_single.log",
     script:
-        "../scripts/plot.py"
+        "../scripts/call.py"
 
 
 register(targets=figure("fig05_inputs_coarse") + figure("fig06_single_coarse"))

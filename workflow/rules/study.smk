@@ -2,7 +2,7 @@
 # Every point is one `isaflow run` with its own netCDF under results/study/runs/.
 import re
 
-from isaflow import study as S
+from isaflow import plan as S
 
 validate(config["study"], "../schemas/study.schema.yaml")
 
@@ -11,7 +11,7 @@ STUDY_RUNS = S.plan(STUDY)
 STUDY_META = S.meta(STUDY_RUNS)
 
 
-STUDY_FIG_CODE = code("figures/*", "study", "methods/__init__", "methods/isa/__init__")
+STUDY_FIG_CODE = FIGURE_CODE
 
 
 rule study_run:
@@ -35,16 +35,16 @@ rule study_run:
 rule study_error_table:
     input:
         runs=S.run_files(STUDY_RUNS, "error_runtime"),
-        code=code("study", "metrics", "theory"),
+        code=code("tables", "plan", "metrics", "theory"),
     output:
         "figures/error_vs_runtime.csv",
     params:
-        func="study.error_table",
+        func="tables.error_table",
         kw={"meta": STUDY_META, "paper": config["paper"]},
     log:
         "logs/study/error_table.log",
     script:
-        "../scripts/study.py"
+        "../scripts/call.py"
 
 
 rule study_fire_tables:
@@ -56,12 +56,12 @@ rule study_fire_tables:
             for var in ("capped", "paper")
             for f in S.run_files(STUDY_RUNS, "error_runtime", lattice=lat, variant=var, du_factor=1)
         ],
-        code=code("study", "metrics", "theory"),
+        code=code("tables", "plan", "metrics", "theory"),
     output:
         "results/study/fire_tuning.csv",
         "results/study/fire_ratio.csv",
     params:
-        func="study.fire_tables",
+        func="tables.fire_tables",
         kw={
             "meta": STUDY_META,
             "paper": config["paper"],
@@ -70,37 +70,37 @@ rule study_fire_tables:
     log:
         "logs/study/fire_tables.log",
     script:
-        "../scripts/study.py"
+        "../scripts/call.py"
 
 
 rule study_map_table:
     input:
         runs=S.run_files(STUDY_RUNS, "stability_map"),
-        code=code("study", "metrics", "theory"),
+        code=code("tables", "plan", "metrics", "theory"),
     output:
         "results/study/stability_map.csv",
     params:
-        func="study.map_table",
+        func="tables.map_table",
         kw={"meta": STUDY_META},
     log:
         "logs/study/map_table.log",
     script:
-        "../scripts/study.py"
+        "../scripts/call.py"
 
 
 rule study_cases_table:
     input:
         runs=S.run_files(STUDY_RUNS, "cases"),
-        code=code("study", "metrics", "theory"),
+        code=code("tables", "plan", "metrics", "theory"),
     output:
         "figures/stability_cases.csv",
     params:
-        func="study.cases_table",
+        func="tables.cases_table",
         kw={"meta": STUDY_META},
     log:
         "logs/study/cases_table.log",
     script:
-        "../scripts/study.py"
+        "../scripts/call.py"
 
 
 rule fig_error_vs_runtime:
@@ -114,7 +114,7 @@ rule fig_error_vs_runtime:
     log:
         "logs/figures/error_vs_runtime.log",
     script:
-        "../scripts/study.py"
+        "../scripts/call.py"
 
 
 rule fig_stability_map:
@@ -128,7 +128,7 @@ rule fig_stability_map:
     log:
         "logs/figures/stability_map.log",
     script:
-        "../scripts/study.py"
+        "../scripts/call.py"
 
 
 rule report_study:
@@ -139,15 +139,15 @@ rule report_study:
         stability_map="results/study/stability_map.csv",
         cases="figures/stability_cases.csv",
         study_config="config/study.yaml",
-        code=code("study", "report"),
+        code=code("report/__init__", "report/study", "tables", "plan"),
     output:
         "results/report/30_study.md",
     params:
-        func="study.report_section",
+        func="report.study.report_section",
     log:
         "logs/report/study.log",
     script:
-        "../scripts/study.py"
+        "../scripts/call.py"
 
 
 register(report=["results/report/30_study.md"])

@@ -1,17 +1,12 @@
 """Study figures: error against run time, stability map.  Drawn from the study tables
 (figures/error_vs_runtime.csv, results/study/stability_map.csv, figures/stability_cases.csv),
-which isaflow.study builds from the run files."""
+which isaflow.tables builds from the run files."""
 
 import numpy as np
 import pandas as pd
 
-from ..study import OUTCOME_STYLE, VARIANTS
-from .style import plt, save
-
-VARIANT_COLOR = {"paper": "tab:red", "capped": "tab:blue", "fire": "tab:green"}
-VARIANT_NAME = {"paper": "paper: x += du F/max|F| (section 3.3)", "capped": "capped (variant, not in paper)",
-                "fire": "FIRE (variant, not in paper)"}
-LATTICE_MARKER = {"coarse": "o", "refined": "s", "fine": "^", "finer": "D"}
+from ..plan import VARIANTS
+from .style import LATTICE_MARKER, OUTCOME_STYLE, plt, save, variant_style
 FLOOR = 1e-4  # smallest |error| drawn on the log axes (exact zeros sit on it)
 
 PANELS = [
@@ -39,7 +34,7 @@ def error_vs_runtime_figure(inputs, outputs):
                     continue
                 y = np.maximum(g[col].abs(), FLOOR)
                 conv = (g["status"] == "converged").values
-                c = VARIANT_COLOR[var]
+                c = variant_style("isa", var)[0]
                 ax.scatter(g["wall_time_s"][conv], y[conv], marker=marker, color=c, s=36, zorder=3)
                 ax.scatter(g["wall_time_s"][~conv], y[~conv], marker=marker, facecolors="none", edgecolors=c, s=36,
                            zorder=3)
@@ -63,7 +58,7 @@ def error_vs_runtime_figure(inputs, outputs):
     leg = axes[-1]
     leg.axis("off")
     for var in [v for v in VARIANTS if v in set(tab["variant"])]:
-        leg.plot([], [], "o", color=VARIANT_COLOR[var], label=VARIANT_NAME[var])
+        leg.plot([], [], "o", color=variant_style("isa", var)[0], label=variant_style("isa", var)[1])
     for lat, marker in LATTICE_MARKER.items():
         g = tab[tab["lattice"] == lat]
         if len(g):
@@ -111,7 +106,7 @@ def stability_map_figure(inputs, outputs):
         ax.set_xlabel("k_b du / w (-)  [k_b: wall stiffness, N/cm; du: cm; w: N]")
         ax.set_ylabel("du / a (-)  [a: lattice spacing, cm]")
         ax.set_ylim(top=g["du_over_a"].max() * 8)
-        ax.set_title(f"{VARIANT_NAME[var]}\nstep limit {int(g['max_steps'].max()):,} steps; "
+        ax.set_title(f"{variant_style('isa', var)[1]}\nstep limit {int(g['max_steps'].max()):,} steps; "
                      "lines: constant k_b (N/cm)")
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=7, loc="lower right")
@@ -137,7 +132,7 @@ def stability_map_figure(inputs, outputs):
                 col.append("white")
         cells.append(row)
         colors.append(col)
-    table = ax.table(cellText=cells, cellColours=colors, colLabels=["extreme case"] + [VARIANT_NAME[v] for v in cvars],
+    table = ax.table(cellText=cells, cellColours=colors, colLabels=["extreme case"] + [variant_style("isa", v)[1] for v in cvars],
                      loc="upper center", cellLoc="left", colWidths=[0.43] + [0.19] * len(cvars))
     table.auto_set_font_size(False)
     table.set_fontsize(6.5)

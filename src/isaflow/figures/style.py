@@ -10,6 +10,24 @@ import matplotlib.pyplot as plt  # noqa: E402
 plt.rcParams.update({"font.size": 9, "axes.titlesize": 9, "figure.dpi": 110, "savefig.dpi": 150})
 
 COMPUTED, THEORY, PAPER = "tab:blue", "tab:orange", "tab:red"
+# colour and marker of each outcome (contract.OUTCOMES); method/variant colours live in the registry
+OUTCOME_STYLE = {
+    "converged": ("tab:green", "o"),
+    "cycle": ("tab:blue", "s"),
+    "step_limit": ("tab:orange", "^"),
+    "escaped": ("tab:red", "X"),
+    "nonfinite": ("k", "*"),
+    "solver_failed": ("tab:brown", "P"),
+}
+LATTICE_MARKER = {"coarse": "o", "refined": "s", "fine": "^", "finer": "D"}
+
+
+def variant_style(method, variant):
+    """(colour, label) of a method's variant, from the registry."""
+    from ..methods import variant as lookup
+
+    v = lookup(method, variant)
+    return v.colour, v.label
 
 
 def save(fig, outputs):

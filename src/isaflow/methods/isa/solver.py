@@ -17,6 +17,16 @@ from . import relax as R
 from .settings import RULES, settings
 
 CYCLE_WINDOW, CYCLE_MAX_PERIOD, CYCLE_RTOL = 400, 50, 1e-6
+# where each outcome is detected (for the report)
+DETECTED_BY = {
+    "converged": "the compiled loop, before every step (relax.relax)",
+    "cycle": f"detect_cycle on the last {CYCLE_WINDOW + CYCLE_MAX_PERIOD} max|F| values at every chunk end, "
+             f"periods 2-{CYCLE_MAX_PERIOD}, while the particles stay put",
+    "step_limit": "the solver, at solver.max_steps",
+    "escaped": "the compiled loop (every move is tested against the walls, core.geometry.crossed_wall) and "
+               "the solver (walls' bounding box at every chunk end)",
+    "nonfinite": "the compiled loop, before every step",
+}
 
 
 def detect_cycle(h, window=CYCLE_WINDOW, max_period=CYCLE_MAX_PERIOD, rtol=CYCLE_RTOL):

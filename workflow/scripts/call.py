@@ -1,0 +1,18 @@
+"""Snakemake script: call one isaflow function; the one calling convention of every script rule.
+
+params.func names 'module.function' under isaflow (e.g. 'tables.error_table',
+'figures.single.single_vessel_figure', 'report.flow.flow_section').  It is
+called as func(**named inputs except 'code', outputs=[output files],
+**params.kw); single-file inputs are passed as a path, others as a list.
+stderr (warnings, tracebacks) goes to the rule's log.
+"""
+import importlib
+import sys
+
+sys.stderr = open(snakemake.log[0], "w")  # noqa: F821
+
+mod, name = snakemake.params.func.rsplit(".", 1)  # noqa: F821
+func = getattr(importlib.import_module(f"isaflow.{mod}"), name)
+inputs = {k: (v if isinstance(v, str) else list(v)) for k, v in snakemake.input.items() if k != "code"}  # noqa: F821
+func(**inputs, outputs=list(snakemake.output), **dict(snakemake.params.get("kw", {}) or {}))  # noqa: F821
+print(f"{snakemake.params.func}: wrote {', '.join(snakemake.output)}", file=sys.stderr)  # noqa: F821
