@@ -1,0 +1,19 @@
+"""MPS (moving particle semi-implicit, Koshizuka & Oka 1996) on the shared tank,
+with three source terms of its pressure Poisson equation (variants)."""
+
+from isaflow.methods import Method, Variant
+
+METHOD = Method(
+    name="mps",
+    label="MPS (Koshizuka & Oka 1996), semi-implicit",
+    paper="hattori_mps_pressure_poisson.txt",
+    variants={
+        "standard": Variant("standard", "MPS, standard source rho0/dt^2 (n0 - n*)/n0 (Koshizuka & Oka 1996; not the paper's method)",
+                            "tab:blue", "s"),
+        "hattori": Variant("hattori", "MPS, Hattori et al. eq. (6) source, Rho* = rho0 n*/n0 (not the paper's method)",
+                           "tab:red", "D"),
+        "mixed": Variant("mixed", "MPS, mixed source rho0/dt div V* + gamma rho0/dt^2 (n0 - n*)/n0 (Tanaka & Masunaga 2010; not the paper's method)",
+                         "tab:green", "^"),
+    },
+    solver="isaflow.methods.mps.solver:solve",
+)

@@ -1,0 +1,285 @@
+"""MPS particle operators and the two halves of one time step (numba).
+
+Koshizuka & Oka (1996) / Koshizuka, Nobe & Oka (1998), 2D (d = 2):
+- weight w(r) = r_e / r - 1 for r < r_e, else 0;
+- number density n_i = sum_j w(r_ij);
+- gradient <grad phi>_i = d / n0 sum_j (phi_j - phi^_i) r_ij / |r_ij|^2 w(r_ij),
+  phi^_i = min(phi_i, phi_j over neighbours) (K&O 1996's stabilised pressure gradient);
+- Laplacian <lap phi>_i = 2 d / (lambda n0) sum_j (phi_j - phi_i) w(r_ij);
+- divergence <div u>_i = d / n0 sum_j (u_j - u_i) . r_ij / |r_ij|^2 w(r_ij).
+r_ij = r_j - r_i.  Particle kinds: FLUID, WALL (first wall layer, in the
+pressure equation) and DUMMY (further wall layers, number density only).
+Units: cm, s, density N s^2 / cm^4 (2D), pressure N / cm^2.
+"""
+
+import numpy as np
+from numba import njit
+
+from isaflow.core.geometry import crossed_wall
+from isaflow.core.neighbours import build_pairs
+
+JIT = dict(cache=True, nogil=True)
+FLUID, WALL, DUMMY = 0, 1, 2
+DIM = 2
+# source terms of the pressure equation (settings name -> id)
+SOURCES = {"standard": 0, "hattori": 1, "mixed": 2}
+
+
+@njit(inline="always", **JIT)
+def weight(r, re):
+    """MPS weight r_e / r - 1 (r clamped at 1e-6 r_e so coincident particles stay finite)."""
+    if r >= re:
+        return 0.0
+    return re / max(r, 1e-6 * re) - 1.0
+
+
+def lattice_constants(re_over_l0, l0=1.0):
+    """(n0, lambda [cm^2]) of a full square lattice of spacing l0 for radius r_e = re_over_l0 l0.
+
+    n0 = sum_j w(|r_j|), lambda = sum_j |r_j|^2 w / sum_j w over the lattice
+    points j != 0 (Koshizuka & Oka 1996).  n0 does not depend on l0.
+    """
+    k = int(np.ceil(re_over_l0)) + 1
+    g = np.arange(-k, k + 1, dtype=float)
+    x, y = np.meshgrid(g, g)
+    r = np.hypot(x, y).ravel()
+    r = r[(r > 0) & (r < re_over_l0)]
+    wts = re_over_l0 / r - 1.0
+    return float(wts.sum()), float((r**2 * wts).sum() / wts.sum() * l0**2)
+
+
+@njit(**JIT)
+def number_density(pos, pi, pj, m, re):
+    """(N,) number density of every particle from the pair list (pairs beyond r_e ignored)."""
+    n = np.zeros(pos.shape[0])
+    for k in range(m):
+        i, j = pi[k], pj[k]
+        r = np.hypot(pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1])
+        wt = weight(r, re)
+        n[i] += wt
+        n[j] += wt
+    return n
+
+
+@njit(**JIT)
+def divergence(pos, vel, pi, pj, m, re, n0):
+    """(N,) MPS divergence of vel [1/s] (all neighbours, wall velocity 0)."""
+    div = np.zeros(pos.shape[0])
+    for k in range(m):
+        i, j = pi[k], pj[k]
+        dx = pos[j, 0] - pos[i, 0]
+        dy = pos[j, 1] - pos[i, 1]
+        r2 = dx * dx + dy * dy
+        wt = weight(np.sqrt(r2), re)
+        if wt == 0.0:
+            continue
+        s = ((vel[j, 0] - vel[i, 0]) * dx + (vel[j, 1] - vel[i, 1]) * dy) / r2 * wt
+        div[i] += s
+        div[j] += s  # (u_i - u_j) . (r_i - r_j) is the same product
+    return div * (DIM / n0)
+
+
+@njit(**JIT)
+def laplacian(pos, f, kind, pi, pj, m, re, n0, lam):
+    """(N, C) MPS Laplacian of f (N, C) over fluid and wall neighbours (dummies excluded)."""
+    out = np.zeros_like(f)
+    for k in range(m):
+        i, j = pi[k], pj[k]
+        if kind[i] == DUMMY or kind[j] == DUMMY:
+            continue
+        wt = weight(np.hypot(pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1]), re)
+        for c in range(f.shape[1]):
+            d = (f[j, c] - f[i, c]) * wt
+            out[i, c] += d
+            out[j, c] -= d
+    return out * (2.0 * DIM / (lam * n0))
+
+
+@njit(**JIT)
+def gradient(pos, p, kind, pi, pj, m, re, n0):
+    """(N, 2) MPS pressure gradient with p^_i = min over neighbours (K&O 1996).
+
+    All particles take part (dummies carry the pressure of their wall particle,
+    see boundary.dummy_sources), so the neighbourhood of a fluid particle next
+    to a wall is complete.  ``kind`` is kept for the caller's symmetry with the other operators.
+    """
+    n = pos.shape[0]
+    pmin = p.copy()
+    for k in range(m):
+        i, j = pi[k], pj[k]
+        if np.hypot(pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1]) < re:
+            pmin[i] = min(pmin[i], p[j])
+            pmin[j] = min(pmin[j], p[i])
+    g = np.zeros((n, 2))
+    for k in range(m):
+        i, j = pi[k], pj[k]
+        dx = pos[j, 0] - pos[i, 0]
+        dy = pos[j, 1] - pos[i, 1]
+        r2 = dx * dx + dy * dy
+        wt = weight(np.sqrt(r2), re)
+        if wt == 0.0:
+            continue
+        a = (p[j] - pmin[i]) / r2 * wt
+        b = (p[i] - pmin[j]) / r2 * wt
+        g[i, 0] += a * dx
+        g[i, 1] += a * dy
+        g[j, 0] -= b * dx
+        g[j, 1] -= b * dy
+    return g * (DIM / n0)
+
+
+@njit(**JIT)
+def source_term(n_star, div_star, n0, rho0, dt, source, gamma):
+    """Right-hand side of lap P = b [N / cm^4] per particle.
+
+    source 0 standard: rho0 / dt^2 (n0 - n*) / n0 (Koshizuka & Oka 1996);
+    1 hattori: (rho0 - Rho*) / dt^2 + (rho0 - Rho*) / dt div V*, Rho* = rho0 n* / n0
+    (eq. 6 of Hattori et al.); 2 mixed: rho0 / dt div V* + gamma rho0 / dt^2 (n0 - n*) / n0
+    (Tanaka & Masunaga 2010).
+    """
+    drho = rho0 * (n0 - n_star) / n0  # rho0 - Rho*
+    if source == 0:
+        return drho / dt**2
+    if source == 1:
+        return drho / dt**2 + drho / dt * div_star
+    return rho0 / dt * div_star + gamma * drho / dt**2
+
+
+@njit(**JIT)
+def assemble(pos, kind, dirichlet, b, pi, pj, m, re, n0, lam):
+    """Pressure equation of the non-Dirichlet fluid and wall particles as CSR.
+
+    Row of unknown i: sum_j w_ij (P_i - P_j) = -(lambda n0 / 2d) b_i, the
+    MPS Laplacian times -(lambda n0 / 2d) (symmetric positive definite when
+    every cluster touches a Dirichlet particle, P = 0).  Returns (unknown (N,)
+    row of each particle or -1, indptr, indices, data, rhs).
+    """
+    n = pos.shape[0]
+    row = np.full(n, -1, np.int64)
+    nu = 0
+    for i in range(n):
+        if kind[i] != DUMMY and not dirichlet[i]:
+            row[i] = nu
+            nu += 1
+    count = np.ones(nu, np.int64)  # diagonal
+    for k in range(m):
+        i, j = pi[k], pj[k]
+        if row[i] >= 0 and row[j] >= 0:
+            if np.hypot(pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1]) < re:
+                count[row[i]] += 1
+                count[row[j]] += 1
+    indptr = np.zeros(nu + 1, np.int64)
+    for r in range(nu):
+        indptr[r + 1] = indptr[r] + count[r]
+    indices = np.empty(indptr[nu], np.int32)
+    data = np.zeros(indptr[nu])
+    fill = indptr[:-1] + 1
+    for r in range(nu):
+        indices[indptr[r]] = r
+    for k in range(m):
+        i, j = pi[k], pj[k]
+        if kind[i] == DUMMY or kind[j] == DUMMY or (row[i] < 0 and row[j] < 0):
+            continue
+        r = np.hypot(pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1])
+        if r >= re:
+            continue
+        wt = weight(r, re)
+        ri, rj = row[i], row[j]
+        if ri >= 0:
+            data[indptr[ri]] += wt
+        if rj >= 0:
+            data[indptr[rj]] += wt
+        if ri >= 0 and rj >= 0:
+            indices[fill[ri]] = rj
+            data[fill[ri]] = -wt
+            fill[ri] += 1
+            indices[fill[rj]] = ri
+            data[fill[rj]] = -wt
+            fill[rj] += 1
+    rhs = np.empty(nu)
+    c = -lam * n0 / (2.0 * DIM)
+    for i in range(n):
+        if row[i] >= 0:
+            rhs[row[i]] = c * b[i]
+    return row, indptr, indices, data, rhs
+
+
+@njit(**JIT)
+def predict(pos, vel, kind, box, dt, gx, gy, nu, re_n, re_l, n0_n, n0_l, lam, beta, rho0, source, gamma):
+    """Explicit half of a step (eq. 3) and the pressure equation at the moved positions.
+
+    Fluid: V* = V + dt (nu lap V + g), U* = U + dt V* (walls fixed).  Then at
+    U*: n*, div V*, free surface (n* < beta n0, fluid and wall particles:
+    Dirichlet P = 0), source term and the CSR system (see assemble).
+    Returns (pos*, vel*, n*, div*, dirichlet, (pi, pj, m) at U*, (row, indptr, indices, data, rhs)).
+    """
+    pi, pj, m = build_pairs(pos, box, re_l)
+    lap = laplacian(pos, vel, kind, pi, pj, m, re_l, n0_l, lam)
+    ps = pos.copy()
+    vs = vel.copy()
+    for i in range(pos.shape[0]):
+        if kind[i] == FLUID:
+            vs[i, 0] = vel[i, 0] + dt * (nu * lap[i, 0] + gx)
+            vs[i, 1] = vel[i, 1] + dt * (nu * lap[i, 1] + gy)
+            ps[i, 0] = pos[i, 0] + dt * vs[i, 0]
+            ps[i, 1] = pos[i, 1] + dt * vs[i, 1]
+    pi, pj, m = build_pairs(ps, box, re_l)
+    n_star = number_density(ps, pi, pj, m, re_n)
+    div = divergence(ps, vs, pi, pj, m, re_n, n0_n)
+    dirichlet = np.zeros(pos.shape[0], np.bool_)
+    b = np.zeros(pos.shape[0])
+    for i in range(pos.shape[0]):
+        if kind[i] != DUMMY:
+            dirichlet[i] = n_star[i] < beta * n0_n
+            b[i] = source_term(n_star[i], div[i], n0_n, rho0, dt, source, gamma)
+    system = assemble(ps, kind, dirichlet, b, pi, pj, m, re_l, n0_l, lam)
+    return ps, vs, n_star, div, dirichlet, pi, pj, m, system
+
+
+@njit(**JIT)
+def correct(pos_old, ps, vs, p, kind, pi, pj, m, re_n, n0_n, rho0, dt, walls, box):
+    """Pressure half of a step (eqs. 4-5): V' = -dt / rho0 grad P, U' = dt V'.
+
+    Returns (pos, vel, grad P (N, 2), bad): bad = (kind of failure, particle,
+    wall): 0 fine, 1 non-finite, 2 crossed a wall (from pos_old), 3 left the box.
+    """
+    g = gradient(ps, p, kind, pi, pj, m, re_n, n0_n)
+    pos = ps.copy()
+    vel = vs.copy()
+    bad = (0, -1, -1)
+    for i in range(pos.shape[0]):
+        if kind[i] != FLUID:
+            continue
+        vel[i, 0] = vs[i, 0] - dt / rho0 * g[i, 0]
+        vel[i, 1] = vs[i, 1] - dt / rho0 * g[i, 1]
+        pos[i, 0] = ps[i, 0] - dt * dt / rho0 * g[i, 0]
+        pos[i, 1] = ps[i, 1] - dt * dt / rho0 * g[i, 1]
+        if bad[0] != 0:
+            continue
+        if not (np.isfinite(pos[i, 0]) and np.isfinite(pos[i, 1]) and np.isfinite(vel[i, 0]) and np.isfinite(vel[i, 1])):
+            bad = (1, i, -1)
+            continue
+        w = crossed_wall(pos_old[i, 0], pos_old[i, 1], pos[i, 0], pos[i, 1], walls)
+        if w >= 0:
+            bad = (2, i, w)
+        elif pos[i, 0] < box[0] or pos[i, 0] > box[2] or pos[i, 1] < box[1] or pos[i, 1] > box[3]:
+            bad = (3, i, -1)
+    return pos, vel, g, bad
+
+
+@njit(**JIT)
+def probe_pressure(pos, p, kind, probes, re):
+    """(K,) pressure [N/cm^2] at fixed points: MPS-weighted mean of fluid particle pressures (NaN if none in range)."""
+    out = np.full(probes.shape[0], np.nan)
+    for k in range(probes.shape[0]):
+        sw = 0.0
+        sp = 0.0
+        for i in range(pos.shape[0]):
+            if kind[i] != FLUID:
+                continue
+            wt = weight(np.hypot(pos[i, 0] - probes[k, 0], pos[i, 1] - probes[k, 1]), re)
+            sw += wt
+            sp += wt * p[i]
+        if sw > 0.0:
+            out[k] = sp / sw
+    return out

@@ -1,0 +1,62 @@
+"""MPS settings: config/methods/mps.yaml, validated by settings.schema.json.
+
+Every value is stored as {value, source}; :func:`load` returns the values
+flattened to ``group.key`` -> value and keeps the sources for the report.
+"""
+
+import copy
+import json
+from importlib import resources
+from pathlib import Path
+
+import jsonschema
+import yaml
+
+from isaflow.scene import SceneError
+
+SCHEMA = json.loads(resources.files("isaflow.methods.mps").joinpath("settings.schema.json").read_text())
+DEFAULT_PATH = "config/methods/mps.yaml"
+
+
+class Settings(dict):
+    """{'group.key': value}; ``sources`` {'group.key': source}; ``path`` the file."""
+
+    def __init__(self, values, sources, path):
+        super().__init__(values)
+        self.sources = sources
+        self.path = path
+
+    def with_overrides(self, **kw):
+        """Copy with values replaced (keys 'group.key'); KeyError for unknown keys."""
+        new = Settings(copy.deepcopy(dict(self)), dict(self.sources), self.path)
+        for k, v in kw.items():
+            if k not in new:
+                raise KeyError(f"unknown MPS setting '{k}'")
+            new[k] = v
+        return new
+
+
+def load(path=DEFAULT_PATH, overrides=()):
+    """Read and validate the settings; overrides 'group.key=value' (YAML value).
+
+    Raises SceneError with one line naming the file and the field.
+    """
+    path = str(path)
+    try:
+        spec = yaml.safe_load(Path(path).read_text())
+    except (OSError, UnicodeDecodeError, yaml.YAMLError) as err:
+        raise SceneError(f"{path}: cannot read MPS settings: {err}") from None
+    for item in overrides:
+        key, sep, value = item.partition("=")
+        group, _, name = key.strip().partition(".")
+        if not sep or not isinstance(spec, dict) or name not in spec.get(group, {}):
+            raise SceneError(f"{path}: override '{item}': no field '{key.strip()}'")
+        spec[group][name]["value"] = yaml.safe_load(value)
+    errors = sorted(jsonschema.Draft202012Validator(SCHEMA).iter_errors(spec), key=lambda e: list(e.absolute_path))
+    if errors:
+        e = errors[0]
+        where = ".".join(str(p) for p in e.absolute_path) or "(top level)"
+        raise SceneError(f"{path}: field '{where}': {e.message}")
+    values = {f"{g}.{k}": v["value"] for g, grp in spec.items() for k, v in grp.items()}
+    sources = {f"{g}.{k}": v["source"] for g, grp in spec.items() for k, v in grp.items()}
+    return Settings(values, sources, path)
