@@ -1,0 +1,23 @@
+"""Hooke's-law solid particles (Marko 2017, marko2017_lagrangian_solid_sph.txt, sections 3-4).
+
+Cubic particles linked to their lattice neighbours (the contact matrix):
+linked pairs pull and push by Hooke's law (eqs. 11-16), unlinked ones only
+push.  Variants: 'paper' (eqs. 11-16 as printed: normal springs only) and
+'hooke' (adds the Poisson contraction of the particle size and shear springs
+of modulus G, our reading of how the paper's Poisson and shear numbers arise).
+"""
+
+from isaflow.methods import Method, Variant
+
+METHOD = Method(
+    name="solid",
+    label="Hooke's-law solid particles (Marko 2017)",
+    paper="marko2017_lagrangian_solid_sph.txt",
+    variants={
+        "paper": Variant("paper", "paper: eqs. 11-16 as printed (normal Hooke springs, no Poisson or shear term)",
+                         "tab:red", "s"),
+        "hooke": Variant("hooke", "hooke: eqs. 11-16 + Poisson size coupling + G shear springs (not in the paper)",
+                         "tab:blue", "o"),
+    },
+    solver="isaflow.methods.solid.cases:run_case",
+)

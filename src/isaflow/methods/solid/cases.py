@@ -1,0 +1,203 @@
+"""The section-4 cases of marko2017 as solid runs: bar (tension, compression), shear, Hertz.
+
+Each ``run_<case>(cfg, variant)`` builds the particles from the settings
+(settings.load), relaxes them to rest and returns a contract.Result whose
+history holds the case's measured numbers (SI-free: cm, N, s; stresses N/cm^2).
+"""
+
+import numpy as np
+
+from isaflow.contract import Result
+from isaflow.core.units import PA
+
+from . import lattice as L
+from . import solve as S
+from .settings import material_units
+
+UM, MM = 1e-4, 0.1  # cm
+
+
+def _material(cfg):
+    return S.Material(*material_units(cfg["material"]))
+
+
+def _budget(cfg, variant):
+    s = cfg["solver"]
+    return s["max_steps"] if variant == "hooke" else s["max_steps_mechanism"]
+
+
+def _result(st, case, status, msg, resid, history, params, start=None):
+    """contract.Result of a solid state: (x, y) in pos, z and stresses in fields, no wall contacts."""
+    b = st.block
+    fields = {
+        "pos_z0": (("particle",), b.ref[:, 2], "cm", "initial particle z"),
+        "pos_z": (("particle",), st.pos[:, 2], "cm", "final particle z"),
+        "stress": (("particle", "stress_component"), st.sig, "N cm-2",
+                   "particle virial stress xx, yy, zz, yx, zy, zx (dim 2: per unit thickness, zz plane strain)"),
+        "lattice_index": (("particle", "axis"), b.index.astype(np.int32), "1", "lattice index i, j, k"),
+    }
+    return Result(
+        method="solid", variant=st.variant, pos0=b.ref[:, :2].copy(), pos=st.pos[:, :2].copy(),
+        weight=st.mass * 981.0, contact_wall=np.zeros(0, int), contact_point=np.zeros((0, 2)),
+        contact_force=np.zeros((0, 2)), status=status, message=msg, steps=st.steps, start_step=0,
+        wall_time=st.wall_time, force_evals=st.steps, residual=resid,
+        residual_name="max|F_free| / max|f_link|", residual_units="1", sim_time=float(st.clock[1]),
+        history=history, fields=fields,
+        params={"case": case, "dim": b.dim, "dx_cm": b.dx, "E_N_cm2": st.mat.E, "nu": st.mat.nu,
+                "rho_N_s2_cm4": st.mat.rho, "dt_min_s": float(st.clock[2]), "dt_max_s": float(st.clock[3]),
+                "dt_rule_s": st.dt_max, **params})
+
+
+def run_bar(cfg, variant, sign=+1):
+    """4.1: the 5 x 11 x 5 bar pulled (sign +1) or pushed (-1) by pull_um along y.
+
+    Measures: stress sigma_yy at the centre particle and its largest magnitude
+    in the middle layer, the per-side width change in x and z at mid-length."""
+    c = cfg["bar"]
+    nx, ny, nz = c["particles"]
+    dx = c["dx_mm"] * MM
+    b = L.block(nx, ny, nz, dx, (-(nx - 1) / 2 * dx, 0.0, -(nz - 1) / 2 * dx))
+    st = S.State(b, _material(cfg), variant, np.ones((b.n, 3)))
+    j = b.index[:, 1]
+    mask = np.zeros((b.n, 3), bool)
+    ends = (j == 0) | (j == ny - 1)
+    if c["grips"] == "clamped":
+        mask[ends] = True
+    else:
+        mask[ends, 1] = True
+        mask[(j == 0) & (b.index[:, 0] == nx // 2) & (b.index[:, 2] == nz // 2)] = True
+    disp = np.zeros((b.n, 3))
+    disp[j == ny - 1, 1] = sign * c["pull_um"] * UM
+    S.prescribe(st, mask, disp)
+    status, msg, resid, _ = S.relax(st, cfg["solver"]["tol"], _budget(cfg, variant), label=f"bar {variant}")
+    mid = j == ny // 2
+    i, k = b.index[:, 0], b.index[:, 2]
+    centre = np.flatnonzero(mid & (i == nx // 2) & (k == nz // 2))[0]
+    u = st.pos - b.ref
+    side_x = 0.5 * (u[mid & (i == nx - 1), 0].mean() - u[mid & (i == 0), 0].mean())
+    side_z = 0.5 * (u[mid & (k == nz - 1), 2].mean() - u[mid & (k == 0), 2].mean())
+    hist = {
+        "sigma_centre": (("record",), [st.sig[centre, 1]], "N cm-2", "sigma_yy of the centre particle"),
+        "sigma_peak": (("record",), [sign * np.abs(st.sig[mid, 1]).max()], "N cm-2",
+                       "largest |sigma_yy| in the mid-length layer, with the load's sign"),
+        "width_change_x": (("record",), [side_x], "cm", "mid-length change of the x half-width (per side)"),
+        "width_change_z": (("record",), [side_z], "cm", "mid-length change of the z half-width (per side)"),
+        "reaction": (("record",), [st.frc[j == ny - 1, 1].sum()], "N", "y force on the moved end layer"),
+    }
+    case = "tension" if sign > 0 else "compression"
+    return _result(st, f"bar_{case}", status, msg, resid, hist, {"pull_cm": sign * c["pull_um"] * UM,
+                                                                  "grips": c["grips"]})
+
+
+def run_shear(cfg, variant):
+    """4.2: the 11 x 3 x 3 block between a held layer below and a layer moved by deflection_um in x above.
+
+    Measures: the shear traction tau_yx at the centre particle and its largest value."""
+    c = cfg["shear"]
+    nx, ny, nz = c["particles"]
+    g = c["grip_layers"]
+    dx = cfg["bar"]["dx_mm"] * MM
+    b = L.block(nx, ny + 2 * g, nz, dx)
+    st = S.State(b, _material(cfg), variant, np.ones((b.n, 3)))
+    j = b.index[:, 1]
+    top = j >= ny + g
+    mask = np.zeros((b.n, 3), bool)
+    mask[(j < g) | top] = True
+    disp = np.zeros((b.n, 3))
+    disp[top, 0] = c["deflection_um"] * UM
+    S.prescribe(st, mask, disp)
+    status, msg, resid, _ = S.relax(st, cfg["solver"]["tol"], _budget(cfg, variant), label=f"shear {variant}")
+    i, k = b.index[:, 0], b.index[:, 2]
+    free = (j >= g) & (j < ny + g)
+    centre = np.flatnonzero((i == nx // 2) & (j == (ny + 2 * g) // 2) & (k == nz // 2))[0]
+    hist = {
+        "tau_centre": (("record",), [st.sig[centre, 3]], "N cm-2", "shear traction tau_yx of the centre particle"),
+        "tau_peak": (("record",), [st.sig[free, 3].max()], "N cm-2", "largest tau_yx of the free layers"),
+        "height": (("record",), [(ny + 2 * g - 1) * dx], "cm", "distance between held and moved layers"),
+    }
+    return _result(st, "shear", status, msg, resid, hist, {"deflection_cm": c["deflection_um"] * UM,
+                                                           "grip_layers": g})
+
+
+def hertz_state(cfg, variant):
+    """The 51 x 10 plate (bottom row held, plane strain, unlinked pairs push) and the rigid disk above it."""
+    c = cfg["hertz"]
+    nx, ny = c["plate"]
+    dx = c["dx_um"] * UM
+    b = L.block(nx, ny, 1, dx, (-(nx - 1) / 2 * dx, -(ny - 1) * dx, 0.0))
+    st = S.State(b, _material(cfg), variant, np.ones((b.n, 3)), push=1)
+    mask = np.zeros((b.n, 3), bool)
+    mask[b.index[:, 1] == 0] = True
+    mask[:, 2] = True
+    S.prescribe(st, mask, np.zeros(3))
+    return st
+
+
+def set_depth(st, R, depth):
+    """Rigid disk of radius R [cm] touching the plate's top face, pressed depth [cm] into it."""
+    st.disk[:] = [0.0, 0.5 * st.block.dx + R - depth, R, 1.0]
+
+
+def run_hertz(cfg, variant):
+    """4.3: the disk pressed in increments; per increment the load and the peak contact pressure.
+
+    Load = the plate's force on the disk per unit thickness [N/cm]; peak pressure
+    = largest contact force on one top particle / dx [N/cm^2]."""
+    c = cfg["hertz"]
+    st = hertz_state(cfg, variant)
+    R, dx = c["radius_mm"] * MM, st.block.dx
+    rows = {k: [] for k in ("depth", "load", "pmax", "n_contact", "steps", "status")}
+    status, msg, resid = "converged", "", 0.0
+    for d in c["depths_um"]:
+        set_depth(st, R, d * UM)
+        s0 = st.steps
+        status, msg, resid, g = S.relax(st, cfg["solver"]["tol"], _budget(cfg, variant), label=f"hertz {variant} {d} um")
+        for key, val in zip(rows, (d * UM, g[1], st.pres.max() / dx, int((st.pres > 0).sum()), st.steps - s0,
+                                   status)):
+            rows[key].append(val)
+        if status in ("escaped", "nonfinite"):
+            break
+    hist = {
+        "depth": (("record",), rows["depth"], "cm", "disk indentation delta"),
+        "load": (("record",), rows["load"], "N cm-1", "force of the plate on the disk per unit thickness"),
+        "pmax": (("record",), rows["pmax"], "N cm-2", "largest contact force on a top particle / dx"),
+        "n_contact": (("record",), rows["n_contact"], "1", "top particles in contact"),
+        "increment_steps": (("record",), rows["steps"], "1", "steps to rest in this increment"),
+        "increment_converged": (("record",), [int(s == "converged") for s in rows["status"]], "1",
+                                "1 if the increment came to rest"),
+    }
+    if status == "converged" and len(rows["depth"]) < len(c["depths_um"]):
+        status = "step_limit"
+    return _result(st, "hertz", status, msg, resid, hist, {"radius_cm": R})
+
+
+def run_hertz_dt(cfg, variant, dt_ns):
+    """The paper's fixed step dt_ns [ns]: settle the first increment with the step rule (eqs. 26-27),
+    then press the second increment at dt_ns for dt_check_steps steps: stable or not?"""
+    c = cfg["hertz"]
+    st = hertz_state(cfg, variant)
+    R = c["radius_mm"] * MM
+    set_depth(st, R, c["depths_um"][0] * UM)
+    S.relax(st, cfg["solver"]["tol"], _budget(cfg, variant), label=f"hertz dt {dt_ns} ns, first increment")
+    set_depth(st, R, c["depths_um"][1] * UM)
+    status, msg, resid, g = S.relax(st, cfg["solver"]["tol"], c["dt_check_steps"], dt=dt_ns * 1e-9,
+                                    label=f"hertz dt {dt_ns} ns")
+    hist = {"load": (("record",), [g[1]], "N cm-1", "force of the plate on the disk per unit thickness")}
+    return _result(st, f"hertz_dt{dt_ns:g}ns", status, msg, resid, hist,
+                   {"dt_fixed_s": dt_ns * 1e-9, "dt_over_rule": dt_ns * 1e-9 / st.dt_max})
+
+
+def to_pa(x):
+    """N/cm^2 -> Pa."""
+    return np.asarray(x, float) / PA
+
+
+CASES = {"bar_tension": lambda cfg, v: run_bar(cfg, v, +1), "bar_compression": lambda cfg, v: run_bar(cfg, v, -1),
+         "shear": run_shear, "hertz": run_hertz}
+
+
+def run_case(cfg, case, variant):
+    """Dispatch: case is a key of CASES or 'hertz_dt<ns>' (the paper's fixed step)."""
+    if case.startswith("hertz_dt"):
+        return run_hertz_dt(cfg, variant, float(case[len("hertz_dt"):].removesuffix("ns")))
+    return CASES[case](cfg, variant)

@@ -1,0 +1,278 @@
+"""Hooke's-law solid particles (marko2017 section 3, eqs. 11-16, 26-27): the compiled step loop.
+
+Plain arrays only (numba); units cm, N, s.  Positions are (N, 3) in every
+dimension (2D runs keep z = 0 and have no z links; forces per unit thickness).
+
+Links (the paper's contact matrix): pairs (a, b) of lattice neighbours with
+reference vector d0 = ref_b - ref_a along lattice axis u (0, 1, 2).  A link
+pushes and pulls; unlinked particles only push, when closer than their mean
+size.  Per link, with the particles' strain diagonal Ebar (mean of a and b,
+previous step):
+
+    strain = (r - L0 (1 + eps_p)) / (L0 (1 + Ebar_u))          eq. 15
+    f_n    = E dx^(d-1) (1 + Ebar_v)(1 + Ebar_w) strain         eq. 16 (force, not dv)
+    f_t    = G dx^(d-1) (d - (d.e) e) / L0      (variant 'hooke' only)
+
+eps_p = -nu (sigma_v + sigma_w) / E (variant 'hooke' only; 0 in 'paper'):
+the Poisson contraction of the particle's natural size.  Particle stress is
+the virial sigma = sum_b f_ab (x) r_ab / (2 V), V = dx^d; its strain diagonal
+E_u = sigma_u / E (paper, eq. 14) or (sigma_u - nu (sigma_v + sigma_w)) / E
+(hooke).  2D is plane strain in 'hooke' (sigma_z = nu (sigma_x + sigma_y)).
+
+Time integration as section 3: accelerations -> velocities -> positions ->
+stresses; dt = min(dx / (4 c), 0.1 dx / V_max) (eqs. 26-27) unless a fixed dt
+is given.  Settling: kinetic damping (all velocities zeroed when the kinetic
+energy falls; not in the paper, which only says the particles "settle").
+"""
+
+import numpy as np
+from numba import njit
+
+from isaflow.core.neighbours import build_pairs
+
+JIT = dict(cache=True, nogil=True)
+
+# status codes of relax()
+RUNNING, CONVERGED, UNSTABLE, NONFINITE = 0, 1, 2, 3
+
+
+@njit(**JIT)
+def link_forces(pos, la, lb, d0, laxis, sig, strain, E, nu, G, area0, poisson, shear, frc, vir):
+    """Add every link's force to frc (N, 3) [N] and its virial to vir (N, 6) [N cm].
+
+    vir columns: f_x d_x, f_y d_y, f_z d_z, f_x d_y, f_y d_z, f_x d_z (the last three: shear
+    tractions on planes normal to y, z, z; not symmetrised, as the shear springs of a link
+    carry only the traction on the plane normal to it).  Returns the largest |f_n| [N]."""
+    fmax = 0.0
+    for k in range(la.shape[0]):
+        a = la[k]
+        b = lb[k]
+        u = laxis[k]
+        v = (u + 1) % 3
+        w = (u + 2) % 3
+        dx = pos[b, 0] - pos[a, 0]
+        dy = pos[b, 1] - pos[a, 1]
+        dz = pos[b, 2] - pos[a, 2]
+        r = np.sqrt(dx * dx + dy * dy + dz * dz)
+        L0 = np.sqrt(d0[k, 0] ** 2 + d0[k, 1] ** 2 + d0[k, 2] ** 2)
+        eu = 0.5 * (strain[a, u] + strain[b, u])
+        ev = 0.5 * (strain[a, v] + strain[b, v])
+        ew = 0.5 * (strain[a, w] + strain[b, w])
+        eps_p = 0.0
+        if poisson:
+            eps_p = -nu * 0.5 * (sig[a, v] + sig[b, v] + sig[a, w] + sig[b, w]) / E
+        s = (r - L0 * (1.0 + eps_p)) / (L0 * (1.0 + eu))
+        fn = E * area0 * (1.0 + ev) * (1.0 + ew) * s
+        fmax = max(fmax, abs(fn))
+        fx = fn * dx / r
+        fy = fn * dy / r
+        fz = fn * dz / r
+        if shear:
+            ex = d0[k, 0] / L0
+            ey = d0[k, 1] / L0
+            ez = d0[k, 2] / L0
+            dn = dx * ex + dy * ey + dz * ez
+            c = G * area0 * (1.0 + ev) * (1.0 + ew) / L0
+            fx += c * (dx - dn * ex)
+            fy += c * (dy - dn * ey)
+            fz += c * (dz - dn * ez)
+        add_pair(a, b, fx, fy, fz, dx, dy, dz, frc, vir)
+    return fmax
+
+
+@njit(inline="always", **JIT)
+def add_pair(a, b, fx, fy, fz, dx, dy, dz, frc, vir):
+    """Force (fx, fy, fz) on a from b (minus on b), separation d = x_b - x_a; both virials."""
+    frc[a, 0] += fx
+    frc[a, 1] += fy
+    frc[a, 2] += fz
+    frc[b, 0] -= fx
+    frc[b, 1] -= fy
+    frc[b, 2] -= fz
+    for p in (a, b):
+        vir[p, 0] += fx * dx
+        vir[p, 1] += fy * dy
+        vir[p, 2] += fz * dz
+        vir[p, 3] += fx * dy
+        vir[p, 4] += fy * dz
+        vir[p, 5] += fx * dz
+
+
+@njit(**JIT)
+def push_forces(pos, size, partners, pi, pj, m, E, dim, frc, vir):
+    """Unlinked pairs closer than (s_a + s_b) / 2 push apart (never pull): springs of two
+    half-particles in series, k = E A / ((s_a + s_b) / 2), A = min(s)^(d-1)."""
+    for k in range(m):
+        a = pi[k]
+        b = pj[k]
+        linked = False
+        for q in range(partners.shape[1]):
+            if partners[a, q] == b:
+                linked = True
+        if linked:
+            continue
+        dx = pos[b, 0] - pos[a, 0]
+        dy = pos[b, 1] - pos[a, 1]
+        dz = pos[b, 2] - pos[a, 2]
+        r = np.sqrt(dx * dx + dy * dy + dz * dz)
+        r0 = 0.5 * (size[a] + size[b])
+        if r >= r0 or r == 0.0:
+            continue
+        area = min(size[a], size[b]) ** (dim - 1)
+        fn = E * area * (r - r0) / r0  # < 0: push
+        add_pair(a, b, fn * dx / r, fn * dy / r, fn * dz / r, dx, dy, dz, frc, vir)
+
+
+@njit(**JIT)
+def disk_forces(pos, size, free, disk, E, dim, frc, vir, pres):
+    """Rigid disk (cx, cy, R, on): a particle whose centre is closer than R + s/2 to the disk
+    centre is pushed out radially by a half-particle spring k = 2 E A / s (rigid partner).
+    pres (N,) receives the contact force magnitude per particle [N]; returns the force (fx, fy)
+    of the particles on the disk [N]."""
+    gx = 0.0
+    gy = 0.0
+    if disk[3] == 0.0:
+        return gx, gy
+    for a in range(pos.shape[0]):
+        pres[a] = 0.0
+        dx = pos[a, 0] - disk[0]
+        dy = pos[a, 1] - disk[1]
+        D = np.sqrt(dx * dx + dy * dy)
+        pen = disk[2] + 0.5 * size[a] - D
+        if pen <= 0.0:
+            continue
+        area = size[a] ** (dim - 1)
+        f = 2.0 * E * area * pen / size[a]
+        fx = f * dx / D
+        fy = f * dy / D
+        frc[a, 0] += fx
+        frc[a, 1] += fy
+        # contact point at distance s/2 from the centre, towards the disk
+        vir[a, 0] += fx * (-0.5 * size[a] * dx / D) * 2.0
+        vir[a, 1] += fy * (-0.5 * size[a] * dy / D) * 2.0
+        pres[a] = f
+        gx -= fx
+        gy -= fy
+    return gx, gy
+
+
+@njit(**JIT)
+def stresses(vir, size, dim, E, nu, poisson, sig, strain):
+    """Particle stress sigma (N, 6) [N/cm^2] = virial / (2 V) (columns as link_forces) and strain diagonal (N, 3)."""
+    for a in range(vir.shape[0]):
+        V = size[a] ** dim
+        for c in range(6):
+            sig[a, c] = vir[a, c] / (2.0 * V)
+        if dim == 2:
+            sig[a, 2] = nu * (sig[a, 0] + sig[a, 1]) if poisson else 0.0
+        for u in range(3):
+            e = sig[a, u]
+            if poisson:
+                e -= nu * (sig[a, (u + 1) % 3] + sig[a, (u + 2) % 3])
+            strain[a, u] = e / E
+        if dim == 2:
+            strain[a, 2] = 0.0
+
+
+@njit(**JIT)
+def relax(pos, vel, ref, target, free, mass, size, la, lb, d0, laxis, partners, disk,
+          E, nu, G, rho, dim, poisson, shear, push, dt_fixed, tol, min_steps, n_steps,
+          sig, strain, frc, pres, state):
+    """Run up to n_steps steps; stop early when converged (residual < tol) or unstable.
+
+    target (N, 3): positions of the prescribed dofs (free == 0).  state (6,)
+    float64 carries between chunks: [kinetic energy of the previous step,
+    sim time s, smallest dt, largest dt, pair-list anchor flag, steps].
+    Returns (steps, status, residual = max free |F| / max link |f_n|,
+    disk force x, disk force y).
+    """
+    n = pos.shape[0]
+    smin = size.min()
+    c = np.sqrt(E / rho)
+    dt_max = smin / (4.0 * c)  # eq. 26
+    area0 = smin ** (dim - 1)
+    vir = np.zeros((n, 6))
+    box = np.empty(4)
+    rc = 1.5 * size.max()
+    skin = 0.25 * size.min()
+    anchor = pos.copy()
+    pi = np.zeros(1, np.int32)
+    pj = np.zeros(1, np.int32)
+    m = 0
+    rebuild = True
+    status = RUNNING
+    resid = np.inf
+    gx = 0.0
+    gy = 0.0
+    for step in range(n_steps):
+        if push:
+            if not rebuild:
+                for a in range(n):
+                    if (pos[a, 0] - anchor[a, 0]) ** 2 + (pos[a, 1] - anchor[a, 1]) ** 2 > 0.25 * skin * skin:
+                        rebuild = True
+                        break
+            if rebuild:
+                box[0] = pos[:, 0].min()
+                box[1] = pos[:, 1].min()
+                box[2] = pos[:, 0].max() + 1e-9
+                box[3] = pos[:, 1].max() + 1e-9
+                pi, pj, m = build_pairs(pos, box, rc + skin)
+                anchor[:, :] = pos
+                rebuild = False
+        frc[:, :] = 0.0
+        vir[:, :] = 0.0
+        fmax = link_forces(pos, la, lb, d0, laxis, sig, strain, E, nu, G, area0, poisson, shear, frc, vir)
+        if push:
+            push_forces(pos, size, partners, pi, pj, m, E, dim, frc, vir)
+        gx, gy = disk_forces(pos, size, free, disk, E, dim, frc, vir, pres)
+        # residual: out-of-balance force on free dofs against the largest link force
+        fres = 0.0
+        vmax = 0.0
+        for a in range(n):
+            for u in range(3):
+                fres = max(fres, abs(frc[a, u]) * free[a, u])
+                vmax = max(vmax, abs(vel[a, u]))
+        resid = fres / fmax if fmax > 0.0 else fres
+        if not np.isfinite(resid):
+            status = NONFINITE
+            break
+        if step >= min_steps and resid < tol:
+            status = CONVERGED
+            break
+        dt = dt_fixed
+        if dt <= 0.0:
+            dt = dt_max if vmax == 0.0 else min(dt_max, 0.1 * smin / vmax)  # eqs. 26-27
+        ke = 0.0
+        for a in range(n):
+            for u in range(3):
+                vel[a, u] = (vel[a, u] + dt * frc[a, u] / mass[a]) * free[a, u]
+                ke += 0.5 * mass[a] * vel[a, u] ** 2
+        if ke < state[0]:  # kinetic damping: past a peak of kinetic energy
+            vel[:, :] = 0.0
+            ke = 0.0
+        state[0] = ke
+        bad = False
+        for a in range(n):
+            for u in range(3):
+                if free[a, u] > 0.0:
+                    pos[a, u] += dt * vel[a, u]
+                else:
+                    pos[a, u] = target[a, u]
+                if not abs(pos[a, u] - ref[a, u]) < size[a]:  # a particle moved a full width: blow-up
+                    bad = True
+        state[1] += dt
+        state[2] = min(state[2], dt)
+        state[3] = max(state[3], dt)
+        state[5] += 1
+        # last step of the section 3 loop: stresses and strains at the new positions
+        stresses(vir, size, dim, E, nu, poisson, sig, strain)
+        if bad:
+            status = UNSTABLE
+            for a in range(n):
+                for u in range(3):
+                    if not np.isfinite(pos[a, u]):
+                        status = NONFINITE
+            return step + 1, status, resid, gx, gy
+    else:
+        return n_steps, status, resid, gx, gy
+    return step, status, resid, gx, gy

@@ -1,0 +1,74 @@
+"""Settings of the solid method (config/methods/solid.yaml): schema, validation, unit conversion.
+
+Every value is ``{value: ..., source: "..."}``; unknown keys are rejected and
+a bad file raises isaflow.scene.SceneError naming the file and field.
+"""
+
+from pathlib import Path
+
+import jsonschema
+import yaml
+
+from isaflow.core.units import KG, PA
+from isaflow.scene import SceneError
+
+
+def _item(value_schema):
+    return {"type": "object", "additionalProperties": False, "required": ["value", "source"],
+            "properties": {"value": value_schema,
+                           "source": {"type": "string", "pattern": "^(page text|inferred|literature)"}}}
+
+
+POS = {"type": "number", "exclusiveMinimum": 0}
+COUNT = {"type": "integer", "minimum": 1}
+
+
+def _section(**fields):
+    return {"type": "object", "additionalProperties": False, "required": list(fields),
+            "properties": {k: _item(v) for k, v in fields.items()}}
+
+
+SCHEMA = {
+    "type": "object", "additionalProperties": False,
+    "required": ["material", "solver", "bar", "shear", "hertz", "vessel"],
+    "properties": {
+        "material": _section(E_GPa=POS, nu={"type": "number", "minimum": 0, "exclusiveMaximum": 0.5}, rho_kg_m3=POS),
+        "solver": _section(tol=POS, max_steps=COUNT, max_steps_mechanism=COUNT),
+        "bar": _section(particles={"type": "array", "items": COUNT, "minItems": 3, "maxItems": 3}, dx_mm=POS,
+                        pull_um=POS, grips={"enum": ["clamped", "sliding"]}, exaggeration=POS),
+        "shear": _section(particles={"type": "array", "items": COUNT, "minItems": 3, "maxItems": 3},
+                          grip_layers={"type": "integer", "minimum": 0}, deflection_um=POS, height_cm=POS),
+        "hertz": _section(plate={"type": "array", "items": COUNT, "minItems": 2, "maxItems": 2}, dx_um=POS,
+                          radius_mm=POS, depths_um={"type": "array", "items": POS, "minItems": 1},
+                          plane={"enum": ["strain"]}, paper_dt_ns={"type": "array", "items": POS},
+                          dt_check_steps=COUNT),
+        "vessel": _section(dx_mm=POS, ring_particles=COUNT, water_radius_particles=COUNT, pressure_Pa=POS,
+                           K_GPa=POS, rho_water_kg_m3=POS, steps=COUNT, dt_ns=POS),
+    },
+}
+
+
+def load(path):
+    """{section: {key: value}} of a settings file, values as written (sources dropped)."""
+    spec = load_with_sources(path)
+    return {sec: {k: v["value"] for k, v in items.items()} for sec, items in spec.items()}
+
+
+def load_with_sources(path):
+    """The validated file as written: {section: {key: {value, source}}}."""
+    path = str(path)
+    try:
+        spec = yaml.safe_load(Path(path).read_text())
+    except (OSError, yaml.YAMLError) as err:
+        raise SceneError(f"{path}: cannot read settings: {err}") from None
+    errors = sorted(jsonschema.Draft202012Validator(SCHEMA).iter_errors(spec), key=lambda e: list(e.path))
+    if errors:
+        e = errors[0]
+        where = ".".join(str(p) for p in e.absolute_path) or "(top level)"
+        raise SceneError(f"{path}: field '{where}': {e.message}")
+    return spec
+
+
+def material_units(mat):
+    """(E N/cm^2, nu, rho N s^2/cm^4) from the file's GPa and kg/m^3."""
+    return mat["E_GPa"] * 1e9 * PA, mat["nu"], mat["rho_kg_m3"] * KG / 1e6
