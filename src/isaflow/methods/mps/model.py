@@ -205,10 +205,55 @@ def assemble(pos, kind, dirichlet, b, pi, pj, m, re, n0, lam):
 
 
 @njit(**JIT)
-def predict(pos, vel, kind, box, dt, gx, gy, nu, re_n, re_l, n0_n, n0_l, lam, beta, rho0, source, gamma):
+def collide(ps, vs, kind, pi, pj, m, dist, restitution, dt):
+    """Collision model (Koshizuka's MPS sample code; Lee et al. 2011): pairs closer than ``dist`` that
+    approach each other exchange the normal relative velocity with restitution e (equal masses; a
+    wall or dummy particle is immovable), positions moved by dt times the velocity change.  In place."""
+    for k in range(m):
+        i, j = pi[k], pj[k]
+        if kind[i] != FLUID and kind[j] != FLUID:
+            continue
+        dx = ps[j, 0] - ps[i, 0]
+        dy = ps[j, 1] - ps[i, 1]
+        r = np.sqrt(dx * dx + dy * dy)
+        if r >= dist or r == 0.0:
+            continue
+        ex = dx / r
+        ey = dy / r
+        vn = (vs[i, 0] - vs[j, 0]) * ex + (vs[i, 1] - vs[j, 1]) * ey  # > 0: approaching
+        if vn <= 0.0:
+            continue
+        if kind[i] == FLUID and kind[j] == FLUID:
+            dv = 0.5 * (1.0 + restitution) * vn
+            vs[i, 0] -= dv * ex
+            vs[i, 1] -= dv * ey
+            vs[j, 0] += dv * ex
+            vs[j, 1] += dv * ey
+            ps[i, 0] -= dt * dv * ex
+            ps[i, 1] -= dt * dv * ey
+            ps[j, 0] += dt * dv * ex
+            ps[j, 1] += dt * dv * ey
+        elif kind[i] == FLUID:
+            dv = (1.0 + restitution) * vn
+            vs[i, 0] -= dv * ex
+            vs[i, 1] -= dv * ey
+            ps[i, 0] -= dt * dv * ex
+            ps[i, 1] -= dt * dv * ey
+        else:
+            dv = (1.0 + restitution) * vn
+            vs[j, 0] += dv * ex
+            vs[j, 1] += dv * ey
+            ps[j, 0] += dt * dv * ex
+            ps[j, 1] += dt * dv * ey
+
+
+@njit(**JIT)
+def predict(pos, vel, kind, box, dt, gx, gy, nu, re_n, re_l, n0_n, n0_l, lam, beta, rho0, source, gamma,
+            coll_dist=0.0, restitution=0.2):
     """Explicit half of a step (eq. 3) and the pressure equation at the moved positions.
 
-    Fluid: V* = V + dt (nu lap V + g), U* = U + dt V* (walls fixed).  Then at
+    Fluid: V* = V + dt (nu lap V + g), U* = U + dt V* (walls fixed), then the
+    collision model if coll_dist > 0 (cm; see collide).  Then at
     U*: n*, div V*, free surface (n* < beta n0, fluid and wall particles:
     Dirichlet P = 0), source term and the CSR system (see assemble).
     Returns (pos*, vel*, n*, div*, dirichlet, (pi, pj, m) at U*, (row, indptr, indices, data, rhs)).
@@ -224,6 +269,8 @@ def predict(pos, vel, kind, box, dt, gx, gy, nu, re_n, re_l, n0_n, n0_l, lam, be
             ps[i, 0] = pos[i, 0] + dt * vs[i, 0]
             ps[i, 1] = pos[i, 1] + dt * vs[i, 1]
     pi, pj, m = build_pairs(ps, box, re_l)
+    if coll_dist > 0.0:
+        collide(ps, vs, kind, pi, pj, m, coll_dist, restitution, dt)
     n_star = number_density(ps, pi, pj, m, re_n)
     div = divergence(ps, vs, pi, pj, m, re_n, n0_n)
     dirichlet = np.zeros(pos.shape[0], np.bool_)

@@ -76,7 +76,8 @@ def step(s, dt, source, cfg, timers=None):
     t0 = time.perf_counter()
     ps, vs, n_star, div, dirichlet, pi, pj, m, system = model.predict(
         s.pos, s.vel, s.kind, s.grid_box, dt, 0.0, -units.G, cfg["model.kinematic_viscosity"], s.re_n, s.re_l,
-        s.n0_n, s.n0_l, s.lam, cfg["model.beta"], s.rho0, model.SOURCES[source], cfg["model.gamma_mixed"])
+        s.n0_n, s.n0_l, s.lam, cfg["model.beta"], s.rho0, model.SOURCES[source], cfg["model.gamma_mixed"],
+        cfg["model.collision_distance"] * s.l0, cfg["model.restitution"])
     row, indptr, indices, data, rhs = system
     t1 = time.perf_counter()
     A = pressure.csr(indptr, indices, data)
@@ -207,7 +208,8 @@ def solve(tank, cfg, variant, spacing, t_end, probes, start=None, snapshots=0, l
         "pressure_rtol": cfg["pressure.rtol"], "max_solve_residual": max_resid, "mean_solve_iterations": float(np.mean(iters)),
         "rest_speed_cm_s": u_rest, "average_window_s": cfg["time.average_window"], "wall_particles": int(nb[model.WALL]),
         "dummy_particles": int(nb[model.DUMMY]), "time_predict_s": timers[0], "time_solve_s": timers[1],
-        "time_correct_s": timers[2], "collision_model": "none", "settings_file": cfg.path,
+        "time_correct_s": timers[2], "collision_distance_cm": cfg["model.collision_distance"] * l0, "restitution": cfg["model.restitution"], "settings_file": cfg.path,
+        "panel_length": cfg["walls.panel_length"],
     }
     return Result(
         method="mps", variant=variant, pos0=pos0, pos=s.pos[: s.nf].copy(), weight=np.full(s.nf, s.weight),

@@ -1,0 +1,76 @@
+"""MPS figures from run files: wall loads per panel against hydrostatics (Fig. 6-like, with the noise band),
+and the flow (Fig. 10-like snapshots and the final state)."""
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from isaflow import metrics, runfile  # noqa: E402
+from isaflow.methods import registry  # noqa: E402
+
+VARIANTS = registry()["mps"].variants
+
+
+def _save(fig, paths):
+    for p in paths:
+        Path(p).parent.mkdir(parents=True, exist_ok=True)
+        fig.savefig(p, dpi=110, metadata={"CreationDate": None} if str(p).endswith(".pdf") else None)
+    plt.close(fig)
+
+
+def wall_loads(paths, out):
+    """One panel per run: |panel force| [N] along the walls (mean and +- std over the window) vs hydrostatic theory."""
+    n = len(paths)
+    fig, axes = plt.subplots(1, n, figsize=(4.2 * n, 3.6), squeeze=False, sharey=True)
+    for ax, p in zip(axes[0], paths):
+        ds = runfile.read(p)
+        e, (cw, cp, mag, th) = metrics.contact_loads(ds)
+        win = ds["in_window"].values.astype(bool)
+        hist = np.hypot(*np.moveaxis(ds["hist_panel_force"].values[win], -1, 0))
+        k = np.arange(len(mag))
+        v = VARIANTS[ds.attrs["variant"]]
+        ax.errorbar(k, mag, yerr=hist.std(0), fmt=v.marker, color=v.colour, ms=4, capsize=2, label="MPS mean +- std")
+        ax.plot(k, th, "k_", ms=10, mew=2, label="hydrostatic theory")
+        names = [str(x) for x in ds["wall"].values]
+        for w in range(len(names)):
+            on = np.flatnonzero(cw == w)
+            if len(on):
+                ax.text(on.mean(), -0.08, names[w], transform=ax.get_xaxis_transform(), ha="center", fontsize=8)
+        ax.set_title(f"{ds.attrs['variant']}, l0 = {float(ds.attrs['spacing']):.3g} cm\n{ds.attrs['status']}", fontsize=9)
+        ax.set_xlabel("panel (10 cm) along the walls", labelpad=14)
+    axes[0, 0].set_ylabel("wall force per panel |F| [N]")
+    axes[0, 0].legend(fontsize=7, loc="upper left")
+    fig.tight_layout()
+    _save(fig, out)
+
+
+def flow(paths, out):
+    """Rows: runs; columns: position snapshots of the flow [cm] with the walls."""
+    dss = [runfile.read(p) for p in paths]
+    ncol = max(ds.sizes.get("snapshot", 1) for ds in dss)
+    fig, axes = plt.subplots(len(dss), ncol, figsize=(2.6 * ncol, 1.7 * len(dss) + 0.6), squeeze=False)
+    for row, ds in zip(axes, dss):
+        v = VARIANTS[ds.attrs["variant"]]
+        snaps = ds["snap_pos"].values if "snap_pos" in ds else ds["pos"].values[None]
+        times = ds["snap_time"].values if "snap_time" in ds else [float(ds["sim_time"])]
+        for ax, pos, t in zip(row, snaps, times):
+            for w in ds["wall_segment"].values:
+                ax.plot(w[[0, 2]], w[[1, 3]], "k-", lw=1)
+            ax.plot(pos[:, 0], pos[:, 1], ".", color=v.colour, ms=1.5)
+            ax.set_xlim(-10, 310)
+            ax.set_ylim(-60, 110)
+            ax.set_aspect("equal")
+            ax.set_title(f"{ds.attrs['variant']} l0={float(ds.attrs['spacing']):.3g} cm, t={t:.2f} s", fontsize=7)
+            ax.tick_params(labelsize=6)
+        for ax in row[len(snaps):]:
+            ax.axis("off")
+    for ax in axes[-1]:
+        ax.set_xlabel("x [cm]", fontsize=7)
+    for ax in axes[:, 0]:
+        ax.set_ylabel("y [cm]", fontsize=7)
+    fig.tight_layout()
+    _save(fig, out)
