@@ -24,6 +24,21 @@ for _rules in sorted(glob.glob("workflow/rules/methods/*.smk")):
     include: _rules
 
 
+# the paper's own outputs: Figures 5-10, Table 1, the report's single-vessel and
+# flow sections (quick start: snakemake -c2 paper)
+PAPER_TARGETS = [
+    f"figures/{name}.{ext}"
+    for name in ("fig05_inputs_coarse", "fig06_single_coarse", "fig07_inputs_refined", "fig08_single_refined",
+                 "fig09_flow_incomplete", "fig10_flow_complete")
+    for ext in ("png", "pdf")
+] + ["figures/table1.csv", "figures/table1.md", "results/report/10_single.md", "results/report/20_flow.md"]
+
+
+rule paper:
+    input:
+        PAPER_TARGETS,
+
+
 rule all:
     input:
         lambda wc: TARGETS["targets"],

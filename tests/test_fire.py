@@ -1,10 +1,12 @@
-"""FIRE (kernels.relax, variant FIRE) on the paper's coarse single vessel: it reaches
+"""FIRE (methods.isa.relax, variant FIRE) on the paper's coarse single vessel: it reaches
 the same equilibrium criterion as the capped update in far fewer force evaluations.
 Units cm, N."""
 
 from pathlib import Path
 
 import numpy as np
+
+import pytest
 
 from isaflow import cli, metrics, runfile
 
@@ -17,9 +19,15 @@ def run(tmp_path, name, *sets):
     return runfile.read(out)
 
 
-def test_fire_reaches_the_capped_equilibrium_in_far_fewer_steps(tmp_path):
-    capped = run(tmp_path, "capped", "solver.variant=capped")
-    fire = run(tmp_path, "fire", "solver.variant=fire", "solver.du=1.0", "solver.dt_max=0.02")
+@pytest.fixture(scope="module")
+def runs(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("fire")
+    return (run(tmp, "capped", "solver.variant=capped"),
+            run(tmp, "fire", "solver.variant=fire", "solver.du=1.0", "solver.dt_max=0.02"))
+
+
+def test_fire_reaches_the_capped_equilibrium_in_far_fewer_steps(runs):
+    capped, fire = runs
     for ds in (capped, fire):
         assert ds.attrs["status"] == "converged"
         assert np.abs(ds["force"].values).max() < 0.1  # f_tol
@@ -31,3 +39,10 @@ def test_fire_reaches_the_capped_equilibrium_in_far_fewer_steps(tmp_path):
     # (298 steps, 33x; FIRE 2.0 was tried: 278 coarse but 805 refined, so not kept);
     # the paper's update never converges.
     assert int(fire["steps"]) < int(capped["steps"]) / 20
+
+
+@pytest.mark.xfail(strict=True, reason="FIRE needs 298 steps against the capped update's 9,964 (33x), short of "
+                   "the 50x target (benchmarks: error-vs-run-time study, fire_ratio.csv)")
+def test_fire_needs_50_times_fewer_force_evaluations(runs):
+    capped, fire = runs
+    assert int(fire["steps"]) * 50 <= int(capped["steps"])

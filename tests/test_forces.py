@@ -2,14 +2,15 @@
 
 import numpy as np
 import pytest
-from isaflow.methods.isa import forces as F
+
 from isaflow.core import geometry as GEO
 from isaflow.core import neighbours as NB
+from isaflow.methods.isa import forces as F
 from isaflow.methods.isa import relax as R
 
+from conftest import L_B, L_P, R_B, R_P
 
-L_P, R_P = 7.0710678, 3535.5339  # coarse pair law: cm, N
-L_B, R_B = 5.0, 10000.0  # wall law
+
 
 
 def test_single_pair_force_by_hand():

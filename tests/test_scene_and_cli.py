@@ -9,18 +9,9 @@ import yaml
 
 from isaflow import cli, runfile, scene
 
-from conftest import ROOT, SCENES
+from conftest import ROOT, SCENES, TINY
 
-TINY = {
-    "name": "tiny",
-    "walls": [{"name": "left", "from": [0, 20], "to": [0, 0]}, {"name": "floor", "from": [0, 0], "to": [20, 0]},
-              {"name": "right", "from": [20, 0], "to": [20, 20]}],
-    "particles": {"weight": 50.0, "lattice": {"a": 10.0, "rows": 3, "row_lengths": [1, 2], "center_x": 10.0,
-                                              "bottom_y": 5.0}},
-    "forces": {"wall": {"law": "linear", "l_u": 5.0, "r_u": 10000.0},
-               "pair": {"law": "linear", "l_u": 7.0710678, "r_u": 3535.5339}},
-    "solver": {"variant": "capped", "du": 0.01, "f_tol": 0.1, "max_steps": 20000, "history": {"every": 10}},
-}
+TINY = {**TINY, "solver": {**TINY["solver"], "history": {"every": 10}}}
 
 
 def write_scene(tmp_path, spec, name="scene.yaml"):

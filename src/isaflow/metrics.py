@@ -130,6 +130,13 @@ def panel_length(ds):
     return float(ds.attrs.get("panel_length", ds.attrs["spacing"]))
 
 
+def pairs(pos, cutoff):
+    """(i, j) int arrays of the particle pairs closer than cutoff [cm] (shared cell list)."""
+    box = np.array([pos[:, 0].min(), pos[:, 1].min(), pos[:, 0].max() + 1e-9, pos[:, 1].max() + 1e-9])
+    pi, pj, m = NB.build_pairs(pos, box, cutoff)
+    return pi[:m], pj[:m]
+
+
 def stress_ratio(ds, vessel=None):
     """Horizontal-to-vertical stress ratio K = sigma_xx / sigma_yy of the lattice.
 
@@ -144,10 +151,9 @@ def stress_ratio(ds, vessel=None):
     a = ds.attrs
     (x0, x1), y0 = v["x_range"], v["floor_y"]
     h = theory.free_surface_level(pos, float(a["spacing"]), v["x_range"]) - y0
-    box = np.array([pos[:, 0].min(), pos[:, 1].min(), pos[:, 0].max() + 1e-9, pos[:, 1].max() + 1e-9])
-    pi, pj, m = NB.build_pairs(pos, box, float(a["pair_l_u"]))
-    d = pos[pi[:m]] - pos[pj[:m]]
-    mid = 0.5 * (pos[pi[:m]] + pos[pj[:m]])
+    pi, pj = pairs(pos, float(a["pair_l_u"]))
+    d = pos[pi] - pos[pj]
+    mid = 0.5 * (pos[pi] + pos[pj])
     sel = ((mid[:, 0] > x0 + 0.2 * (x1 - x0)) & (mid[:, 0] < x1 - 0.2 * (x1 - x0))
            & (mid[:, 1] > y0 + 0.1 * h) & (mid[:, 1] < y0 + 0.6 * h))
     dist = np.hypot(d[sel, 0], d[sel, 1])
@@ -315,10 +321,9 @@ def law_usage(ds):
     mag = np.hypot(*ds["contact_force"].values.T)
     out["wall_use"] = float(mag.max() / a["wall_r_u"]) if len(mag) else 0.0
     l_u = float(a["pair_l_u"])
-    box = np.array([pos[:, 0].min(), pos[:, 1].min(), pos[:, 0].max() + 1e-9, pos[:, 1].max() + 1e-9])
-    pi, pj, m = NB.build_pairs(pos, box, l_u)
-    if m:
-        d = np.hypot(*(pos[pi[:m]] - pos[pj[:m]]).T)
+    pi, pj = pairs(pos, l_u)
+    if len(pi):
+        d = np.hypot(*(pos[pi] - pos[pj]).T)
         out["min_pair_cm"] = float(d.min())
         out["pair_use"] = float(1.0 - d.min() / l_u)
     else:

@@ -106,9 +106,14 @@ def run_files(runs, group, **match):
             if m["group"] == group and all(m.get(k) == v for k, v in match.items())]
 
 
+def set_args(sets):
+    """``--set 'key=value' ...`` arguments of ``isaflow run`` for scene overrides, quoted for the shell."""
+    return " ".join(f"--set '{s}'" for s in sets)
+
+
 def cli_overrides(runs, sid):
-    """The --set arguments of one planned run, quoted for the shell."""
-    return " ".join(f"--set '{s}'" for s in runs[sid]["set"])
+    """The --set arguments of one planned run."""
+    return set_args(runs[sid]["set"])
 
 
 def meta(runs):

@@ -3,21 +3,20 @@
 Units: length cm, force N.  A scene error names the file and the field.
 """
 
-import copy
 import hashlib
 import json
 from dataclasses import dataclass, field
 from importlib import resources
 from pathlib import Path
 
-import jsonschema
 import numpy as np
-import yaml
+
+from . import inputs
+from .inputs import InputError
 
 SCHEMA = json.loads(resources.files("isaflow").joinpath("scene.schema.json").read_text())
 
-class SceneError(ValueError):
-    """Invalid scene: message names the file and the offending field."""
+SceneError = InputError  # invalid scene, tank or settings: the message names the file and the field
 
 
 @dataclass
@@ -28,6 +27,7 @@ class Scene:
     spec: dict
     text: str
     overrides: list = field(default_factory=list)
+    pos0: np.ndarray = None  # (N, 2) cm initial positions of a lattice or points scene, built once at load
 
     @property
     def name(self):
@@ -91,6 +91,8 @@ def _set(spec, dotted, value, path):
         if not isinstance(node, dict) or k not in node:
             raise SceneError(f"{path}: override '{dotted}': no field '{k}'")
         node = node[k]
+    if not isinstance(node, dict):
+        raise SceneError(f"{path}: override '{dotted}': field '{'.'.join(keys[:-1])}' is not a mapping")
     node[keys[-1]] = value
 
 
@@ -101,22 +103,17 @@ def load(path, overrides=()):
     'forces.pair.r_u=1000'.  Raises SceneError naming the file and field.
     """
     path = str(path)
-    try:
-        text = Path(path).read_text()
-        spec = yaml.safe_load(text)
-    except (OSError, yaml.YAMLError) as err:
-        raise SceneError(f"{path}: cannot read scene: {err}") from None
-    spec = copy.deepcopy(spec)
+    text, spec = inputs.read_yaml(path, "scene")
     for item in overrides:
         if "=" not in item:
             raise SceneError(f"{path}: override '{item}' is not of the form key=value")
         key, value = item.split("=", 1)
-        _set(spec, key.strip(), yaml.safe_load(value), path)
-    errors = sorted(jsonschema.Draft202012Validator(SCHEMA).iter_errors(spec), key=lambda e: list(e.path))
-    if errors:
-        e = errors[0]
-        where = ".".join(str(p) for p in e.absolute_path) or "(top level)"
-        raise SceneError(f"{path}: field '{where}': {e.message}")
+        try:
+            parsed = inputs.parse_yaml(value)
+        except InputError as err:
+            raise SceneError(f"{path}: override '{item}': {err}") from None
+        _set(spec, key.strip(), parsed, path)
+    inputs.validate(spec, SCHEMA, path)
     scene = Scene(path, spec, text, list(overrides))
     _check_geometry(scene)
     return scene
@@ -136,7 +133,7 @@ def _check_geometry(scene):
     part = scene.spec["particles"]
     if "from_run" in part:
         return
-    pos = initial_positions(scene)
+    pos = scene.pos0 = initial_positions(scene)
     if not np.isfinite(pos).all():
         raise SceneError(f"{path}: field 'particles': positions must be finite")
     lo, hi = walls.reshape(-1, 2).min(0), walls.reshape(-1, 2).max(0)
@@ -169,7 +166,7 @@ def initial_state(scene):
         if ((pos < lo) | (pos > hi)).any():
             raise SceneError(f"{scene.path}: field 'particles.from_run': particles of '{src}' lie outside the walls")
         return pos, ds["weight"].values, int(ds["steps"]), float(ds.attrs["spacing"])
-    pos = initial_positions(scene)
+    pos = scene.pos0 if scene.pos0 is not None else initial_positions(scene)
     return pos, np.full(len(pos), float(part["weight"])), 0, scene.spacing or np.nan
 
 
@@ -216,16 +213,7 @@ class Tank:
 def load_tank(path):
     """Read and validate a tank file; raises SceneError naming the file and field."""
     path = str(path)
-    try:
-        text = Path(path).read_text()
-        spec = yaml.safe_load(text)
-    except (OSError, UnicodeDecodeError, yaml.YAMLError) as err:
-        raise SceneError(f"{path}: cannot read tank: {err}") from None
-    errors = sorted(jsonschema.Draft202012Validator(TANK_SCHEMA).iter_errors(spec), key=lambda e: list(e.path))
-    if errors:
-        e = errors[0]
-        where = ".".join(str(p) for p in e.absolute_path) or "(top level)"
-        raise SceneError(f"{path}: field '{where}': {e.message}")
+    text, spec = inputs.load(path, TANK_SCHEMA, "tank")
     tank = Tank(path, spec, text)
     if not np.isfinite(tank.walls).all():
         raise SceneError(f"{path}: field 'walls': coordinates must be finite")

@@ -40,7 +40,7 @@ def table1(rows, run_files, benchmark_files):
             "ours_du_mm": float(last.attrs["du"]) * 10.0,
             "ours_steps": int(last["steps"]),
             "ours_status": last.attrs["status"],
-            "ours_residual": round(float(last["residual"]), 4),
+            "ours_max_force_N": round(float(last["residual"]), 4),
             "ours_solver_s": round(solver_s, 3),
             "ours_job_s": round(job_s, 2),
             "speedup_solver": round(r["time_s"] / solver_s, 0),

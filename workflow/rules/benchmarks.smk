@@ -35,24 +35,4 @@ rule bench_output:
         "python {input.script} > {log} 2>&1"
 
 
-rule report_speed:
-    input:
-        step_cost="benchmarks/results/step_cost.csv",
-        compile="benchmarks/results/compile.csv",
-        memory="benchmarks/results/memory.csv",
-        machine="benchmarks/results/machine.txt",
-        output_cost="benchmarks/results/output_cost.csv",
-        table1="figures/table1.csv",
-        code=code("report/__init__", "report/speed"),
-    output:
-        "results/report/40_speed.md",
-    params:
-        func="report.speed.speed_section",
-    log:
-        "logs/report/speed.log",
-    script:
-        "../scripts/call.py"
-
-
-register(report=["results/report/40_speed.md"])
 register(targets=["benchmarks/results/output_cost.csv"])

@@ -3,6 +3,9 @@ import glob
 
 from snakemake.utils import validate
 
+from isaflow.plan import set_args
+from isaflow.scene import load as load_scene
+
 validate(config, "../schemas/config.schema.yaml")
 
 RUNS = config["runs"]
@@ -43,28 +46,14 @@ def run_file(run):
 
 
 def run_overrides(wildcards):
-    return " ".join(f"--set '{s}'" for s in RUNS[wildcards.run].get("set", []))
+    return set_args(RUNS[wildcards.run].get("set", []))
 
 
 def start_file(run):
     """The run file a run continues from (particles.from_run, after overrides), if any."""
-    import yaml
-
-    for item in RUNS[run].get("set", []):
-        if item.startswith("particles.from_run="):
-            return [item.split("=", 1)[1]]
-    with open(RUNS[run]["scene"]) as fh:
-        src = yaml.safe_load(fh).get("particles", {}).get("from_run")
+    spec = load_scene(RUNS[run]["scene"], RUNS[run].get("set", [])).spec
+    src = spec["particles"].get("from_run")
     return [src] if src else []
-
-
-def scene_law(scene_path, which):
-    """(l_u cm, r_u N) of a scene's 'wall' or 'pair' force law."""
-    import yaml
-
-    with open(scene_path) as fh:
-        law = yaml.safe_load(fh)["forces"][which]
-    return law["l_u"], law["r_u"]
 
 
 # runs whose metrics go into results/metrics.csv
@@ -76,16 +65,16 @@ CAL = config["calibration"]
 
 def calibration_overrides(wc):
     """Scene overrides of one calibration point: k_b = kb, k_p = ratio kb."""
-    scene = RUNS[wc.run]["scene"]
-    wl_u, _ = scene_law(scene, "wall")
-    pl_u, _ = scene_law(scene, "pair")
+    scene = load_scene(RUNS[wc.run]["scene"])
+    wall_l_u, _ = scene.law("wall")
+    pair_l_u, _ = scene.law("pair")
     kb, ratio = float(wc.kb), float(wc.ratio)
     sets = [
-        f"forces.wall.r_u={kb * wl_u}",
-        f"forces.pair.r_u={kb * ratio * pl_u}",
+        f"forces.wall.r_u={kb * wall_l_u}",
+        f"forces.pair.r_u={kb * ratio * pair_l_u}",
         f"solver.variant={CAL['variant']}",
         f"solver.max_steps={CAL['max_steps']}",
         "solver.accept=[converged,cycle,step_limit]",
         "solver.history={}",
     ]
-    return " ".join(f"--set '{s}'" for s in sets)
+    return set_args(sets)

@@ -55,22 +55,7 @@ rule table1:
         "../scripts/call.py"
 
 
-rule report_flow:
-    input:
-        metrics="results/metrics.csv",
-        table1="figures/table1.csv",
-        config="config/config.yaml",
-        code=code("report/__init__", "report/flow"),
-    output:
-        "results/report/20_flow.md",
-    params:
-        func="report.flow.flow_section",
-    log:
-        "logs/report/flow.log",
-    script:
-        "../scripts/call.py"
 
 
-register(report=["results/report/20_flow.md"])
 register(targets=figure("fig09_flow_incomplete") + figure("fig10_flow_complete") + figure("flow_history"))
 register(targets=["figures/table1.csv", "figures/table1.md"])

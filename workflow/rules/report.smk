@@ -1,4 +1,4 @@
-# Metrics table and docs/replication.md, regenerated from the run files.
+# Metrics table, every report fragment of the paper's workflow, and docs/replication.md.
 # Each part writes a fragment results/report/NN_part.md (register(report=...)).
 
 
@@ -47,7 +47,45 @@ rule report_inferred:
         "../scripts/call.py"
 
 
-register(report=["results/report/10_single.md", "results/report/90_inferred.md"])
+rule report_flow:
+    input:
+        metrics="results/metrics.csv",
+        table1="figures/table1.csv",
+        config="config/config.yaml",
+        code=code("report/__init__", "report/flow"),
+    output:
+        "results/report/20_flow.md",
+    params:
+        func="report.flow.flow_section",
+    log:
+        "logs/report/flow.log",
+    script:
+        "../scripts/call.py"
+
+
+
+
+rule report_speed:
+    input:
+        step_cost="benchmarks/results/step_cost.csv",
+        compile="benchmarks/results/compile.csv",
+        memory="benchmarks/results/memory.csv",
+        machine="benchmarks/results/machine.txt",
+        output_cost="benchmarks/results/output_cost.csv",
+        table1="figures/table1.csv",
+        code=code("report/__init__", "report/speed"),
+    output:
+        "results/report/40_speed.md",
+    params:
+        func="report.speed.speed_section",
+    log:
+        "logs/report/speed.log",
+    script:
+        "../scripts/call.py"
+
+
+REPORT_PAPER = ["10_single", "20_flow", "40_speed", "90_inferred"]
+register(report=[f"results/report/{part}.md" for part in REPORT_PAPER])
 
 
 rule replication_report:

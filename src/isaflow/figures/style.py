@@ -34,7 +34,9 @@ def save(fig, outputs):
     """Write fig to every output path (PNG, PDF), creating folders."""
     for out in outputs:
         Path(out).parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(out, bbox_inches="tight")
+        # no creation date in PDFs: two runs of the same commit give the same bytes
+        meta = {"CreationDate": None} if str(out).endswith(".pdf") else {}
+        fig.savefig(out, bbox_inches="tight", metadata=meta)
     plt.close(fig)
 
 
