@@ -1,0 +1,23 @@
+"""Weakly compressible SPH (issue 10): the liquid of marko2017 section 2 on the project's tanks.
+
+Modules: ``kernels`` (numba pair passes and the compiled leapfrog loop),
+``particles`` (liquid lattice, wall particles, wall contacts), ``settings``
+(config/methods/sph.yaml and its schema), ``solver`` (chunks, rest test,
+outcome -> contract.Result), ``analysis`` (measures, summary, claims, report),
+``figures``, ``workflow`` (what the Snakemake rules call).
+"""
+
+from .. import Method, Variant
+
+METHOD = Method(
+    name="sph",
+    label="weakly compressible SPH",
+    paper="marko2017_lagrangian_solid_sph",
+    variants={
+        "wcsph": Variant("wcsph", "WCSPH: marko2017 eqs. 4, 6, 9 + Tait EOS, artificial viscosity, Adami walls "
+                                  "(completions from literature)", "tab:orange", "D"),
+        "delta_wc2": Variant("delta_wc2", "delta-SPH, Wendland C2: continuity density + density diffusion "
+                                          "(variant, not marko2017)", "tab:red", "v"),
+    },
+    solver="isaflow.methods.sph.solver:solve",
+)

@@ -1,0 +1,341 @@
+"""Weakly compressible SPH kernels (numba): pair passes and the whole step loop.
+
+Arrays (units cm, N, s; masses N s^2/cm, densities N s^2/cm^4, pressures N/cm^2):
+- x (n, 2): positions, rows 0..nf-1 liquid particles, rows nf..n-1 wall
+  (boundary) particles, which never move;
+- v (nf, 2) velocities; rho (n,) densities; p (n,) pressures;
+- pairs (pi, pj, m): half list of core.neighbours.build_pairs over all
+  particles within rc = 2 h + skin, wall-wall pairs dropped, pi < pj (so pi
+  is always liquid and pj >= nf marks a wall particle);
+- par (NPAR,) float64 settings, indices below (see :func:`pack`).
+
+Equations: marko2017 eq. 6 (density summation) or the continuity equation,
+eq. 9 in its symmetric form -sum_b m_b (P_a/rho_a^2 + P_b/rho_b^2) grad_a W_ab,
+Tait or linear equation of state, Monaghan (1992) artificial viscosity, Adami,
+Hu & Adams (2012) wall pressure, optional density diffusion (Molteni &
+Colagrossi 2009, hydrostatic part removed as Fourtakas et al. 2019).
+"""
+
+import numpy as np
+from numba import njit
+
+from ...core.geometry import crossed_wall
+from ...core.neighbours import build_pairs
+from ...core.smoothing import dw as kernel_dw
+from ...core.smoothing import w as kernel_w
+
+JIT = dict(cache=True, nogil=True)
+
+# indices into par
+(H, MASS, RHO0, C0, GAMMA, ALPHA, DELTA, GRAV, DT, SKIN, KERNEL, NORM, TAIT, CLAMP, SUMMATION,
+ WALL_VISC, LJ_D, LJ_R0, NPAR) = range(19)
+# return codes of advance()
+OK, CROSSED, LEFT_BOX, NONFINITE = range(4)
+
+
+@njit(inline="always", **JIT)
+def pressure_of(rho, rho0, c0, gamma, tait, clamp):
+    """Equation of state P(rho) [N/cm^2]: Tait B((rho/rho0)^gamma - 1), B = rho0 c0^2/gamma, or linear."""
+    if tait:
+        p = rho0 * c0 * c0 / gamma * ((rho / rho0) ** gamma - 1.0)
+    else:
+        p = c0 * c0 * (rho - rho0)
+    if clamp and p < 0.0:
+        p = 0.0
+    return p
+
+
+@njit(inline="always", **JIT)
+def density_of(p, rho0, c0, gamma, tait):
+    """Inverse equation of state rho(P) [N s^2/cm^4]."""
+    if tait:
+        return rho0 * max(1.0 + p * gamma / (rho0 * c0 * c0), 1e-6) ** (1.0 / gamma)
+    return rho0 + p / (c0 * c0)
+
+
+@njit(**JIT)
+def list_pairs(x, nf, box, rc):
+    """Pair list over all particles within rc, wall-wall pairs dropped, pi < pj."""
+    pi, pj, m = build_pairs(x, box, rc)
+    k = 0
+    for q in range(m):
+        a = pi[q]
+        b = pj[q]
+        if a > b:
+            a, b = b, a
+        if a < nf:
+            pi[k] = a
+            pj[k] = b
+            k += 1
+    return pi, pj, k
+
+
+@njit(**JIT)
+def kernel_pass(x, pi, pj, m, par, wk, fk):
+    """Per pair: wk = W(r) [1/cm^2] and fk = (dW/dr)/r [1/cm^4] (0 beyond 2h), so grad_a W = fk (x_a - x_b)."""
+    h = par[H]
+    kind = int(par[KERNEL])
+    c = par[NORM] / (h * h)
+    for k in range(m):
+        a = pi[k]
+        b = pj[k]
+        dx = x[a, 0] - x[b, 0]
+        dy = x[a, 1] - x[b, 1]
+        r = np.sqrt(dx * dx + dy * dy)
+        q = r / h
+        if q >= 2.0:
+            wk[k] = 0.0
+            fk[k] = 0.0
+        else:
+            wk[k] = c * kernel_w(kind, q)
+            fk[k] = c * kernel_dw(kind, q) / (h * r) if r > 0.0 else 0.0
+
+
+@njit(**JIT)
+def sum_density(rho, nf, pi, pj, m, wk, par):
+    """rho[:nf] = sum_b m_b W_ab over liquid and wall particles, self included (marko2017 eq. 6)."""
+    mass, h = par[MASS], par[H]
+    w0 = mass * par[NORM] / (h * h) * kernel_w(int(par[KERNEL]), 0.0)
+    for a in range(nf):
+        rho[a] = w0
+    for k in range(m):
+        a = pi[k]
+        b = pj[k]
+        rho[a] += mass * wk[k]
+        if b < nf:
+            rho[b] += mass * wk[k]
+
+
+@njit(**JIT)
+def density_rate(x, v, rho, nf, pi, pj, m, fk, par, drho):
+    """drho (nf,) = continuity sum_b m_b v_ab . grad_a W_ab (walls at rest) plus, with delta > 0,
+    the density diffusion delta h c0 sum_b V_b psi_ab . grad_a W_ab among liquid particles, its
+    hydrostatic part rho0 g (y_a - y_b) / c0^2 removed.  Uses the cached fk of the pairs."""
+    mass, h, c0, rho0, g, delta = par[MASS], par[H], par[C0], par[RHO0], par[GRAV], par[DELTA]
+    drho[:nf] = 0.0
+    for k in range(m):
+        f = fk[k]
+        if f == 0.0:
+            continue
+        a = pi[k]
+        b = pj[k]
+        dx = x[a, 0] - x[b, 0]
+        dy = x[a, 1] - x[b, 1]
+        if b >= nf:
+            drho[a] += mass * f * (v[a, 0] * dx + v[a, 1] * dy)
+            continue
+        dd = mass * f * ((v[a, 0] - v[b, 0]) * dx + (v[a, 1] - v[b, 1]) * dy)
+        drho[a] += dd
+        drho[b] += dd
+        if delta > 0.0:
+            d = (rho[b] - rho[a]) - rho0 * g * dy / (c0 * c0)
+            t = -2.0 * delta * h * c0 * mass * d * f
+            drho[a] += t / rho[b]
+            drho[b] -= t / rho[a]
+
+
+@njit(**JIT)
+def forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum):
+    """Pressures (liquid: equation of state; walls: Adami et al. 2012 eq. 27) and accelerations.
+
+    rho[:nf] is read; rho[nf:] and p are overwritten.  acc (nf, 2) cm/s^2
+    includes gravity; wall_force (nw, 2) N: force of each wall particle on the
+    liquid; wsum (nw, 3) scratch.  Every pair force is applied with opposite
+    signs to both particles (eq. 9 in its symmetric form).
+    """
+    mass, rho0, c0, gamma = par[MASS], par[RHO0], par[C0], par[GAMMA]
+    h, g = par[H], par[GRAV]
+    tait, clamp = par[TAIT] > 0, par[CLAMP] > 0
+    for a in range(nf):
+        p[a] = pressure_of(rho[a], rho0, c0, gamma, tait, clamp)
+    # walls at rest: p_w = (sum_f p_f W_wf + g . sum_f rho_f r_wf W_wf) / sum_f W_wf
+    wsum[:] = 0.0
+    for k in range(m):
+        b = pj[k]
+        if b >= nf and wk[k] > 0.0:
+            a = pi[k]
+            q = b - nf
+            wsum[q, 0] += wk[k]
+            wsum[q, 1] += p[a] * wk[k]
+            wsum[q, 2] += rho[a] * (-g) * (x[b, 1] - x[a, 1]) * wk[k]
+    for q in range(wsum.shape[0]):
+        pw = 0.0
+        if wsum[q, 0] > 0.0:
+            pw = (wsum[q, 1] + wsum[q, 2]) / wsum[q, 0]
+        if clamp and pw < 0.0:
+            pw = 0.0
+        p[nf + q] = pw
+        rho[nf + q] = density_of(pw, rho0, c0, gamma, tait)
+    alpha = par[ALPHA]
+    wall_visc = par[WALL_VISC] > 0
+    eps2 = 0.01 * h * h
+    for a in range(nf):
+        acc[a, 0] = 0.0
+        acc[a, 1] = -g
+    wall_force[:] = 0.0
+    for k in range(m):
+        f = fk[k]
+        if f == 0.0:
+            continue
+        a = pi[k]
+        b = pj[k]
+        dx = x[a, 0] - x[b, 0]
+        dy = x[a, 1] - x[b, 1]
+        wall = b >= nf
+        if wall:
+            dvx = v[a, 0]
+            dvy = v[a, 1]
+        else:
+            dvx = v[a, 0] - v[b, 0]
+            dvy = v[a, 1] - v[b, 1]
+        ra = rho[a]
+        rb = rho[b]
+        s = p[a] / (ra * ra) + p[b] / (rb * rb)
+        vr = dvx * dx + dvy * dy
+        if vr < 0.0 and alpha > 0.0 and (wall_visc or not wall):
+            mu = h * vr / (dx * dx + dy * dy + eps2)
+            s += -alpha * c0 * mu / (0.5 * (ra + rb))
+        s *= mass * f
+        ax = -s * dx
+        ay = -s * dy
+        acc[a, 0] += ax
+        acc[a, 1] += ay
+        if wall:
+            wall_force[b - nf, 0] += mass * ax
+            wall_force[b - nf, 1] += mass * ay
+        else:
+            acc[b, 0] -= ax
+            acc[b, 1] -= ay
+
+
+@njit(**JIT)
+def evaluate(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum):
+    """Kernels, densities (summed, eq. 6, or rho[:nf] as given) and forces of a state (see forces)."""
+    kernel_pass(x, pi, pj, m, par, wk, fk)
+    if par[SUMMATION] > 0:
+        sum_density(rho, nf, pi, pj, m, wk, par)
+    forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum)
+
+
+@njit(**JIT)
+def wall_repulsion(x, nf, walls, panel0, npanel, par, acc, panel_force):
+    """Lennard-Jones wall repulsion (marko2017 eq. 7, Monaghan 1994: M = 12, N = 4) as a safety net.
+
+    A liquid particle closer than r0 = par[LJ_R0] to a wall segment gets
+    D ((r0/d)^12 - (r0/d)^4) / d [cm/s^2] along the wall's normal through it
+    (D = par[LJ_D], cm^2/s^2).  The force of the wall on the liquid is added to
+    panel_force[panel0[w] + k] (N) for the panel k of the wall's npanel[w] equal panels.
+    """
+    r0 = par[LJ_R0]
+    if r0 <= 0.0:
+        return
+    D = par[LJ_D]
+    mass = par[MASS]
+    for a in range(nf):
+        px = x[a, 0]
+        py = x[a, 1]
+        for w in range(walls.shape[0]):
+            ex = walls[w, 2] - walls[w, 0]
+            ey = walls[w, 3] - walls[w, 1]
+            L2 = ex * ex + ey * ey
+            t = ((px - walls[w, 0]) * ex + (py - walls[w, 1]) * ey) / L2
+            t = min(1.0, max(0.0, t))
+            dx = px - (walls[w, 0] + t * ex)
+            dy = py - (walls[w, 1] + t * ey)
+            d = np.sqrt(dx * dx + dy * dy)
+            if d >= r0 or d == 0.0:
+                continue
+            q4 = (r0 / d) ** 4
+            f = D * (q4 * q4 * q4 - q4) / (d * d)
+            acc[a, 0] += f * dx
+            acc[a, 1] += f * dy
+            k = panel0[w] + min(npanel[w] - 1, int(t * npanel[w]))
+            panel_force[k, 0] += mass * f * dx
+            panel_force[k, 1] += mass * f * dy
+
+
+@njit(**JIT)
+def advance(x, v, rho, p, nf, walls, box, grid_box, par, n_steps, xref, pi, pj, m, wk, fk, acc,
+            wall_force, wsum, force_sum, panel0, npanel, panel_sum, diag):
+    """Velocity Verlet (kick-drift-kick) for n_steps steps; acc must hold the current state's.
+
+    Summed density: a function of the positions.  Continuity density: a
+    position-like variable, rho_{n+1} = rho_n + dt/2 (D(x_n) + D(x_{n+1})) with
+    both rates D taken at the half-step velocities (trapezoidal drift), so the
+    pressure is never a half step behind the positions.  Rebuilds the pair
+    list (cells over grid_box) when a particle has moved more than skin / 2
+    since the last build (xref).  Stops early if a particle crosses a wall,
+    leaves box (the walls' bounding box), or a value is not finite.
+    force_sum (nw, 2) += wall_force every step; panel_sum (P, 2) += the
+    wall_repulsion forces on the panels (panel0, npanel per wall).  diag (4,) out: max over the
+    steps of the rms speed [cm/s], final kinetic energy [N cm], list builds,
+    offending particle (or -1).  Returns (code, steps done, pi, pj, m, wk, fk).
+    """
+    dt = par[DT]
+    half = 0.5 * dt
+    lim2 = (0.5 * par[SKIN]) ** 2
+    rc = 2.0 * par[H] + par[SKIN]
+    summation = par[SUMMATION] > 0
+    mass = par[MASS]
+    rate0 = np.zeros(nf)
+    rate1 = np.zeros(nf)
+    rho_n = np.zeros(nf)
+    diag[0] = 0.0
+    diag[2] = 0.0
+    diag[3] = -1.0
+    for step in range(n_steps):
+        for a in range(nf):
+            v[a, 0] += half * acc[a, 0]
+            v[a, 1] += half * acc[a, 1]
+        if not summation:
+            density_rate(x, v, rho, nf, pi, pj, m, fk, par, rate0)
+            rho_n[:] = rho[:nf]
+        moved2 = 0.0
+        for a in range(nf):
+            x0 = x[a, 0]
+            y0 = x[a, 1]
+            x1 = x0 + dt * v[a, 0]
+            y1 = y0 + dt * v[a, 1]
+            if not (np.isfinite(x1) and np.isfinite(y1)):
+                diag[3] = a
+                return NONFINITE, step, pi, pj, m, wk, fk
+            if crossed_wall(x0, y0, x1, y1, walls) >= 0:
+                diag[3] = a
+                return CROSSED, step, pi, pj, m, wk, fk
+            if x1 < box[0] or x1 > box[2] or y1 < box[1] or y1 > box[3]:
+                diag[3] = a
+                return LEFT_BOX, step, pi, pj, m, wk, fk
+            x[a, 0] = x1
+            x[a, 1] = y1
+            ddx = x1 - xref[a, 0]
+            ddy = y1 - xref[a, 1]
+            moved2 = max(moved2, ddx * ddx + ddy * ddy)
+        if moved2 > lim2:
+            pi, pj, m = list_pairs(x, nf, grid_box, rc)
+            if wk.shape[0] < m:
+                wk = np.empty(pi.shape[0])
+                fk = np.empty(pi.shape[0])
+            xref[:nf] = x[:nf]
+            diag[2] += 1.0
+        kernel_pass(x, pi, pj, m, par, wk, fk)
+        if summation:
+            sum_density(rho, nf, pi, pj, m, wk, par)
+        else:
+            density_rate(x, v, rho, nf, pi, pj, m, fk, par, rate1)
+            for a in range(nf):
+                rho[a] = rho_n[a] + half * (rate0[a] + rate1[a])
+        forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum)
+        wall_repulsion(x, nf, walls, panel0, npanel, par, acc, panel_sum)
+        v2 = 0.0
+        for a in range(nf):
+            v[a, 0] += half * acc[a, 0]
+            v[a, 1] += half * acc[a, 1]
+            v2 += v[a, 0] * v[a, 0] + v[a, 1] * v[a, 1]
+        if not np.isfinite(v2):
+            return NONFINITE, step + 1, pi, pj, m, wk, fk
+        diag[0] = max(diag[0], np.sqrt(v2 / nf))
+        diag[1] = 0.5 * mass * v2
+        for q in range(force_sum.shape[0]):
+            force_sum[q, 0] += wall_force[q, 0]
+            force_sum[q, 1] += wall_force[q, 1]
+    return OK, n_steps, pi, pj, m, wk, fk

@@ -1,0 +1,188 @@
+"""Initial liquid lattice and wall (boundary) particles of a tank (NumPy, setup only).
+
+Units cm.  The liquid fills the first vessel to the tank's depth on a
+rectangular lattice of nx x ny cells (dx, dy) = (B / nx, depth / ny), one
+particle per cell centre, so the cells tile the liquid exactly and every
+particle weighs W / (nx ny).  Wall particles continue that lattice behind
+each wall (Adami et al. 2012: layers of fixed particles covering the kernel
+support), anchored to the liquid lattice's origin so that a straight wall
+sees the same lattice on both sides.
+"""
+
+import numpy as np
+
+from ...core.neighbours import build_pairs
+
+
+def lattice_shape(width, depth, particles=None, spacing=None):
+    """(nx, ny): cells across the width and the depth [cm] for a target particle
+    count or a target spacing [cm] (cells as close to square as the counts allow)."""
+    if spacing is None:
+        spacing = np.sqrt(width * depth / particles)
+    return max(1, int(round(width / spacing))), max(1, int(round(depth / spacing)))
+
+
+def liquid_lattice(x0, floor_y, width, depth, nx, ny):
+    """(nx ny, 2) cell centres [cm], row by row from the floor; and (dx, dy) [cm]."""
+    dx, dy = width / nx, depth / ny
+    gx, gy = np.meshgrid(x0 + (np.arange(nx) + 0.5) * dx, floor_y + (np.arange(ny) + 0.5) * dy)
+    return np.column_stack([gx.ravel(), gy.ravel()]), (dx, dy)
+
+
+def hydrostatic_heights(y, floor_y, depth, rho_ratio):
+    """Heights [cm] of liquid at undisturbed heights y once compressed to the
+    hydrostatic density: y' = floor + integral_0^(y - floor) dz / r(z), with
+    r(z) = rho / rho_ref at depth (depth - z) (rho_ratio: callable of depth [cm])."""
+    z = np.linspace(0.0, depth, 2001)
+    inv = 1.0 / rho_ratio(depth - z)
+    cum = np.concatenate([[0.0], np.cumsum(0.5 * (inv[1:] + inv[:-1]) * np.diff(z))])
+    return floor_y + np.interp(y - floor_y, z, cum)
+
+
+def _closest(px, py, seg):
+    """(distance, t in [0, 1], side) of points to a segment; side > 0 on its left (liquid side)."""
+    x0, y0, x1, y1 = seg
+    ex, ey = x1 - x0, y1 - y0
+    L2 = ex * ex + ey * ey
+    t = np.clip(((px - x0) * ex + (py - y0) * ey) / L2, 0.0, 1.0)
+    d = np.hypot(px - (x0 + t * ex), py - (y0 + t * ey))
+    side = ex * (py - y0) - ey * (px - x0)
+    return d, t, side
+
+
+def joints(walls):
+    """{(wall, end): other wall} for wall ends shared with another wall (end 0 start, 1 end)."""
+    out = {}
+    for a, sa in enumerate(walls):
+        for b, sb in enumerate(walls):
+            if a != b and np.allclose(sa[2:], sb[:2]):
+                out[a, 1] = b
+                out[b, 0] = a
+    return out
+
+
+def is_solid(px, py, walls):
+    """(P,) bool: the point lies behind the walls (not on the liquid side).
+
+    Decided by the nearest wall: behind it if the nearest point is inside the
+    segment; at a joint of walls A -> B, behind both (a right turn, the liquid
+    wraps round the corner) or behind either (a left turn); at a free wall end
+    the point is not solid (no caps round open ends).
+    """
+    walls = np.asarray(walls, float)
+    res = [_closest(px, py, s) for s in walls]
+    d = np.array([r[0] for r in res])
+    near = np.argmin(d, axis=0)
+    jt = joints(walls)
+    out = np.zeros(len(px), bool)
+    for i in range(len(px)):
+        w = near[i]
+        t, side = res[w][1][i], res[w][2][i]
+        if 0.0 < t < 1.0:
+            out[i] = side < 0
+            continue
+        end = int(t >= 1.0)
+        other = jt.get((w, end))
+        if other is None:
+            continue
+        a, b = (w, other) if end == 1 else (other, w)
+        ea, eb = walls[a, 2:] - walls[a, :2], walls[b, 2:] - walls[b, :2]
+        turn = ea[0] * eb[1] - ea[1] * eb[0]
+        sa, sb = res[a][2][i] < 0, res[b][2][i] < 0
+        out[i] = (sa and sb) if turn < 0 else (sa or sb)
+    return out
+
+
+def wall_particles(walls, dx, dy, support, origin=(0.0, 0.0)):
+    """Wall particles behind every wall, covering `support` [cm] (the kernel's 2 h).
+
+    Each wall gets layers (k - 1/2) d_n behind it (d_n = dy for horizontal,
+    dx for vertical walls, sqrt(dx dy) otherwise), points d_t apart along it in
+    the phase of the lattice through `origin`; at joints the layers run on
+    past the end to fill the corner, kept where behind the walls (is_solid).
+    Points closer than half a spacing to an earlier one are dropped.
+    Returns (pos (P, 2) cm, wall (P,) int: the wall each belongs to).
+    """
+    walls = np.asarray(walls, float)
+    jt = joints(walls)
+    pts, owner, extra = [], [], []
+    for w, (x0, y0, x1, y1) in enumerate(walls):
+        ex, ey = x1 - x0, y1 - y0
+        L = np.hypot(ex, ey)
+        tx, ty = ex / L, ey / L
+        nx_, ny_ = ty, -tx  # back (right-hand) normal
+        if abs(ty) < 1e-12:
+            d_t, d_n = dx, dy
+        elif abs(tx) < 1e-12:
+            d_t, d_n = dy, dx
+        else:
+            d_t = d_n = np.sqrt(dx * dy)
+        layers = int(np.ceil(support / d_n))
+        s_org = (origin[0] - x0) * tx + (origin[1] - y0) * ty  # lattice phase along the wall
+        n_ext = int(np.ceil(support / d_t))
+        # past a joint: fill the corner; at a free end: cover the wall to its tip
+        lo = -n_ext * d_t if (w, 0) in jt else -0.5 * d_t
+        hi = L + n_ext * d_t if (w, 1) in jt else L + 0.5 * d_t
+        j = np.arange(np.floor((lo - s_org) / d_t) - 1, np.ceil((hi - s_org) / d_t) + 1)
+        s = s_org + (j + 0.5) * d_t
+        s = s[(s >= lo) & (s <= hi)]
+        tips = [e for e, free in ((0.0, (w, 0) not in jt), (L, (w, 1) not in jt)) if free]
+        s = np.concatenate([tips, s])  # free ends: a column at the very tip (later duplicates dropped)
+        for k in range(1, layers + 1):
+            off = (k - 0.5) * d_n
+            px, py = x0 + s * tx + off * nx_, y0 + s * ty + off * ny_
+            pts.append(np.column_stack([px, py]))
+            owner.append(np.full(len(s), w))
+            extra.append(((s < 0) & ((w, 0) in jt)) | ((s > L) & ((w, 1) in jt)))
+    pos, owner, extra = np.concatenate(pts), np.concatenate(owner), np.concatenate(extra)
+    keep = ~extra | is_solid(pos[:, 0], pos[:, 1], walls)
+    # layer points first, then corner points; keep(fewer than half a spacing apart: drop the later)
+    order = np.flatnonzero(keep)[np.argsort(extra[keep], kind="stable")]
+    pos, owner = pos[order], owner[order]
+    lo, hi = pos.min(0) - 1.0, pos.max(0) + 1.0
+    pi, pj, m = build_pairs(pos, np.array([lo[0], lo[1], hi[0], hi[1]]), 0.5 * min(dx, dy))
+    drop = np.zeros(len(pos), bool)
+    for a, b in sorted(zip(np.minimum(pi[:m], pj[:m]), np.maximum(pi[:m], pj[:m]))):
+        if not drop[a]:
+            drop[b] = True
+    return pos[~drop], owner[~drop]
+
+
+def wall_contacts(walls, wpos, owner, force):
+    """Split wall-particle forces into (wall, point on the wall, force) contributions.
+
+    A particle behind the inside of its wall gives its whole force to that
+    wall at its foot point; one beyond a joint (a corner particle) splits its
+    force along the two walls' normals, each part acting at the joint.
+    wpos (P, 2) cm, owner (P,) int, force (P, 2) N.  Returns (wall (Q,), point
+    (Q, 2), force (Q, 2)).
+    """
+    walls = np.asarray(walls, float)
+    jt = joints(walls)
+    ws, pts, fs = [], [], []
+    for q, (w, (px, py), f) in enumerate(zip(owner, wpos, force)):
+        x0, y0, x1, y1 = walls[w]
+        e = np.array([x1 - x0, y1 - y0])
+        t = ((px - x0) * e[0] + (py - y0) * e[1]) / (e @ e)
+        if 0.0 <= t <= 1.0 or (w, int(t > 1.0)) not in jt:
+            tc = min(1.0, max(0.0, t))
+            ws.append(w)
+            pts.append([x0 + tc * e[0], y0 + tc * e[1]])
+            fs.append(f)
+            continue
+        other = jt[w, int(t > 1.0)]
+        corner = walls[w, 2:] if t > 1.0 else walls[w, :2]
+        n = []
+        for k in (w, other):
+            ek = walls[k, 2:] - walls[k, :2]
+            n.append(np.array([-ek[1], ek[0]]) / np.hypot(*ek))  # liquid-side normal
+        A = np.column_stack(n)
+        if abs(np.linalg.det(A)) < 1e-9:
+            coef = np.array([0.5, 0.5]) * (f @ n[0])
+        else:
+            coef = np.linalg.solve(A, f)
+        for k, c, nk in zip((w, other), coef, n):
+            ws.append(k)
+            pts.append(list(corner))
+            fs.append(c * nk)
+    return np.array(ws, int), np.array(pts, float).reshape(-1, 2), np.array(fs, float).reshape(-1, 2)
