@@ -48,7 +48,7 @@ def vessel_view(ds, vessel=None):
     return dict(x_range=(x0, x1), width=x1 - x0, floor_y=floor_y, wall_in=wall_in, horizontal=horiz, inside=inside)
 
 
-def level(ds, vessel=None):
+def level_of(ds, vessel=None):
     """Free-surface level [cm] of a vessel (None: the whole scene) of a run Dataset."""
     return theory.free_surface_level(ds["pos"].values, float(ds.attrs["spacing"]), vessel_view(ds, vessel)["x_range"])
 
@@ -130,6 +130,55 @@ def panel_length(ds):
     return float(ds.attrs.get("panel_length", ds.attrs["spacing"]))
 
 
+def surface_measures(ds, vessel=None):
+    """Flatness of the free surface of a vessel: slope_deg (least-squares line through the
+    top particle of each strip of width a), surface_range_cm (max - min of those tops).
+    A liquid at rest has both about 0; a heap does not."""
+    v = vessel_view(ds, vessel)
+    x, top = theory.surface_profile(ds["pos"].values, float(ds.attrs["spacing"]), v["x_range"])
+    slope, rng = theory.surface_slope(x, top)
+    return dict(slope_deg=slope, surface_range_cm=rng)
+
+
+def compressibility(ds, vessel=None, level=None):
+    """Area measures of the paper's incompressibility claim (section 5: a rhomb loses at most 8.6 %).
+
+    - area_loss_global: 1 - (B h / N) / (a^2 / 2), the area per particle the
+      level implies against the initial lattice's a^2 / 2 (any run);
+    - rhomb_loss_mean, rhomb_loss_max: mean and largest 1 - A / A_0 over the
+      interior rhombs of the initial rhombic lattice (pos0), A by the shoelace
+      formula of the same four particles now; rhomb_loss_surface_mean: the
+      rhombs whose top particle is in the top row.  NaN when pos0 is no lattice.
+    """
+    v = vessel_view(ds, vessel)
+    a = float(ds.attrs["spacing"])
+    level = level_of(ds, vessel) if level is None else level
+    n = int(v["inside"].sum())
+    out = dict(area_loss_global=1.0 - v["width"] * (level - v["floor_y"]) / n / (a * a / 2) if n else np.nan,
+               rhomb_loss_mean=np.nan, rhomb_loss_max=np.nan, rhomb_loss_surface_mean=np.nan, rhombs=0)
+    pos0 = ds["pos0"].values
+    quads = theory.rhombs(pos0, a)
+    if len(quads) == 0 or not np.isfinite(ds["pos"].values).all():
+        return out
+    loss = 1.0 - theory.polygon_area(ds["pos"].values, quads) / (a * a / 2)
+    top = np.isclose(pos0[quads[:, 2], 1], pos0[:, 1].max())
+    inner = loss[~top] if (~top).any() else loss
+    out.update(rhomb_loss_mean=float(inner.mean()), rhomb_loss_max=float(inner.max()),
+               rhomb_loss_surface_mean=float(loss[top].mean()) if top.any() else np.nan, rhombs=len(quads))
+    return out
+
+
+def wall_law_usage(ds):
+    """max_wall_reaction_N: largest |R_b|; wall_gap_reduction: 1 - (smallest particle-wall
+    distance) / l_bu, the paper's "distance from boundary ... not reduced more than 10 %"
+    (l_bu is the initial boundary distance of both lattices).  Point-particle runs only."""
+    if "contact_particle" not in ds or not ds.sizes.get("contact"):
+        return dict(max_wall_reaction_N=np.nan, wall_gap_reduction=np.nan)
+    mag = np.hypot(*ds["contact_force"].values.T)
+    gap = np.hypot(*(ds["pos"].values[ds["contact_particle"].values] - ds["contact_point"].values).T)
+    return dict(max_wall_reaction_N=float(mag.max()), wall_gap_reduction=float(1.0 - gap.min() / ds.attrs["wall_l_u"]))
+
+
 def pairs(pos, cutoff):
     """(i, j) int arrays of the particle pairs closer than cutoff [cm] (shared cell list)."""
     box = np.array([pos[:, 0].min(), pos[:, 1].min(), pos[:, 0].max() + 1e-9, pos[:, 1].max() + 1e-9])
@@ -188,6 +237,9 @@ def run_row(ds, vessel=None):
         row.update(flow_measures(ds))
     row["loads_vessel"] = vessel or "all"
     row.update(load_errors(ds, vessel))
+    row.update(surface_measures(ds, vessel))
+    row.update(compressibility(ds, vessel, row["level"]))
+    row.update(wall_law_usage(ds))
     row["stress_ratio"] = stress_ratio(ds, vessel)
     row.update(convergence_measures(ds))
     return row

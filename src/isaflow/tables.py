@@ -132,7 +132,7 @@ def fire_tables(tuning, references, outputs, meta, paper, required_ratio):
         row = _base_row(sid, ds)
         row.update(lattice=m["lattice"], du_factor=m["du_factor"], dt_factor=m["dt_factor"],
                    dt_max_s=float(ds.attrs["dt_max"]), a_cm=float(ds.attrs["spacing"]),
-                   level_cm=metrics.level(ds))
+                   level_cm=metrics.level_of(ds))
         grid.append(row)
     grid = pd.DataFrame(grid).sort_values(["lattice", "du_factor", "dt_factor"], key=_lattice_key)
     refs = {}
@@ -140,7 +140,7 @@ def fire_tables(tuning, references, outputs, meta, paper, required_ratio):
         m = meta[_stem(p)]
         ds = read(p)
         refs[m["lattice"], m["variant"]] = dict(steps=int(ds["steps"]), status=ds.attrs["status"],
-                                                level=metrics.level(ds))
+                                                level=metrics.level_of(ds))
     ratio = []
     for lattice, g in grid.groupby("lattice", sort=False):
         ok = g[g["status"] == "converged"]
@@ -183,7 +183,7 @@ def stability_row(sid, ds, m):
                du_over_a=a["du"] / lat_a if np.isfinite(lat_a) else np.nan, positions_finite=finite,
                floor_cm=float(ds["wall_segment"].values[:, [1, 3]].min()),
                top_cm=float(pos[:, 1].max()) if finite else np.nan, top0_cm=float(ds["pos0"].values[:, 1].max()),
-               level_cm=metrics.level(ds) if finite and np.isfinite(lat_a) else np.nan)
+               level_cm=metrics.level_of(ds) if finite and np.isfinite(lat_a) else np.nan)
     row.update(metrics.law_usage(ds))
     if "vessel" in ds.coords and finite:
         for name in ds["vessel"].values:

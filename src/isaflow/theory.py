@@ -8,21 +8,59 @@ measured level: gamma = W / (B h) [N/cm^2] for a vessel of width B.
 import numpy as np
 
 
-def free_surface_level(pos, a, x_range):
-    """Free-surface level [cm]: mean over vertical strips of width ``a`` of the
-    highest particle in each strip (the line one reads off the paper's figures).
+def surface_profile(pos, a, x_range):
+    """Free surface as the highest particle of each vertical strip of width ``a``.
 
-    pos (N, 2) cm; a strip width cm (the lattice diagonal); x_range (xmin, xmax)
-    is the vessel: strips start at xmin, particles outside are ignored.  Strips
-    holding no particle are skipped.  NaN if the vessel is empty.
+    pos (N, 2) cm; a strip width cm (the particle spacing); x_range (xmin, xmax)
+    is the vessel: strips start at xmin, particles outside are ignored, strips
+    holding no particle are skipped.  Returns (x (S,) cm strip centres, top (S,) cm).
     """
     pos = np.asarray(pos)
     pos = pos[(pos[:, 0] >= x_range[0]) & (pos[:, 0] < x_range[1])]
-    if len(pos) == 0:
-        return float("nan")
     strip = np.floor((pos[:, 0] - x_range[0]) / a).astype(int)
-    tops = [pos[strip == s, 1].max() for s in np.unique(strip)]
-    return float(np.mean(tops))
+    ids = np.unique(strip)
+    return x_range[0] + (ids + 0.5) * a, np.array([pos[strip == s, 1].max() for s in ids])
+
+
+def free_surface_level(pos, a, x_range):
+    """Free-surface level [cm]: mean of :func:`surface_profile` (the line one reads off
+    the paper's figures); NaN if the vessel is empty."""
+    _, top = surface_profile(pos, a, x_range)
+    return float(np.mean(top)) if len(top) else float("nan")
+
+
+def surface_slope(x, top):
+    """(slope in degrees of the least-squares line through the profile, max - min [cm]);
+    a liquid at rest has both about 0.  NaN for fewer than two strips."""
+    if len(x) < 2:
+        return float("nan"), float("nan")
+    k = np.polyfit(x, top, 1)[0]
+    return float(np.degrees(np.arctan(k))), float(top.max() - top.min())
+
+
+def rhombs(pos0, a, tol=1e-6):
+    """(R, 4) particle indices of the rhombic elements of a rhombic lattice (paper section 5).
+
+    A rhomb has its bottom particle i at p, then p + (a/2, a/2), p + (0, a),
+    p + (-a/2, a/2) counter-clockwise: diagonals a, sides a / sqrt(2), area a^2 / 2.
+    """
+    pos0 = np.asarray(pos0, float)
+    key = {(round(x / (a / 2)), round(y / (a / 2))): i for i, (x, y) in enumerate(pos0)}
+    out = []
+    for (ix, iy), i in key.items():
+        corners = [key.get((ix + dx, iy + dy)) for dx, dy in ((1, 1), (0, 2), (-1, 1))]
+        if None not in corners:
+            out.append([i, *corners])
+    out = np.array(out, int).reshape(-1, 4)
+    ok = np.abs(np.abs(polygon_area(pos0, out)) - a * a / 2) < tol * a * a
+    return out[ok]
+
+
+def polygon_area(pos, quads):
+    """(R,) signed shoelace areas [cm^2] of the quadrilaterals pos[quads] (R, 4), counter-clockwise > 0."""
+    p = np.asarray(pos)[quads]
+    x, y = p[..., 0], p[..., 1]
+    return 0.5 * np.sum(x * np.roll(y, -1, axis=1) - np.roll(x, -1, axis=1) * y, axis=1)
 
 
 def specific_weight(total_weight, width, level, floor_y=0.0):
