@@ -75,8 +75,7 @@ rule mps_figures:
     run:
         from isaflow.methods.mps import figures
 
-        finest = MPS_DX["single"][-1]
-        figures.wall_loads([f"results/mps/single_{v}_dx{finest}.nc" for v in MPS_VARIANTS], output.loads)
+        figures.wall_loads([r for r in input.runs if "/single_" in r], output.loads)
         figures.flow([f"results/mps/flow_{v}_dx{MPS_DX['flow'][-1]}.nc" for v in MPS_VARIANTS], output.flow)
 
 

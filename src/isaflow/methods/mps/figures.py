@@ -22,8 +22,22 @@ def _save(fig, paths):
     plt.close(fig)
 
 
+def pick_runs(paths):
+    """Per variant, the finest run that neither escaped nor became non-finite (else the coarsest)."""
+    best = {}
+    for p in paths:
+        ds = runfile.read(p)
+        ok = ds.attrs["status"] not in ("escaped", "nonfinite")
+        key = (ok, -float(ds.attrs["spacing"]) if ok else float(ds.attrs["spacing"]))
+        v = ds.attrs["variant"]
+        if v not in best or key > best[v][0]:
+            best[v] = (key, p)
+    return [best[v][1] for v in VARIANTS if v in best]
+
+
 def wall_loads(paths, out):
-    """One panel per run: |panel force| [N] along the walls (mean and +- std over the window) vs hydrostatic theory."""
+    """Per variant (pick_runs): |panel force| [N] along the walls (mean and +- std over the window) vs hydrostatic theory."""
+    paths = pick_runs(paths)
     n = len(paths)
     fig, axes = plt.subplots(1, n, figsize=(4.2 * n, 3.6), squeeze=False, sharey=True)
     for ax, p in zip(axes[0], paths):
@@ -39,11 +53,12 @@ def wall_loads(paths, out):
         for w in range(len(names)):
             on = np.flatnonzero(cw == w)
             if len(on):
-                ax.text(on.mean(), -0.08, names[w], transform=ax.get_xaxis_transform(), ha="center", fontsize=8)
+                ax.text(on.mean(), 0.97, names[w], transform=ax.get_xaxis_transform(), ha="center", va="top", fontsize=8)
+        ax.set_xticks([])
         ax.set_title(f"{ds.attrs['variant']}, l0 = {float(ds.attrs['spacing']):.3g} cm\n{ds.attrs['status']}", fontsize=9)
-        ax.set_xlabel("panel (10 cm) along the walls", labelpad=14)
+        ax.set_xlabel("10 cm panels along the walls (left, floor, right)")
     axes[0, 0].set_ylabel("wall force per panel |F| [N]")
-    axes[0, 0].legend(fontsize=7, loc="upper left")
+    axes[0, 0].legend(fontsize=7, loc="upper left", bbox_to_anchor=(0.0, 0.9))
     fig.tight_layout()
     _save(fig, out)
 

@@ -121,7 +121,7 @@ def summary_row(path):
         fm = metrics.flow_measures(ds)
         w = float(ds["weight"].values[0])
         row.update(mass_left_N=fm["particles_left"] * w, mass_left_frac=fm["particles_left"] / ds.sizes["particle"],
-                   second_level_cm=metrics.level(ds, vessel), second_slope=surface_slope(ds, vessel),
+                   second_level_cm=metrics.load_errors(ds, vessel)["level"], second_slope=surface_slope(ds, vessel),
                    mass_conserved=fm["mass_conserved"])
     if case == "single" or (vessel and row["mass_left_frac"] < 0.5):
         row.update(metrics.hydrostatic_errors(ds, vessel=vessel))

@@ -53,6 +53,10 @@ def fragment(df, cfg):
     for _, r in df[df.case == "flow"].iterrows():
         lines.append(f"| {r.run} | {r.status} | {_fmt(r.get('mass_left_frac'))} | {_fmt(r.get('second_level_cm'))} | "
                      f"{_fmt(r.get('second_slope'))} | {_fmt(r.time_to_rest_s)} |")
+    counts = df.groupby(["case", "status"]).size()
+    lines += ["", "Outcomes: " + "; ".join(f"{c} {s}: {n}" for (c, s), n in counts.items()) + ".  Every MPS run here "
+              "ends moving or escaped: the liquid at rest develops motion (rms speed in the table, rest limit "
+              "rho u^2/2 < 0.001 rho g l0) and particles cross the walls; the flow runs start from those states."]
     big = df.sort_values("particles").iloc[-1]
     lines += ["", f"Cost per step of the largest run ({big.particles} liquid particles plus walls): {big.ms_per_step:.3g} ms "
               "(target: 50 ms for 5,000 particles; pressure solver "
