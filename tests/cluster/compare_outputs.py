@@ -1,0 +1,83 @@
+"""Compare the outputs of two runs of the workflow (a local run and a SLURM run).
+
+    python tests/cluster/compare_outputs.py LOCAL_CLONE SLURM_CLONE [STAMP]
+
+Walks results/, figures/ and docs/ of LOCAL_CLONE (files newer than STAMP
+only, i.e. what the run wrote; results/benchmarks/ is timing, skipped) and requires the same file in SLURM_CLONE with equal content:
+run files (.nc) variable by variable, bit for bit, except wall-clock timings
+and the creation-time attributes; PNG by pixels; everything else byte for byte.
+Prints one line per file; exit status 1 if any differs or is missing.
+"""
+
+import sys
+from pathlib import Path
+
+import numpy as np
+
+SKIP_DIRS = ("results/benchmarks",)
+TIME_ATTRS = {"date_created", "time_coverage_start", "time_coverage_end", "history"}
+
+
+def is_timing(var):
+    return "wall_time" in var.name or "wall-clock" in var.attrs.get("long_name", "")
+
+
+def netcdf_difference(a, b):
+    """'' if the two run files hold the same results, else what differs."""
+    import xarray as xr
+
+    with xr.open_dataset(a) as da, xr.open_dataset(b) as db:
+        names_a = {n for n in da.variables if not is_timing(da[n])}
+        names_b = {n for n in db.variables if not is_timing(db[n])}
+        if names_a != names_b:
+            return f"variables differ: {sorted(names_a ^ names_b)}"
+        for n in sorted(names_a):
+            if not np.array_equal(da[n].values, db[n].values, equal_nan=da[n].dtype.kind == "f"):
+                return f"variable {n} differs"
+        attrs = [k for k in set(da.attrs) | set(db.attrs)
+                 if k not in TIME_ATTRS and str(da.attrs.get(k)) != str(db.attrs.get(k))]
+        return f"attributes differ: {sorted(attrs)}" if attrs else ""
+
+
+def png_difference(a, b):
+    from matplotlib.image import imread
+
+    pa, pb = imread(a), imread(b)
+    return "" if pa.shape == pb.shape and np.array_equal(pa, pb) else "pixels differ"
+
+
+def difference(a, b):
+    if not b.exists():
+        return "missing"
+    if a.read_bytes() == b.read_bytes():
+        return ""
+    if a.suffix == ".nc":
+        return netcdf_difference(a, b)
+    if a.suffix == ".png":
+        return png_difference(a, b)
+    return "bytes differ"
+
+
+def outputs(root, since=0.0):
+    for top in ("results", "figures", "docs"):
+        for path in sorted((root / top).rglob("*")):
+            rel = path.relative_to(root).as_posix()
+            if (path.is_file() and path.stat().st_mtime > since and not rel.startswith(SKIP_DIRS)
+                    and not path.name.startswith(".")):
+                yield rel
+
+
+def main(local, slurm, stamp=None):
+    local, slurm = Path(local), Path(slurm)
+    bad = 0
+    files = list(outputs(local, Path(stamp).stat().st_mtime if stamp else 0.0))
+    for rel in files:
+        why = difference(local / rel, slurm / rel)
+        bad += bool(why)
+        print(f"{'DIFFERS' if why else 'equal  '} {rel}{': ' + why if why else ''}")
+    print(f"{len(files) - bad} of {len(files)} outputs equal")
+    return 1 if bad or not files else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(*sys.argv[1:]))
