@@ -38,6 +38,11 @@ if ! dpkg -s $PKGS >/dev/null 2>&1; then
         skip "apt-get install $PKGS failed"
 fi
 
+# srun inside a job reads the default /etc/slurm/slurm.conf: the jobstep plugin
+# drops every SLURM_* variable (SLURM_CONF too) before calling it.  A link to
+# this cluster's file is put there for the run and removed afterwards.
+[ ! -e /etc/slurm/slurm.conf ] || skip "/etc/slurm/slurm.conf exists (a real cluster here?); not touching it"
+
 WORK=$(mktemp -d /tmp/isaflow-slurm.XXXXXX)
 ETC=$WORK/etc
 export SLURM_CONF=$ETC/slurm.conf
@@ -55,6 +60,7 @@ stop_all() {
         kill -9 "${entry#*:}" 2>/dev/null || true
     done
     rm -f "$WORK"/*.pid "$WORK"/munge/*.pid
+    [ "$(readlink /etc/slurm/slurm.conf 2>/dev/null)" != "$SLURM_CONF" ] || rm -f /etc/slurm/slurm.conf
     if [ "${KEEP:-0}" = 1 ] || [ "$STATUS" != 0 ]; then
         log "kept $WORK (logs in $WORK/log)"
     else
@@ -141,6 +147,9 @@ MinJobAge=300
 $NODELINE NodeAddr=127.0.0.1 State=UNKNOWN
 PartitionName=debug Nodes=$NODE Default=YES MaxTime=INFINITE State=UP
 EOF
+
+mkdir -p /etc/slurm
+ln -s "$SLURM_CONF" /etc/slurm/slurm.conf
 
 # --- daemons ------------------------------------------------------------------
 slurmdbd -D >"$WORK/log/slurmdbd.out" 2>&1 &
