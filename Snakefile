@@ -31,7 +31,8 @@ PAPER_TARGETS = [
     for name in ("fig05_inputs_coarse", "fig06_single_coarse", "fig07_inputs_refined", "fig08_single_refined",
                  "fig09_flow_incomplete", "fig10_flow_complete")
     for ext in ("png", "pdf")
-] + ["figures/table1.csv", "figures/table1.md", "results/report/10_single.md", "results/report/20_flow.md"]
+] + ["figures/table1.csv", "figures/table1.md", "results/report/10_single.md", "results/report/20_flow.md",
+      "results/claims/papadopoulos2016.csv"]
 
 
 rule paper:

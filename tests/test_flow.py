@@ -89,18 +89,20 @@ def test_level_matches_the_liquid_moved(chain):
     assert metrics.load_errors(ds, "second")["depth"] == pytest.approx(moved / 180 * level1 / 2, abs=A / 4)
 
 
-def test_all_floors_together_carry_the_weight(chain):
-    for key in ("app4", "app4c"):
-        ds = chain[key]
-        R = ds["wall_resultant"].values.sum(0)
-        resid = max(float(ds["residual"]), 0.1) * 180
-        assert abs(R[1] - 9000.0) <= resid and abs(R[0]) <= resid
+@pytest.mark.parametrize("key", ["app4", "app4c"])
+def test_all_floors_together_carry_the_weight(chain, key):
+    """Vertical and horizontal equilibrium of the whole liquid to the paper's standard: |sum| <= N f_tol
+    (holds even in the literal update's cycle: its residual forces nearly cancel over the liquid)."""
+    R = chain[key]["wall_resultant"].values.sum(0)
+    assert abs(R[1] - 9000.0) <= 180 * 0.1 and abs(R[0]) <= 180 * 0.1
 
 
+@pytest.mark.xfail(strict=True, reason="the particles left at the opening lean on the second vessel's liquid: its "
+                   "floor carries 0.7 % more than its own particles' weight (the bound N f_tol / W holds for the "
+                   "whole liquid only)")
 def test_second_vessel_floor_carries_its_liquid(chain):
-    ds = chain["app4"]
-    e = metrics.load_errors(ds, "second")
-    assert abs(e["floor_err"]) <= float(ds["residual"]) * 180 / e["weight"]
+    e = metrics.load_errors(chain["app4c"], "second")
+    assert abs(e["floor_err"]) <= (e["weight"] / 50.0) * 0.1 / e["weight"]  # N_2 f_tol / W_2
 
 
 @pytest.mark.xfail(strict=True, reason="the second vessel's lattice keeps the lateral stress of the inflow "
@@ -121,3 +123,21 @@ def test_particles_left_regression(chain):
     """Regression: 30 particles stay behind, within half a floor row (5)."""
     for key in ("app4", "app4c"):
         assert abs(metrics.flow_measures(chain[key])["particles_left"] - 30) <= 100 / A / 2
+
+
+# -- the second vessel's surface (a liquid at rest is flat) -----------------------
+# Documented: slope -10.2 deg, range 39.8 cm (docs/replication.md).  Tolerances from the lattice: one row
+# pitch a/2 at one end of the 200 cm vessel moves the slope by atan((a/2)/200 cm) = 1.4 deg; the range by a/2.
+SLOPE_TOL = np.degrees(np.arctan((A / 2) / 200.0))
+
+
+@pytest.mark.parametrize("key", ["app4", "app4c"])
+def test_second_vessel_surface_is_the_documented_heap(chain, key):
+    s = metrics.surface_measures(chain[key], "second")
+    assert abs(s["slope_deg"] - (-10.2)) <= SLOPE_TOL and abs(s["surface_range_cm"] - 39.8) <= A / 2
+
+
+@pytest.mark.xfail(strict=True, reason="the lattice ends as a heap (slope ~10 deg), not a flat liquid surface "
+                   "(docs/replication.md, claims)")
+def test_second_vessel_surface_is_flat_like_a_liquid(chain):
+    assert metrics.surface_measures(chain["app4c"], "second")["surface_range_cm"] <= A / 2

@@ -151,14 +151,17 @@ def test_outcome_detail_separates_the_two_escapes():
     assert tables.outcome_detail("step_limit", "") == "step limit"
 
 
-def test_recommend_takes_the_fastest_converged_run_of_a_robust_family():
-    rows = [("a", "coarse", "paper", "cycle", 0.001, 0.01), ("b", "coarse", "fire", "converged", -0.04, 0.1),
-            ("c", "coarse", "capped", "converged", 0.03, 0.5), ("d", "refined", "fire", "converged", -0.2, 0.05),
-            ("e", "refined", "capped", "converged", 0.02, 0.02), ("f", "refined", "capped", "converged", 0.3, 0.04)]
-    tab = pd.DataFrame([dict(run=r, lattice=la, variant=v, du_cm=0.01, status=s, side_err=e, wall_time_s=ts, steps=100)
-                        for r, la, v, s, e, ts in rows])
+def test_recommend_takes_the_cheapest_converged_run_of_a_robust_family():
+    """Cost = particle-steps (steps x particles), never wall-clock time."""
+    rows = [("a", "coarse", "paper", "cycle", 0.001, 10), ("b", "coarse", "fire", "converged", -0.04, 100),
+            ("c", "coarse", "capped", "converged", 0.03, 500), ("d", "refined", "fire", "converged", -0.2, 13),
+            ("e", "refined", "capped", "converged", 0.02, 5), ("f", "refined", "capped", "converged", 0.3, 10)]
+    tab = pd.DataFrame([dict(run=r, lattice=la, variant=v, du_cm=0.01, status=s, side_err=e, steps=n,
+                             particles=180 if la == "coarse" else 684, wall_time_s=0.0)
+                        for r, la, v, s, e, n in rows])
     rec = tables.recommend(tab, {"side_err": [0.5, 0.05, 0.035, 0.01]}).set_index("target")
-    # every family stays within 0.5: the fastest converged run of all ('a' never converged)
+    # every family stays within 0.5: the cheapest converged run of all ('a' never converged;
+    # 'e' costs 5 x 684 = 3,420 particle-steps against b's 18,000)
     assert rec.loc[0.5, "run"] == "e"
     # refined/capped misses 0.05 at one du ('f'), so its fast 'e' meets it by chance only
     assert rec.loc[0.05, "run"] == "b" and rec.loc[0.05, "family_worst"] == pytest.approx(0.04)
@@ -201,4 +204,5 @@ def test_reduced_study_builds_both_figures_and_the_report_fragment(tmp_path):
     ratio = pd.read_csv(tmp_path / "results" / "study" / "fire_ratio.csv").iloc[0]
     assert ratio["ratio_vs_capped"] > 1 and ratio["ratio_vs_paper_reported"] > 1
     text = (tmp_path / "results" / "report" / "30_study.md").read_text()
-    assert "## Error against run time and numerical stability" in text and "Which configuration to pick" in text
+    assert "## Error against work, and numerical stability" in text and "Which configuration to pick" in text
+    assert " s)" not in text and "wall_time" not in text  # no timing in the report text

@@ -297,17 +297,18 @@ def tolerances(row, a, n_particles, f_tol):
     row: a run_row dict; a lattice diagonal cm.  Returns {name: (tol, why)}:
     - level: a / 4 cm.  The surface is a layer of particles whose rows are
       a / 2 apart, so any reading of it is uncertain by half a row pitch.
-    - floor: relative N max|F| / W.  Vertical equilibrium of the whole liquid:
-      the wall reactions balance the weight up to the residual forces.
-    - side: relative (a / 4) / h.  The side total W h / (2 B) inherits the
+    - floor: relative N f_tol / W.  Vertical equilibrium of the whole liquid to
+      the paper's own equilibrium standard (every |F| < f_tol): the wall
+      reactions balance the weight up to N f_tol.  (N max|F| / W, the old rule,
+      could not fail for a run stuck in a cycle: 47 % for the paper's update.)
+    - side: relative (a / 4) / (h - floor).  The side total W h / (2 B) inherits the
       level's uncertainty.
     - side_height: a / 4 cm.  Side contacts sit a / 2 apart.
     """
-    h = row["level"]
-    resid = max(row["residual"], f_tol) * n_particles
+    h = row["depth"]
     return {
         "level": (a / 4, "half a row pitch a/2: the level is a layer of particles"),
-        "floor": (resid / row["weight"], "N max|F| / W: global vertical equilibrium up to the residuals"),
+        "floor": (n_particles * f_tol / row["weight"], "N f_tol / W: vertical equilibrium to the paper's standard"),
         "side": ((a / 4) / h, "(a/4)/h: the side total W h/(2B) inherits the level's uncertainty"),
         "side_height": (a / 4, "half the a/2 spacing of the side contacts"),
     }

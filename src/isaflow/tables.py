@@ -222,12 +222,14 @@ def recommend(table, targets):
     state depends on the relaxation path, so the converged runs of one lattice
     and update rule spread over du; a (lattice, variant) family is *robust* for
     a target when all its converged runs meet it.  Returns one row per target:
-    the fastest converged run of a robust family (``run``; 'none' if no family
-    is robust) with that family's worst error (``family_worst``), and the
-    fastest converged run meeting the target at all (``by_chance``: another du
-    of the same family may miss it).
+    converged run of a robust family with the least work (particle-steps;
+    ``run``, 'none' if no family is robust) with that family's worst error
+    (``family_worst``), and the cheapest converged run meeting the target at
+    all (``by_chance``: another du of the same family may miss it).  Ranked by
+    force evaluations, not wall-clock time, so the choice is deterministic.
     """
-    ok = table[table["status"] == "converged"]
+    ok = table[table["status"] == "converged"].copy()
+    ok["work"] = ok["steps"] * ok["particles"]  # particle-steps: the cost of a relaxation, machine-independent
     rows = []
     for measure, values in targets.items():
         worst = ok.groupby(["lattice", "variant"])[measure].apply(lambda s: s.abs().max())
@@ -238,14 +240,14 @@ def recommend(table, targets):
             row = dict(measure=measure, target=t,
                        robust_families=", ".join(f"{la}/{va}" for la, va in fams) or "none")
             if len(robust):
-                b = robust.loc[robust["wall_time_s"].idxmin()]
+                b = robust.loc[robust["work"].idxmin()]
                 row.update(run=b["run"], lattice=b["lattice"], variant=b["variant"], du_mm=10 * b["du_cm"],
                            error=b[measure], family_worst=worst[b["lattice"], b["variant"]],
-                           wall_time_s=b["wall_time_s"], steps=int(b["steps"]))
+                           particle_steps=int(b["steps"]) * int(b["particles"]), steps=int(b["steps"]))
             else:
                 row.update(run="none", lattice="", variant="", du_mm=np.nan, error=np.nan,
-                           family_worst=worst.min() if len(worst) else np.nan, wall_time_s=np.nan, steps=np.nan)
-            row["by_chance"] = anyhit.loc[anyhit["wall_time_s"].idxmin(), "run"] if len(anyhit) else "none"
+                           family_worst=worst.min() if len(worst) else np.nan, particle_steps=np.nan, steps=np.nan)
+            row["by_chance"] = anyhit.loc[anyhit["work"].idxmin(), "run"] if len(anyhit) else "none"
             rows.append(row)
     return pd.DataFrame(rows)
 
@@ -261,8 +263,8 @@ def resolution_table(table, measures=("level_err_paper_cm", "level_err_hydro_cm"
         for m in measures:
             row[f"{m} capped"] = ref[m].iloc[0] if len(ref) else np.nan
             row[f"{m} range"] = f"{g[m].min():.3g} .. {g[m].max():.3g}" if g[m].notna().any() else ""
-        row["capped_time_s"] = ref["wall_time_s"].iloc[0] if len(ref) else np.nan
-        row["fastest_s"] = g["wall_time_s"].min()
+        row["capped_steps"] = int(ref["steps"].iloc[0]) if len(ref) else np.nan
+        row["fewest_steps"] = int(g["steps"].min())
         rows.append(row)
     return pd.DataFrame(rows)
 

@@ -142,6 +142,8 @@ rule report_study:
         code=code("report/__init__", "report/study", "tables", "plan"),
     output:
         "results/report/30_study.md",
+        "docs/tables/study_recommendation.csv",
+        "docs/tables/study_cases.csv",
     params:
         func="report.study.report_section",
     log:
