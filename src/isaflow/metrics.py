@@ -193,8 +193,10 @@ def stress_ratio(ds, vessel=None):
     vessel (middle 60 % of the width, 10-60 % of the liquid height), away from
     walls and surface.  A fluid has K = 1; the hydrostatic side-wall loads
     scale with K, so 1 - K is the side-wall deficit a solid-like lattice shows.
+    Point-particle (ISA) runs only: NaN for methods without the pair law.
     """
-
+    if "pair_l_u" not in ds.attrs:
+        return float("nan")
     v = vessel_view(ds, vessel)
     pos = ds["pos"].values
     a = ds.attrs
@@ -213,14 +215,15 @@ def stress_ratio(ds, vessel=None):
 
 
 def run_row(ds, vessel=None):
-    """One metrics-table row (dict) of a run Dataset."""
+    """One metrics-table row (dict) of a run Dataset of any method (NaN where a measure does not apply)."""
     row = dict(
         scene=ds.attrs["scene"],
+        method=ds.attrs.get("method", "isa"),
         variant=ds.attrs["variant"],
         particles=int(ds.sizes["particle"]),
-        du_cm=float(ds.attrs["du"]),
+        du_cm=float(ds.attrs.get("du", np.nan)),
         spacing_cm=float(ds.attrs["spacing"]),
-        f_tol_N=float(ds.attrs["f_tol"]),
+        f_tol_N=float(ds.attrs.get("f_tol", np.nan)),
         steps=int(ds["steps"]),
         wall_time_s=float(ds["wall_time"]),
         status=ds.attrs["status"],

@@ -304,3 +304,58 @@ def calibration_table(runs, outputs):
     df = pd.DataFrame(rows).sort_values(["run", "k_wall", "ratio"])
     _write(df, outputs[0])
     return df
+
+
+# -- methods compared on the same tank ---------------------------------------------
+
+SINGLE_MEASURES = ["side_err", "contact_rms", "side_height_err_cm", "level_err_hydro_cm"]
+FLOW_MEASURES = ["particles_left", "left_fraction", "depth", "slope_deg", "surface_range_cm", "floor_err", "side_err"]
+
+
+def _method_runs(summary):
+    """(method, run id, run file) of every run listed in a method's results/<method>/summary.csv."""
+    folder = Path(summary).parent
+    df = pd.read_csv(summary)
+    case = df["case"] if "case" in df else pd.Series("single", index=df.index)
+    return [(folder.name, r, c, folder / f"{r}.nc") for r, c in zip(df["run"], case) if (folder / f"{r}.nc").exists()]
+
+
+def methods_tables(isa_errors, isa_metrics, summaries, outputs, isa_flows=("flow_complete", "flow_complete_capped",
+                                                                          "flow_refined_complete")):
+    """figures/methods_error_vs_runtime.csv (single vessel: every method's wall-load and level errors with its
+    solver time; a timing file) and figures/methods_flow.csv (the flow's end state per method; no timing).
+
+    Every measure comes from metrics (hydrostatic_errors, run_row) on the run files, so the methods are judged
+    by the same rules on the same panels.  ISA single-vessel rows are the error-against-run-time sweep.
+    """
+    single, flow = [], []
+    isa = pd.read_csv(isa_errors)
+    for _, r in isa.iterrows():
+        single.append(dict(method="isa", variant=r["variant"], run=r["run"], spacing_cm=r["a_cm"],
+                           particles=int(r["particles"]), status=r["status"], steps=int(r["steps"]),
+                           wall_time_s=r["wall_time_s"], **{k: r[k] for k in SINGLE_MEASURES}))
+    m = pd.read_csv(isa_metrics).set_index("run")
+    for run in isa_flows:
+        if run in m.index:
+            r = m.loc[run]
+            flow.append(dict(method="isa", variant=r["variant"], run=run, spacing_cm=r["spacing_cm"],
+                             particles=int(r["particles"]), status=r["status"],
+                             left_fraction=r["particles_left"] / r["particles"],
+                             **{k: r[k] for k in FLOW_MEASURES if k != "left_fraction"}))
+    for summary in summaries:
+        for method, run, case, path in _method_runs(summary):
+            ds = read(path)
+            a = ds.attrs
+            base = dict(method=method, variant=a["variant"], run=run, spacing_cm=float(a["spacing"]),
+                        particles=int(ds.sizes["particle"]), status=a["status"], steps=int(ds["steps"]))
+            if not np.isfinite(ds["pos"].values).all():
+                continue
+            if case == "flow" and "vessel" in ds.coords:
+                r = metrics.run_row(ds)
+                flow.append(dict(**base, left_fraction=r["particles_left"] / r["particles"],
+                                 **{k: r[k] for k in FLOW_MEASURES if k != "left_fraction"}))
+            elif case == "single":
+                e = metrics.hydrostatic_errors(ds)
+                single.append(dict(**base, wall_time_s=float(ds["wall_time"]), **{k: e[k] for k in SINGLE_MEASURES}))
+    _write(pd.DataFrame(single), outputs[0])
+    _write(pd.DataFrame(flow), outputs[1])

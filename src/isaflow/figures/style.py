@@ -2,6 +2,8 @@
 
 from pathlib import Path
 
+import numpy as np
+
 import matplotlib
 
 matplotlib.use("Agg")
@@ -20,6 +22,7 @@ OUTCOME_STYLE = {
     "solver_failed": ("tab:brown", "P"),
 }
 LATTICE_MARKER = {"coarse": "o", "refined": "s", "fine": "^", "finer": "D"}
+METHOD_MARKER = {"isa": "o", "sph": "s", "mps": "^", "sph1d": "v", "solid": "D"}  # when methods share a figure
 
 
 def variant_style(method, variant):
@@ -50,3 +53,74 @@ def run_caption(ds):
     """One line naming the scene, the algorithm variant and the outcome."""
     a = ds.attrs
     return f"scene {a['scene']} | {a['variant_label']} | {a['status']}: {a['status_message']}"
+
+
+# ---- shared helpers for readable figures -------------------------------------------------
+OURS_LEVEL = dict(color=COMPUTED, ls="-", lw=1.2)  # our measured level / surface
+PAPER_LEVEL = dict(color=PAPER, ls=(0, (5, 3)), lw=1.6)  # a level the paper measured
+PAPER_EXPECTED = dict(color="tab:purple", ls=(0, (1, 2)), lw=1.8)  # a level the paper computed
+LABEL_BOX = dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.85)
+CALIBRATED = "k_p calibrated to match this level (config/inferred.yaml)"
+
+
+def state_phrase(ds):
+    """What the drawn positions are: 'state at the detected cycle, step N' for a cycle,
+    'converged state, step N', 'state at the step limit, step N', ... (from the run's status)."""
+    st, n = ds.attrs["status"], int(ds["steps"])
+    return {
+        "converged": f"converged state, step {n:,}",
+        "cycle": f"state at the detected cycle, step {n:,}",
+        "step_limit": f"state at the step limit, step {n:,}",
+    }.get(st, f"last state ({st}), step {n:,}")
+
+
+def nice_value(x):
+    """Largest 1, 2 or 5 x 10^k not above x (for scale bars)."""
+    k = np.floor(np.log10(x))
+    return max(m * 10**k for m in (1, 2, 5) if m * 10**k <= x)
+
+
+def scale_bar(ax, xy, length, label, vertical=False, color="gray"):
+    """A scale bar of ``length`` data units starting at xy, labelled beside it."""
+    x, y = xy
+    end = (x, y + length) if vertical else (x + length, y)
+    ax.plot([x, end[0]], [y, end[1]], color=color, lw=2.2, solid_capstyle="butt")
+    if vertical:
+        ax.text(x + 1.5, y + length / 2, label, color=color, va="center", ha="left", fontsize=8)
+    else:
+        ax.text(x + length / 2, y - 1.5, label, color=color, va="top", ha="center", fontsize=8)
+
+
+def legend_below(ax, ncol=2, **kw):
+    """Legend under the axes (never on the data)."""
+    return ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.1), ncol=ncol, fontsize=8, frameon=False, **kw)
+
+
+def surface_line(ax, ds, vessel, color, name=None):
+    """Draw the measured free surface of a vessel: the top particle of each strip of width a
+    (theory.surface_profile) and its least-squares line; the legend entry states slope (deg),
+    range (cm) and mean level (cm) from metrics.surface_measures / level_of."""
+    from .. import metrics, theory
+
+    v = metrics.vessel_view(ds, vessel)
+    x, top = theory.surface_profile(ds["pos"].values, float(ds.attrs["spacing"]), v["x_range"])
+    if len(x) == 0:
+        return None
+    s = metrics.surface_measures(ds, vessel)
+    depth = metrics.level_of(ds, vessel) - v["floor_y"]
+    ax.plot(x, top, "-", color=color, lw=1.3, marker="_", ms=8, zorder=4,
+            label=f"measured surface, {name or vessel} vessel (top particle per {float(ds.attrs['spacing']):g} cm strip): "
+                  f"slope {s['slope_deg']:.1f}°, range {s['surface_range_cm']:.1f} cm, mean depth {depth:.1f} cm")
+    if len(x) > 1:
+        k = np.polyfit(x, top, 1)
+        ax.plot(x, np.polyval(k, x), ":", color=color, lw=1, zorder=4)
+    return s
+
+
+def literal_levels(calibration_csv, k_wall=2000, ratio=0.5):
+    """{run: level (cm)} of the literal reading k_p = k_b / 2 (ratio 0.5) in results/calibration.csv."""
+    import pandas as pd
+
+    t = pd.read_csv(calibration_csv)
+    t = t[np.isclose(t["k_wall"], k_wall) & np.isclose(t["ratio"], ratio)]
+    return dict(zip(t["run"], t["level"]))

@@ -200,9 +200,6 @@ def paper_claims(metrics, calibration, config, outputs):
                      "refined flow's dip); times: measured on other hardware",
                      "not testable here (computing times depend on the 2016 hardware; ours are in the Speed section)",
                      "figures/table1.md"))
-    rows.append(_row("1, 7", '"approximates dynamic behavior with strong damping"',
-                     "needs a dynamic method on the same tank: see the SPH and MPS rows", "not testable here "
-                     "(by the paper's method alone)", "docs/replication.md, methods compared"))
     df = pd.DataFrame(rows, columns=COLUMNS)
     df.to_csv(outputs[0], index=False)
     with open(outputs[1], "w") as fh:
