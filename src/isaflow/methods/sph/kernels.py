@@ -37,7 +37,13 @@ OK, CROSSED, LEFT_BOX, NONFINITE = range(4)
 def pressure_of(rho, rho0, c0, gamma, tait, clamp):
     """Equation of state P(rho) [N/cm^2]: Tait B((rho/rho0)^gamma - 1), B = rho0 c0^2/gamma, or linear."""
     if tait:
-        p = rho0 * c0 * c0 / gamma * ((rho / rho0) ** gamma - 1.0)
+        r = rho / rho0
+        if gamma == 7.0:  # the usual exponent, without a pow call
+            r2 = r * r
+            rg = r2 * r2 * r2 * r
+        else:
+            rg = r**gamma
+        p = rho0 * c0 * c0 / gamma * (rg - 1.0)
     else:
         p = c0 * c0 * (rho - rho0)
     if clamp and p < 0.0:

@@ -186,3 +186,44 @@ def wall_contacts(walls, wpos, owner, force):
             pts.append(list(corner))
             fs.append(c * nk)
     return np.array(ws, int), np.array(pts, float).reshape(-1, 2), np.array(fs, float).reshape(-1, 2)
+
+
+def along_spacing(wall, dx, dy):
+    """Spacing [cm] of the wall particles along a wall (x0, y0, x1, y1)."""
+    ex, ey = wall[2] - wall[0], wall[3] - wall[1]
+    if abs(ey) < 1e-12 * abs(ex):
+        return dx
+    if abs(ex) < 1e-12 * abs(ey):
+        return dy
+    return float(np.sqrt(dx * dy))
+
+
+def spread_to_panels(walls, length, cw, cpt, cf, dx, dy):
+    """Sum wall-particle contributions into the panels of core.panels.wall_panels, each
+    spread uniformly over its tributary length (one along-wall spacing centred on its
+    foot point; joint contributions stay points), so that panels holding a different
+    number of wall-particle columns are not aliased.  Belongs in core.panels.
+    Returns (wall (P,), centre (P, 2) cm, force (P, 2) N)."""
+    from ...core.panels import wall_panels
+
+    walls = np.asarray(walls, float)
+    pw, pc, s0, s1 = wall_panels(walls, length)
+    out = np.zeros((len(pw), 2))
+    for w, seg in enumerate(walls):
+        mine = np.flatnonzero(cw == w)
+        panels = np.flatnonzero(pw == w)
+        if len(mine) == 0:
+            continue
+        L = np.hypot(seg[2] - seg[0], seg[3] - seg[1])
+        s = np.hypot(cpt[mine, 0] - seg[0], cpt[mine, 1] - seg[1])
+        half = 0.5 * along_spacing(seg, dx, dy)
+        point = (s <= 1e-9) | (s >= L - 1e-9)  # joint contributions
+        lo, hi = np.clip(s - half, 0, L), np.clip(s + half, 0, L)
+        for k, q in enumerate(mine):
+            if point[k] or hi[k] <= lo[k]:
+                j = panels[min(len(panels) - 1, np.searchsorted(s1[panels], s[k], side="right"))]
+                out[j] += cf[q]
+                continue
+            frac = np.clip(np.minimum(hi[k], s1[panels]) - np.maximum(lo[k], s0[panels]), 0, None) / (hi[k] - lo[k])
+            out[panels] += frac[:, None] * cf[q]
+    return pw, pc, out

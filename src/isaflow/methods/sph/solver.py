@@ -16,7 +16,7 @@ import numpy as np
 from ...contract import Result
 from ...core import smoothing
 from ...core.geometry import bounding_box
-from ...core.panels import bin_to_panels, wall_panels
+from ...core.panels import wall_panels
 from ...core.units import DENSITY_2D, G, VELOCITY
 from . import kernels as K
 from . import particles as P
@@ -198,7 +198,7 @@ def _run(tank, s, resolution, start, on_wall, t_max, log):
             what = {K.CROSSED: "crossed a wall", K.LEFT_BOX: "left the walls' bounding box",
                     K.NONFINITE: "became non-finite"}[code]
             k = int(diag[3])
-            message = f"particle {k} at ({x[k, 0]:.4g}, {x[k, 1]:.4g}) cm {what} at step {steps} (t = {t:.4g} s)"
+            message = f"particle {k}, at ({x[k, 0]:.4g}, {x[k, 1]:.4g}) cm before the step, {what} at step {steps} (t = {t:.4g} s)"
         elif rest >= s["rest_window"] - 0.5 * dt:
             status = "converged"
             message = (f"at rest: rms speed < {s['rest_speed']:g} cm/s for {s['rest_window']:g} s "
@@ -214,7 +214,7 @@ def _run(tank, s, resolution, start, on_wall, t_max, log):
     wall_time = time.perf_counter() - started
     mean_force = np.mean(np.array(window), axis=0) if window else np.zeros((nw, 2))
     cw, cpt, cf = P.wall_contacts(walls, st["wpos"], st["owner"], mean_force)
-    pw, pc, pf = bin_to_panels(walls, s["panel_length"], cw, cpt, cf)
+    pw, pc, pf = P.spread_to_panels(walls, s["panel_length"], cw, cpt, cf, st["dx"], st["dy"])
     if lj_window:
         pf = pf + np.mean(np.array(lj_window), axis=0)
     history = {
@@ -234,7 +234,7 @@ def _run(tank, s, resolution, start, on_wall, t_max, log):
         "velocity": (("particle", "xy"), v.copy(), VELOCITY, "particle velocity"),
     }
     params = {f"sph_{k}": (str(v_) if isinstance(v_, (bool, list)) else v_) for k, v_ in s.items()}
-    params.update(cell_dx=st["dx"], cell_dy=st["dy"], smoothing_length=st["h"], sound_speed=st["c0"], dt=dt,
+    params.update(liquid_depth=tank.depth, first_vessel_width=float(np.diff(first_vessel(tank)[:2])[0]), cell_dx=st["dx"], cell_dy=st["dy"], smoothing_length=st["h"], sound_speed=st["c0"], dt=dt,
                   particle_mass=st["mass"], rho_ref=st["rho_ref"], wall_particles=nw, t_max=t_max,
                   panel_length=s["panel_length"], load_window=len(window) * n_chunk * dt,
                   resolution=str(resolution) if start is None else "continued", on_wall=str(bool(on_wall)))
