@@ -4,20 +4,25 @@ import numpy as np
 
 from .. import metrics, theory
 from ..runfile import read
-from .style import COMPUTED, PAPER, THEORY, draw_walls, plt, run_caption, save
+from .style import (CALIBRATED, COMPUTED, LABEL_BOX, OURS_LEVEL, PAPER, PAPER_LEVEL, THEORY, draw_walls,
+                    legend_below, literal_levels, nice_value, plt, run_caption, save, scale_bar, state_phrase)
 
 
-def _law_axes(ax, l_u, r_u, sym, title):
-    l = np.linspace(0, 1.3 * l_u, 200)
+def _law_axes(ax, l_u, r_u, sym, title, note=""):
+    l = np.linspace(0, 1.6 * l_u, 200)
     ax.plot(l, np.where(l < l_u, r_u * (1 - l / l_u), 0.0) / 1000, color="k")
     ax.set_xlabel(f"$l_{sym}$ (cm)")
     ax.set_ylabel(f"$R_{sym}$ (kN)")
     ax.set_title(title)
-    ax.annotate(f"$R_{{{sym}u}}$ = {r_u / 1000:.3g} kN", (0, r_u / 1000), xytext=(0.25 * l_u, 0.85 * r_u / 1000))
-    ax.annotate(f"$l_{{{sym}u}}$ = {l_u:.3g} cm", (l_u, 0), xytext=(0.55 * l_u, 0.15 * r_u / 1000))
-    ax.text(0.98, 0.6, f"stiffness {r_u / l_u:.4g} N/cm", transform=ax.transAxes, ha="right")
-    ax.set_xlim(0, None)
-    ax.set_ylim(0, None)
+    # labels beside the line, never across it
+    ax.annotate(f"$R_{{{sym}u}}$ = {r_u / 1000:.3g} kN", (0, r_u / 1000), xytext=(0.3 * l_u, 0.92 * r_u / 1000),
+                va="center", arrowprops=dict(arrowstyle="->", lw=0.6))
+    ax.annotate(f"$l_{{{sym}u}}$ = {l_u:.3g} cm", (l_u, 0), xytext=(1.08 * l_u, 0.2 * r_u / 1000),
+                ha="left", arrowprops=dict(arrowstyle="->", lw=0.6))
+    ax.text(0.97, 0.75, f"stiffness $R_{{{sym}u}}/l_{{{sym}u}}$\n= {r_u / l_u:.4g} N/cm{note}", transform=ax.transAxes,
+            ha="right", va="top", fontsize=8)
+    ax.set_xlim(0, 1.6 * l_u)
+    ax.set_ylim(0, 1.08 * r_u / 1000)
 
 
 def inputs_figure(inputs, outputs):
@@ -46,17 +51,22 @@ def inputs_figure(inputs, outputs):
     axb.annotate("", (c[0] + 0.15 * a, floor_y), (c[0] + 0.15 * a, c[1] - a / 2), arrowprops=dict(arrowstyle="<->"))
     axb.text(c[0] + 0.18 * a, 0.5 * (floor_y + c[1] - a / 2), f"{c[1] - a / 2 - floor_y:.3g} cm to wall\n"
              f"($l_{{bu}}$ = {wl:.3g} cm)", va="center")
-    axb.text(c[0], c[1] + 0.04 * a, f"a = {a:g} cm", ha="center", va="bottom")
-    axb.text(c[0] + 0.36 * a, c[1] + 0.36 * a, f"a/√2 = {a / np.sqrt(2):.3g} cm", rotation=-45, ha="center",
-             va="center")
+    # the horizontal diagonal's label left of the vertical one; the side's label outside the rhomb
+    axb.text(c[0] - 0.56 * a, c[1], f"diagonal\na = {a:g} cm", ha="right", va="center")
+    axb.text(c[0] + 0.32 * a, c[1] + 0.32 * a, f"a/√2 = {a / np.sqrt(2):.3g} cm", rotation=-45,
+             rotation_mode="anchor", ha="center", va="bottom")
     axb.set_aspect("equal")
-    axb.set_xlim(-0.8 * a, 0.8 * a)
+    axb.set_xlim(c[0] - 1.15 * a, c[0] + 1.15 * a)
+    axb.set_ylim(floor_y - 0.12 * a, c[1] + 0.8 * a)
     axb.set_xlabel("x (cm)")
     axb.set_ylabel("y (cm)")
     axb.set_title("(b) rhombic element and distance from the boundary")
     _law_axes(ax[1, 0], wl, float(ds.attrs["wall_r_u"]), "b", "(c) boundary-particle function $R_b - l_b$")
     _law_axes(ax[1, 1], float(ds.attrs["pair_l_u"]), float(ds.attrs["pair_r_u"]), "p",
-              "(d) inter-particle function $R_p - l_p$")
+              "(d) inter-particle function $R_p - l_p$",
+              note=f"\ncalibrated to the paper's levels\n(config/inferred.yaml); the literal\n"
+                   f"k_p = k_b/2 would be {float(ds.attrs['wall_r_u']) / wl / 2:.4g} N/cm")
+    fig.subplots_adjust(hspace=0.3)
     fig.suptitle(f"Inputs of scene {ds.attrs['scene']}: du = {ds.attrs['du'] * 10:g} mm, f_tol = {ds.attrs['f_tol']:g} N "
                  f"(solver: {ds.attrs['variant_label']})")
     save(fig, outputs)
@@ -80,91 +90,137 @@ def _contact_bars(ax, ds, th, scale):
             ax.plot([base[0], tip[0]], [base[1], tip[1]], color=color, lw=2.2, solid_capstyle="butt")
 
 
-def single_vessel_figure(inputs, outputs, paper_level=None):
-    """Paper Figs. 6 / 8: final state, level, wall reactions vs hydrostatic theory."""
+def _level_lines(ax, x_span, level, paper_level, literal):
+    """Our level (solid blue) and the paper's (dashed red) across x_span, named in the legend only."""
+    ours = f"our level {level:.1f} cm"
+    if paper_level is not None:
+        ours += f": {CALIBRATED}"
+        if literal is not None:
+            ours += f";\nthe literal reading k_p = k_b/2 gives {literal:.1f} cm (results/calibration.csv)"
+    # the paper's line under ours: both stay visible where they (almost) coincide
+    ax.plot(x_span, [level] * 2, label=ours, zorder=5, **OURS_LEVEL)
+    if paper_level is not None:
+        ax.plot(x_span, [paper_level] * 2, label=f"paper's level {paper_level:g} cm", zorder=4,
+                **{**PAPER_LEVEL, "lw": 3.0, "alpha": 0.7})
+
+
+def single_vessel_figure(inputs, outputs, paper_level=None, calibration=None):
+    """Paper Figs. 6 / 8: final state, level, wall reactions vs hydrostatic theory.
+
+    calibration: results/calibration.csv, for the level of the literal reading k_p = k_b / 2."""
     ds = read(inputs[0])
     e, (_, _, _, th) = metrics.contact_loads(ds)
     pos = ds["pos"].values
     walls = ds["wall_segment"].values
-    fig, (ax, axp) = plt.subplots(1, 2, figsize=(12, 6.2), gridspec_kw={"width_ratios": [1.15, 1]})
+    literal = literal_levels(calibration).get(ds.attrs["scene"]) if calibration else None
+    fig, (ax, axp) = plt.subplots(1, 2, figsize=(12.5, 6.2), gridspec_kw={"width_ratios": [1.1, 1]})
     draw_walls(ax, ds)
     ax.plot(pos[:, 0], pos[:, 1], "o", ms=3 if len(pos) < 300 else 1.6, color="k")
     x0, x1 = walls[:, [0, 2]].min(), walls[:, [0, 2]].max()
-    ax.axhline(e["level"], color=COMPUTED, ls="--", lw=1)
-    ax.text(x0 + 2, e["level"] + 1.5, f"level {e['level']:.1f} cm (ours)", color=COMPUTED)
-    if paper_level is not None:
-        ax.axhline(paper_level, color=PAPER, ls=":", lw=1.2)
-        ax.text(x1 - 2, paper_level - 4, f"paper {paper_level:g} cm", color=PAPER, ha="right")
+    _level_lines(ax, (x0 - 28, x1 + 28), e["level"], paper_level, literal)
     fmax = np.nanmax(np.concatenate([np.hypot(*ds["contact_force"].values.T), th]))
     scale = 25.0 / fmax
     _contact_bars(ax, ds, th, scale)
-    ax.plot([], [], color=COMPUTED, lw=2.2, label="computed reaction $R_b$")
+    ax.plot([], [], color=COMPUTED, lw=2.2, label="computed reaction $R_b$ of each contact")
     ax.plot([], [], color=THEORY, lw=2.2, label="hydrostatic theory (tributary length)")
-    ax.plot([x1 + 3, x1 + 3], [-20, -20 + 1000 * scale], color="gray", lw=2)
-    ax.text(x1 + 5, -20, "1 kN", color="gray", va="bottom")
-    ax.legend(loc="upper center", fontsize=8, ncol=2, bbox_to_anchor=(0.5, 1.0))
+    # force scale in the empty lower-left corner, clear of every bar
+    bar = nice_value(0.8 * fmax)
+    scale_bar(ax, (x0 - 30, -18), bar * scale, f"{bar:g} N")
+    legend_below(ax, ncol=1)
     ax.set_aspect("equal")
-    ax.set_xlim(x0 - 30, x1 + 30)
+    ax.set_xlim(x0 - 33, x1 + 30)
     ax.set_ylim(-30, 110)
     ax.set_xlabel("x (cm)")
     ax.set_ylabel("y (cm)")
     names = list(ds["wall"].values)
     totals = ", ".join(f"{n} {e['load_' + n]:.0f} N (theory {e['theory_' + n]:.0f})" for n in names)
-    ax.set_title(f"(a) final positions and wall reactions\n{totals}")
-    # (b) theoretical pressure diagram
+    ax.set_title(f"(a) {state_phrase(ds)}, and wall reactions\n{totals}")
+    _pressure_panel(axp, ds, e, names, x0, x1)
+    fig.suptitle(run_caption(ds), fontsize=8)
+    save(fig, outputs)
+
+
+def _pressure_panel(axp, ds, e, names, x0, x1):
+    """(b) hydrostatic pressure on the walls, drawn to a stated scale; the text below the axes."""
     h, gamma = e["level"], e["gamma"]
     draw_walls(axp, ds)
     pbot = gamma * h  # N/cm per cm of wall = N/cm^2 x cm
-    s = 30.0 / pbot
+    s = 30.0 / pbot  # drawing cm per N/cm
     y = np.linspace(0, h, 50)
-    axp.fill_betweenx(y, x0, x0 - gamma * (h - y) * s, color=THEORY, alpha=0.5)
-    axp.fill_betweenx(y, x1, x1 + gamma * (h - y) * s, color=THEORY, alpha=0.5)
-    axp.fill_between([x0, x1], 0, -pbot * s, color=THEORY, alpha=0.5)
-    axp.axhline(h, color=COMPUTED, ls="--", lw=1)
-    axp.text(x0 - 2, -pbot * s - 6, f"p = γh = {pbot:.1f} N/cm", ha="left")
-    axp.text(0.5 * (x0 + x1), h + 2, f"h = {h:.1f} cm, γ = W/(B h) = {gamma:.3f} N/cm²", ha="center")
-    axp.text(0.5 * (x0 + x1), 0.45 * h, f"floor: γhB = W = {e['theory_floor']:.0f} N\n"
-             f"each side: γh²/2 = {e['theory_' + names[0]]:.0f} N at h/3 = {h / 3:.1f} cm", ha="center")
+    axp.fill_betweenx(y, x0, x0 - gamma * (h - y) * s, color=THEORY, alpha=0.5, lw=0)
+    axp.fill_betweenx(y, x1, x1 + gamma * (h - y) * s, color=THEORY, alpha=0.5, lw=0)
+    axp.fill_between([x0, x1], 0, -pbot * s, color=THEORY, alpha=0.5, lw=0)
+    axp.plot([x0 - 30, x1 + 30], [h, h], **OURS_LEVEL)
+    axp.text(x0 + 3, h + 2, f"h = {h:.1f} cm", color=COMPUTED, va="bottom")
+    # the scale: a dimension line on the floor diagram, the pressure at the bottom
+    xd = 0.5 * (x0 + x1)
+    axp.annotate("", (xd, 0), (xd, -pbot * s), arrowprops=dict(arrowstyle="<->", lw=0.8))
+    axp.text(xd + 2, -pbot * s / 2, f"γh = {pbot:.1f} N/cm", va="center", ha="left", bbox=LABEL_BOX)
+    bar = nice_value(0.6 * pbot)
+    scale_bar(axp, (x0 - 38, -40), bar * s, f"pressure scale: {bar:g} N/cm", label_right=True)
     axp.set_aspect("equal")
     axp.set_xlim(x0 - 40, x1 + 40)
-    axp.set_ylim(-45, 110)
+    axp.set_ylim(-48, 110)
     axp.set_xlabel("x (cm)")
     axp.set_ylabel("y (cm)")
-    axp.set_title("(b) theoretical hydrostatic pressure on the boundaries (2D, per unit depth)")
-    fig.suptitle(run_caption(ds), fontsize=8)
-    save(fig, outputs)
+    axp.set_title("(b) theoretical hydrostatic pressure on the boundaries\n(2D, per unit depth; p = γ (h - y))")
+    axp.text(0.5, -0.15, f"γ = W/(B h) = {gamma:.3f} N/cm² (W: weight held, B: width, h: our level)\n"
+             f"floor: γhB = W = {e['theory_floor']:.0f} N\n"
+             f"each side: γh²/2 = {e['theory_' + names[0]]:.0f} N, acting at h/3 = {h / 3:.1f} cm",
+             transform=axp.transAxes, ha="center", va="top", fontsize=8)
 
 
 def calibration_figure(inputs, outputs, paper_levels=None, adopted=None):
     """Free-surface level against wall stiffness and stiffness ratio, per resolution.
 
-    adopted: {k_wall, ratio} of the scenes' reading, starred in every panel."""
-    tab = metrics.calibration_table(inputs)
+    adopted: {k_wall, ratio} of the scenes' reading, starred in the panels of the scenes
+    that use it (those with a paper level); the literal reading k_p = k_b / 2 is ringed."""
+    import tempfile
+
+    from ..tables import calibration_table
+
+    with tempfile.TemporaryDirectory() as tmp:
+        tab = calibration_table(inputs, [f"{tmp}/calibration.csv"])
     scenes = list(dict.fromkeys(tab["run"]))
     fig, axes = plt.subplots(1, len(scenes), figsize=(5.2 * len(scenes), 4.4), sharey=True, squeeze=False)
+    handles, literal = {}, {}
     for ax, sc in zip(axes[0], scenes):
         t = tab[tab["run"] == sc]
         for ratio, g in t.groupby("ratio"):
             g = g.sort_values("k_wall")
             line, = ax.plot(g["k_wall"], g["level"], "-", label=f"$k_p/k_b$ = {ratio:g}")
+            handles.setdefault(line.get_label(), line)
             ok = g["status"] == "converged"
             ax.plot(g["k_wall"][ok], g["level"][ok], "o", color=line.get_color())
             ax.plot(g["k_wall"][~ok], g["level"][~ok], "o", mfc="none", color=line.get_color())
         base = sc.removesuffix("_lbu25")
         if paper_levels and base in paper_levels:
-            ax.axhline(paper_levels[base], color=PAPER, ls=":", label=f"paper {paper_levels[base]:g} cm")
-        if adopted:
-            pick = t[(t["k_wall"] == adopted["k_wall"]) & (t["ratio"] == adopted["ratio"])]
-            ax.plot(pick["k_wall"], pick["level"], "*", ms=16, mfc="none", color="k",
-                    label=f"adopted: k_b = {adopted['k_wall']:g} N/cm, k_p/k_b = {adopted['ratio']:g}")
+            h = ax.axhline(paper_levels[base], label="paper's level ("
+                           + ", ".join(f"{v:g} cm {k}" for k, v in paper_levels.items()) + ")", **PAPER_LEVEL)
+            handles.setdefault("paper", h)
+        if adopted and paper_levels and sc in paper_levels:  # only the scenes that use the reading
+            pick = t[np.isclose(t["k_wall"], adopted["k_wall"]) & np.isclose(t["ratio"], adopted["ratio"])]
+            h, = ax.plot(pick["k_wall"], pick["level"], "*", ms=16, mfc="none", mec="k", ls="none",
+                         label=f"adopted: k_b = {adopted['k_wall']:g} N/cm, k_p/k_b = {adopted['ratio']:g} "
+                               f"(k_p calibrated to match the paper's level)")
+            handles.setdefault("adopted", h)
+            lit = t[np.isclose(t["k_wall"], adopted["k_wall"]) & np.isclose(t["ratio"], 0.5)]
+            h, = ax.plot(lit["k_wall"], lit["level"], "o", ms=14, mfc="none", mec="k", ls="none")
+            literal[sc] = float(lit["level"].iloc[0]) if len(lit) else np.nan
+            handles["literal"] = h
         ax.set_xscale("log")
         ks = sorted(t["k_wall"].unique())
         ax.set_xticks(ks, [f"{k:g}" for k in ks])
         ax.minorticks_off()
         ax.set_xlabel("wall stiffness $k_b = R_{bu}/l_{bu}$ (N/cm)")
-        ax.set_title(f"{sc} ({t['variant'].iloc[0]} variant)")
-        ax.legend(fontsize=8)
+        what = "" if sc in (paper_levels or {}) else ": alternative $l_{bu}$, not adopted"
+        ax.set_title(f"{sc} ({t['variant'].iloc[0]}){what}")
     axes[0, 0].set_ylabel("free-surface level (cm)")
+    if "literal" in handles:
+        handles["literal"].set_label("literal reading k_p = k_b/2 (page text: \"half\"): "
+                                     + ", ".join(f"{v:.1f} cm {k}" for k, v in literal.items()))
+    fig.legend(list(handles.values()), [h.get_label() for h in handles.values()], loc="upper center",
+               bbox_to_anchor=(0.5, 0.0), ncol=3, fontsize=8, frameon=False)
     fig.suptitle("Free-surface level vs force-law stiffness (filled: converged to f_tol, open: not converged)")
     save(fig, outputs)
 
@@ -173,12 +229,13 @@ def convergence_figure(inputs, outputs):
     """max|F| against the step: the paper's update and the capped variant."""
     runs = [read(p) for p in inputs]
     scenes = list(dict.fromkeys(ds.attrs["scene"] for ds in runs))
-    fig, axes = plt.subplots(1, len(scenes), figsize=(6 * len(scenes), 4.4), squeeze=False)
+    fig, axes = plt.subplots(1, len(scenes), figsize=(6 * len(scenes), 4.2), squeeze=False)
     for ax, sc in zip(axes[0], scenes):
         for ds in (d for d in runs if d.attrs["scene"] == sc):
             a = ds.attrs
             st = ds["hist_step"].values
-            line, = ax.plot(st, ds["hist_fmax"].values, lw=0.8, label=f"{a['variant_label']}\n-> {a['status']} at step {int(ds['steps'])}")
+            line, = ax.plot(st, ds["hist_fmax"].values, lw=0.8, label=f"{a['variant_label']}\n-> {a['status']} at step {int(ds['steps']):,}"
+                            + (" (detected: max|F| repeats, not a convergence step)" if a["status"] == "cycle" else ""))
             ax.fill_between(st, ds["hist_fmax_lo"].values, ds["hist_fmax_hi"].values, color=line.get_color(), alpha=0.25, lw=0)
             if a["variant"] == "paper":
                 lam, floor = theory.step_floor(ds["pos"].values, ds["wall_segment"].values, a["wall_l_u"],
@@ -190,6 +247,6 @@ def convergence_figure(inputs, outputs):
         ax.set_xlabel("algorithm step")
         ax.set_ylabel("max|F| (N)")
         ax.set_title(sc)
-        ax.legend(fontsize=7)
+        legend_below(ax, ncol=1, handlelength=2.5)
     fig.suptitle("Convergence of the single-vessel runs (band: min-max of max|F| over each record stride)")
     save(fig, outputs)

@@ -80,12 +80,14 @@ def nice_value(x):
     return max(m * 10**k for m in (1, 2, 5) if m * 10**k <= x)
 
 
-def scale_bar(ax, xy, length, label, vertical=False, color="gray"):
-    """A scale bar of ``length`` data units starting at xy, labelled beside it."""
+def scale_bar(ax, xy, length, label, vertical=False, color="gray", label_right=False):
+    """A scale bar of ``length`` data units starting at xy, labelled below it (or right of it)."""
     x, y = xy
     end = (x, y + length) if vertical else (x + length, y)
     ax.plot([x, end[0]], [y, end[1]], color=color, lw=2.2, solid_capstyle="butt")
-    if vertical:
+    if label_right and not vertical:
+        ax.text(end[0] + 1.5, y, label, color=color, va="center", ha="left", fontsize=8)
+    elif vertical:
         ax.text(x + 1.5, y + length / 2, label, color=color, va="center", ha="left", fontsize=8)
     else:
         ax.text(x + length / 2, y - 1.5, label, color=color, va="top", ha="center", fontsize=8)
