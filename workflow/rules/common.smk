@@ -41,6 +41,12 @@ def figure(name):
     return [f"figures/{name}.png", f"figures/{name}.pdf"]
 
 
+def report_figure(name, caption, category):
+    """figure(name) with the PNG marked for the Snakemake report (caption: workflow/report/<caption>.rst)."""
+    png, pdf = figure(name)
+    return [report(png, caption=f"../report/{caption}.rst", category=category), pdf]
+
+
 def run_file(run):
     return f"results/runs/{run}.nc"
 

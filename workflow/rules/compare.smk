@@ -14,6 +14,8 @@ rule methods_tables:
         "figures/methods_flow.csv",
     params:
         func="tables.methods_tables",
+    conda:
+        "../envs/isaflow.yaml"
     log:
         "logs/compare/tables.log",
     script:
@@ -25,9 +27,11 @@ rule fig_methods:
         inputs=["figures/methods_error_vs_runtime.csv"],
         code=FIGURE_CODE,
     output:
-        figure("methods_error_vs_runtime"),
+        report_figure("methods_error_vs_runtime", "methods_figure", "Methods compared"),
     params:
         func="figures.methods.methods_error_vs_runtime_figure",
+    conda:
+        "../envs/isaflow.yaml"
     log:
         "logs/figures/methods_error_vs_runtime.log",
     script:
@@ -44,6 +48,8 @@ rule report_methods:
         "results/claims/methods.csv",
     params:
         func="report.methods.methods_section",
+    conda:
+        "../envs/isaflow.yaml"
     log:
         "logs/report/methods.log",
     script:

@@ -8,13 +8,16 @@ rule fig_flow:
         inputs=lambda wc: [run_file(FIGS[wc.name])],
         code=FIGURE_CODE,
     output:
-        figure("{name}"),
+        report_figure("{name}", "paper_figure", "Paper figures"),
     params:
         func=lambda wc: {
             "fig09_flow_incomplete": "figures.flow.flow_incomplete_figure",
             "fig10_flow_complete": "figures.flow.flow_complete_figure",
         }[wc.name],
         kw={"paper": FLOW["paper"]},
+    conda:
+        "../envs/isaflow.yaml"
+    priority: 10  # the paper's own outputs first (snakemake -c2 paper)
     log:
         "logs/figures/{name}.log",
     wildcard_constraints:
@@ -28,10 +31,12 @@ rule fig_flow_history:
         inputs=sorted({run_file(r) for chain in FLOW["chains"].values() for r in chain}),
         code=FIGURE_CODE,
     output:
-        figure("flow_history"),
+        report_figure("flow_history", "study_figure", "Studies"),
     params:
         func="figures.flow.flow_history_figure",
         kw={"chains": FLOW["chains"]},
+    conda:
+        "../envs/isaflow.yaml"
     log:
         "logs/figures/flow_history.log",
     script:
@@ -44,8 +49,11 @@ rule table1:
         benchmarks=[f"results/benchmarks/run/{r}.tsv" for r in TABLE1_RUNS],
         code=code("tables", "report/__init__"),
     output:
-        "figures/table1.csv",
+        report("figures/table1.csv", caption="../report/table.rst", category="Claims"),
         "figures/table1.md",
+    conda:
+        "../envs/isaflow.yaml"
+    priority: 10  # the paper's own outputs first (snakemake -c2 paper)
     log:
         "logs/table1.log",
     params:

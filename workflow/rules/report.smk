@@ -11,6 +11,9 @@ rule metrics:
         "results/metrics.csv",
     params:
         func="tables.metrics_table",
+    conda:
+        "../envs/isaflow.yaml"
+    priority: 10  # the paper's own outputs first (snakemake -c2 paper)
     log:
         "logs/metrics.log",
     script:
@@ -24,10 +27,13 @@ rule report_claims:
         config="config/config.yaml",
         code=code("report/__init__", "report/claims", "metrics"),
     output:
-        "results/claims/papadopoulos2016.csv",
+        report("results/claims/papadopoulos2016.csv", caption="../report/claims.rst", category="Claims"),
         "results/report/findings.md",
     params:
         func="report.claims.paper_claims",
+    conda:
+        "../envs/isaflow.yaml"
+    priority: 10  # the paper's own outputs first (snakemake -c2 paper)
     log:
         "logs/report/claims.log",
     script:
@@ -46,6 +52,9 @@ rule report_single:
         "docs/tables/calibration.csv",
     params:
         func="report.single.single_section",
+    conda:
+        "../envs/isaflow.yaml"
+    priority: 10  # the paper's own outputs first (snakemake -c2 paper)
     log:
         "logs/report/single.log",
     script:
@@ -61,6 +70,9 @@ rule report_flow:
         "results/report/20_flow.md",
     params:
         func="report.flow.flow_section",
+    conda:
+        "../envs/isaflow.yaml"
+    priority: 10  # the paper's own outputs first (snakemake -c2 paper)
     log:
         "logs/report/flow.log",
     script:
@@ -76,6 +88,8 @@ rule report_inferred:
         "results/report/90_inferred.md",
     params:
         func="report.inferred.inferred_section",
+    conda:
+        "../envs/isaflow.yaml"
     log:
         "logs/report/inferred.log",
     script:
@@ -96,6 +110,8 @@ rule timing_report:
         "docs/timing.md",
     params:
         func="report.speed.speed_section",
+    conda:
+        "../envs/isaflow.yaml"
     log:
         "logs/report/timing.log",
     script:
@@ -117,6 +133,8 @@ rule replication_report:
         "docs/replication.md",
     params:
         func="report.assemble",
+    conda:
+        "../envs/isaflow.yaml"
     log:
         "logs/report/assemble.log",
     script:

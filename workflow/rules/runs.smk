@@ -10,6 +10,9 @@ rule run:
         "results/runs/{run}.nc",
     params:
         overrides=run_overrides,
+    conda:
+        "../envs/isaflow.yaml"
+    priority: 10  # the paper's own outputs first (snakemake -c2 paper)
     log:
         "logs/run/{run}.log",
     benchmark:

@@ -15,6 +15,8 @@ rule calibration_run:
         "results/calibration/{run}_kb{kb}_r{ratio}.nc",
     params:
         overrides=calibration_overrides,
+    conda:
+        "../envs/isaflow.yaml"
     log:
         "logs/calibration/{run}_kb{kb}_r{ratio}.log",
     benchmark:
@@ -31,6 +33,9 @@ rule calibration_table:
         "results/calibration.csv",
     params:
         func="tables.calibration_table",
+    conda:
+        "../envs/isaflow.yaml"
+    priority: 10  # the paper's own outputs first (snakemake -c2 paper)
     log:
         "logs/calibration_table.log",
     script:
@@ -45,9 +50,12 @@ rule fig_inputs:
         inputs=lambda wc: [run_file(FIGS[wc.name])],
         code=FIGURE_CODE,
     output:
-        figure("{name}"),
+        report_figure("{name}", "paper_figure", "Paper figures"),
     params:
         func="figures.single.inputs_figure",
+    conda:
+        "../envs/isaflow.yaml"
+    priority: 10  # the paper's own outputs first (snakemake -c2 paper)
     log:
         "logs/figures/{name}.log",
     wildcard_constraints:
@@ -61,10 +69,13 @@ rule fig_single:
         inputs=lambda wc: [run_file(FIGS[wc.name])],
         code=FIGURE_CODE,
     output:
-        figure("{name}"),
+        report_figure("{name}", "paper_figure", "Paper figures"),
     params:
         func="figures.single.single_vessel_figure",
         kw=lambda wc: {"paper_level": config["paper"][FIGS[wc.name].removesuffix("_capped")]["level"]},
+    conda:
+        "../envs/isaflow.yaml"
+    priority: 10  # the paper's own outputs first (snakemake -c2 paper)
     log:
         "logs/figures/{name}.log",
     wildcard_constraints:
@@ -78,10 +89,12 @@ rule fig_calibration:
         inputs=CAL_FILES,
         code=FIGURE_CODE,
     output:
-        figure("calibration_free_surface"),
+        report_figure("calibration_free_surface", "study_figure", "Studies"),
     params:
         func="figures.single.calibration_figure",
         kw={"paper_levels": {k: v["level"] for k, v in config["paper"].items()}, "adopted": CAL["adopted"]},
+    conda:
+        "../envs/isaflow.yaml"
     log:
         "logs/figures/calibration_free_surface.log",
     script:
@@ -93,9 +106,11 @@ rule fig_convergence:
         inputs=[run_file(r) for r in ["single_coarse", "single_coarse_capped", "single_refined", "single_refined_capped"]],
         code=FIGURE_CODE,
     output:
-        figure("convergence_single"),
+        report_figure("convergence_single", "study_figure", "Studies"),
     params:
         func="figures.single.convergence_figure",
+    conda:
+        "../envs/isaflow.yaml"
     log:
         "logs/figures/convergence_single.log",
     script:

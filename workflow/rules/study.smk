@@ -22,6 +22,8 @@ rule study_run:
         "results/study/runs/{sid}.nc",
     params:
         overrides=lambda wc: S.cli_overrides(STUDY_RUNS, wc.sid),
+    conda:
+        "../envs/isaflow.yaml"
     log:
         "logs/study/run/{sid}.log",
     benchmark:
@@ -41,6 +43,8 @@ rule study_error_table:
     params:
         func="tables.error_table",
         kw={"meta": STUDY_META, "paper": config["paper"]},
+    conda:
+        "../envs/isaflow.yaml"
     log:
         "logs/study/error_table.log",
     script:
@@ -67,6 +71,8 @@ rule study_fire_tables:
             "paper": config["paper"],
             "required_ratio": STUDY["fire_tuning"]["required_ratio"],
         },
+    conda:
+        "../envs/isaflow.yaml"
     log:
         "logs/study/fire_tables.log",
     script:
@@ -82,6 +88,8 @@ rule study_map_table:
     params:
         func="tables.map_table",
         kw={"meta": STUDY_META},
+    conda:
+        "../envs/isaflow.yaml"
     log:
         "logs/study/map_table.log",
     script:
@@ -97,6 +105,8 @@ rule study_cases_table:
     params:
         func="tables.cases_table",
         kw={"meta": STUDY_META},
+    conda:
+        "../envs/isaflow.yaml"
     log:
         "logs/study/cases_table.log",
     script:
@@ -108,9 +118,11 @@ rule fig_error_vs_runtime:
         inputs=["figures/error_vs_runtime.csv"],
         code=STUDY_FIG_CODE,
     output:
-        figure("error_vs_runtime"),
+        report_figure("error_vs_runtime", "study_figure", "Studies"),
     params:
         func="figures.study.error_vs_runtime_figure",
+    conda:
+        "../envs/isaflow.yaml"
     log:
         "logs/figures/error_vs_runtime.log",
     script:
@@ -122,9 +134,11 @@ rule fig_stability_map:
         inputs=["results/study/stability_map.csv", "figures/stability_cases.csv"],
         code=STUDY_FIG_CODE,
     output:
-        figure("stability_map"),
+        report_figure("stability_map", "study_figure", "Studies"),
     params:
         func="figures.study.stability_map_figure",
+    conda:
+        "../envs/isaflow.yaml"
     log:
         "logs/figures/stability_map.log",
     script:
@@ -146,6 +160,8 @@ rule report_study:
         "docs/tables/study_cases.csv",
     params:
         func="report.study.report_section",
+    conda:
+        "../envs/isaflow.yaml"
     log:
         "logs/report/study.log",
     script:
