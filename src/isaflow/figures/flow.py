@@ -1,11 +1,16 @@
 """Flow figures: paper Figs. 9-10 and the flow history (from run files only)."""
 
 import numpy as np
+from matplotlib.ticker import FuncFormatter
 
 from .. import metrics
 from ..runfile import read
 from .single import _contact_bars
-from .style import COMPUTED, PAPER, THEORY, draw_walls, plt, run_caption, save
+from .style import (COMPUTED, LABEL_BOX, PAPER_EXPECTED, PAPER_LEVEL, THEORY, draw_walls, legend_below, nice_value,
+                    plt, run_caption, save, scale_bar, state_phrase, surface_line)
+
+RESULTANT = "tab:brown"
+VESSEL_COLOURS = ("tab:green", "k")
 
 
 def _state_axes(ax, ds):
@@ -14,7 +19,7 @@ def _state_axes(ax, ds):
     pos = ds["pos"].values
     fm = metrics.flow_measures(ds)
     names = [str(n) for n in ds["vessel"].values]
-    for name, color in zip(names, ("tab:green", "k")):
+    for name, color in zip(names, VESSEL_COLOURS):
         x0, x1 = ds["vessel_x"].sel(vessel=name).values
         sel = (pos[:, 0] >= x0) & (pos[:, 0] < x1)
         ax.plot(pos[sel, 0], pos[sel, 1], "o", ms=3, color=color,
@@ -25,66 +30,105 @@ def _state_axes(ax, ds):
     return fm
 
 
-def _reaction_arrows(ax, ds, scale):
-    """Each wall's resultant reaction on the liquid as an arrow from the wall's middle."""
+def _reaction_arrows(ax, ds, bar_room):
+    """Each wall's resultant reaction on the liquid as an arrow from the wall's middle into the
+    liquid, its value written outside the wall beyond the contact bars (bar_room cm); returns the
+    arrow scale (cm per N)."""
     walls = ds["wall_segment"].values
-    for name, w, r in zip(ds["wall"].values, walls, ds["wall_resultant"].values):
+    res = ds["wall_resultant"].values
+    scale = 30.0 / max(np.hypot(*res.T).max(), 1.0)
+    for name, w, r in zip(ds["wall"].values, walls, res):
         if np.hypot(*r) < 1.0:
             continue
         mid = 0.5 * (w[:2] + w[2:])
-        ax.annotate("", mid + r * scale, mid, arrowprops=dict(arrowstyle="->", color=COMPUTED, lw=1.5))
-        ax.text(*(mid + r * scale), f"{name}: ({r[0]:.0f}, {r[1]:.0f}) N", fontsize=7, color=COMPUTED)
+        e = (w[2:] - w[:2]) / np.hypot(*(w[2:] - w[:2]))
+        out = np.array([e[1], -e[0]])  # away from the liquid
+        ax.annotate("", mid + r * scale, mid, arrowprops=dict(arrowstyle="-|>", color=RESULTANT, lw=1.8), zorder=6)
+        at = mid + out * (bar_room + 3)
+        ha = "right" if out[0] < -0.5 else "left" if out[0] > 0.5 else "center"
+        va = "top" if out[1] < -0.5 else "bottom" if out[1] > 0.5 else "center"
+        ax.text(*at, f"{name}:\n({int(round(r[0]))}, {int(round(r[1]))}) N", fontsize=7, color=RESULTANT, ha=ha, va=va,
+                bbox=LABEL_BOX)
+    return scale
+
+
+def _scales(ax, xy, arrow_scale, bar_scale, bar_max):
+    """Scale of the resultant arrows and of the contact bars, stacked from xy down."""
+    x, y = xy
+    f = nice_value(15.0 / arrow_scale)
+    ax.annotate("", (x + f * arrow_scale, y), (x, y), arrowprops=dict(arrowstyle="-|>", color=RESULTANT, lw=1.8))
+    ax.text(x + f * arrow_scale + 2, y, f"{f:g} N (resultant)", va="center", fontsize=8, color=RESULTANT)
+    b = nice_value(bar_max)
+    scale_bar(ax, (x, y - 10), b * bar_scale, f"{b:g} N (contact $R_b$)", color=COMPUTED, label_right=True)
+
+
+def _surfaces(ax, ds):
+    """Measured free surface of every vessel (top particle per strip), coloured as its particles."""
+    for name, color in zip([str(n) for n in ds["vessel"].values], VESSEL_COLOURS):
+        surface_line(ax, ds, name, color)
 
 
 def flow_incomplete_figure(inputs, outputs, paper=None):
     """Paper Fig. 9: state at step 100,000 with boundary reactions and sum F_x."""
     ds = read(inputs[0])
-    fig, ax = plt.subplots(figsize=(12, 5.5))
+    fig, ax = plt.subplots(figsize=(12, 6.2))
     fm = _state_axes(ax, ds)
-    _reaction_arrows(ax, ds, 0.004)
+    _surfaces(ax, ds)
     mag = np.hypot(*ds["contact_force"].values.T)
-    _contact_bars(ax, ds, np.full(len(mag), np.nan), 12.0 / max(mag.max(), 1.0))
+    bar_scale = 12.0 / max(mag.max(), 1.0)
+    _contact_bars(ax, ds, np.full(len(mag), np.nan), bar_scale)
+    arrow_scale = _reaction_arrows(ax, ds, 12.0)
+    _scales(ax, (5, -35), arrow_scale, bar_scale, mag.max())
     sfx = fm["sum_fx_N"]
-    ax.set_title(f"(Fig. 9) step {int(ds['steps']):,}: sum of horizontal wall reactions ΣF_x = {sfx:+.0f} N "
-                 f"(paper: ΣF_x >> 0, to the right); max|F| = {float(ds['residual']):.3g} N; "
+    ax.set_title(f"(Fig. 9) {state_phrase(ds)}: sum of horizontal wall reactions ΣF_x = {sfx:+.0f} N "
+                 f"(paper: ΣF_x >> 0, to the right)\nmax|F| = {float(ds['residual']):.3g} N; "
                  f"{fm['particles_second']} of {ds.sizes['particle']} particles transferred")
-    ax.plot([], [], color=COMPUTED, lw=2.2, label="contact reactions $R_b$ (bars) and wall resultants (arrows)")
-    ax.legend(loc="upper right", fontsize=8)
-    ax.set_ylim(-75, 115)
+    ax.plot([], [], color=COMPUTED, lw=2.2, label="contact reactions $R_b$ (bars outside the walls)")
+    ax.plot([], [], color=RESULTANT, lw=1.8, marker=">", label="resultant reaction of each wall on the liquid (arrows)")
+    legend_below(ax, ncol=1)
+    ax.set_xlim(-45, 355)
+    ax.set_ylim(-78, 108)
     fig.suptitle(run_caption(ds), fontsize=8)
     save(fig, outputs)
 
 
 def flow_complete_figure(inputs, outputs, paper=None):
-    """Paper Fig. 10: final state, particles left, level in the second vessel,
-    and the hydrostatic overlay on the second vessel's walls."""
+    """Paper Fig. 10: final state, particles left, the measured surface in both vessels,
+    the paper's measured and expected levels, and the hydrostatic overlay on the second
+    vessel's walls."""
     ds = read(inputs[0])
     paper = paper or {}
-    fig, ax = plt.subplots(figsize=(12, 6))
+    fig, ax = plt.subplots(figsize=(12, 6.6))
     fm = _state_axes(ax, ds)
     second = str(ds["vessel"].values[-1])
     e, (_, _, mag, th) = metrics.contact_loads(ds, second)
     v = metrics.vessel_view(ds, second)
-    _contact_bars(ax, ds, th, 15.0 / np.nanmax(np.concatenate([mag, th])))
+    bar_scale = 15.0 / np.nanmax(np.concatenate([mag, th]))
+    _contact_bars(ax, ds, th, bar_scale)
+    _surfaces(ax, ds)
     x0, x1 = v["x_range"]
     fy = v["floor_y"]
-    ax.plot([x0, x1], [e["level"]] * 2, "--", color=COMPUTED, lw=1)
-    ax.text(x1 - 2, e["level"] + 2, f"level {e['depth']:.1f} cm above the floor (ours)", color=COMPUTED, ha="right")
+    if "level_second" in paper:
+        ax.plot([x0, x1], [fy + paper["level_second"]] * 2, label=f"paper: level measured in the second vessel "
+                f"{paper['level_second']:.1f} cm above its floor", **PAPER_LEVEL)
     if "level_expected" in paper:
-        ax.plot([x0, x1], [fy + paper["level_expected"]] * 2, ":", color=PAPER, lw=1.2)
-        ax.text(x0 + 2, fy + paper["level_expected"] + 2, f"paper: expected {paper['level_expected']:g} cm, "
-                f"observed {paper.get('level_second', np.nan):g} cm", color=PAPER)
+        ax.plot([x0, x1], [fy + paper["level_expected"]] * 2, label=f"paper: level expected from the particles "
+                f"transferred, {paper['level_expected']:.1f} cm", **PAPER_EXPECTED)
     ax.plot([], [], color=COMPUTED, lw=2.2, label="computed reaction $R_b$")
-    ax.plot([], [], color=THEORY, lw=2.2, label="hydrostatic theory, second vessel (flat level, tributary length)")
-    ax.legend(loc="upper right", fontsize=8)
+    ax.plot([], [], color=THEORY, lw=2.2, label="hydrostatic theory, second vessel (flat level at the mean depth)")
+    b = nice_value(np.nanmax(mag))
+    scale_bar(ax, (5, -35), b * bar_scale, f"{b:g} N (contact $R_b$)", color=COMPUTED, label_right=True)
+    legend_below(ax, ncol=1)
     left = fm["particles_left"]
-    exp_ours = (ds.sizes["particle"] - left) / ds.sizes["particle"] * paper.get("level_first", np.nan) / 2
-    ax.set_title(f"(Fig. 10) step {int(ds['steps']):,}: {left} particles left in the first vessel "
-                 f"(paper {paper.get('particles_left', '?')}); second vessel depth {e['depth']:.1f} cm "
-                 f"(paper {paper.get('level_second', '?')} cm; ((N - {left})/N) x {paper.get('level_first', '?')}/2 "
-                 f"= {exp_ours:.1f} cm)\nsecond-vessel loads: floor {e.get('floor_err', np.nan):+.1%}, "
-                 f"side walls {e['side_err']:+.1%} against hydrostatics")
-    ax.set_ylim(-75, 115)
+    n = ds.sizes["particle"]
+    exp_ours = (n - left) / n * paper.get("level_first", np.nan) / 2
+    ax.set_title(f"(Fig. 10) {state_phrase(ds)}: {left} particles left in the first vessel "
+                 f"(paper {paper.get('particles_left', '?')})\nsecond vessel: mean depth {e['depth']:.1f} cm "
+                 f"(paper {paper.get('level_second', np.nan):.1f} cm); from the particles transferred ((N - {left})/N) x "
+                 f"{paper.get('level_first', '?')}/2 = {exp_ours:.1f} cm\nsecond-vessel loads against hydrostatics: "
+                 f"floor {e.get('floor_err', np.nan):+.1%}, side walls {e['side_err']:+.1%}")
+    ax.set_xlim(-15, 335)
+    ax.set_ylim(-62, 108)
     fig.suptitle(run_caption(ds), fontsize=8)
     save(fig, outputs)
 
@@ -92,33 +136,45 @@ def flow_complete_figure(inputs, outputs, paper=None):
 def flow_history_figure(inputs, outputs, chains=None):
     """Particles per vessel, sum F_x and max|F| against the step along each chain.
 
-    chains: {label: [run file stems in order]}; inputs are the run files.
+    chains: {label: [run file stems in order]}; inputs are the run files.  Each run of a
+    chain is a numbered, alternately shaded stretch of steps, named in the column's key.
     """
     by_stem = {p.rsplit("/", 1)[-1].removesuffix(".nc"): p for p in inputs}
-    fig, axes = plt.subplots(3, len(chains), figsize=(6.5 * len(chains), 9), sharex="col", squeeze=False)
+    fig, axes = plt.subplots(3, len(chains), figsize=(6.5 * len(chains), 9.5), sharex="col", squeeze=False)
     for col, (label, stems) in enumerate(chains.items()):
         ax_n, ax_f, ax_m = axes[:, col]
-        for stem in stems:
+        key = []
+        for k, stem in enumerate(stems):
             ds = read(by_stem[stem])
+            start, end = int(ds["start_step"]), int(ds["steps"])  # both counted from the chain's start
+            key.append(f"{k + 1}: {stem} ({ds.attrs['variant']} update, steps {start:,}-{end:,}, "
+                       f"{ds.attrs['status']})")
+            for ax in (ax_n, ax_f, ax_m):
+                if k % 2 == 0:
+                    ax.axvspan(start, end, color="0.93", lw=0, zorder=0)
+            ax_n.annotate(f"{k + 1}", (0.5 * (start + end), 1.0), xycoords=("data", "axes fraction"),
+                          xytext=(0, 2), textcoords="offset points", ha="center", va="bottom", fontsize=8,
+                          fontweight="bold")
             if "hist_step" in ds:
                 ax_m.plot(ds["hist_step"], ds["hist_fmax"], lw=0.6, color="k")
                 ax_m.fill_between(ds["hist_step"], ds["hist_fmax_lo"], ds["hist_fmax_hi"], color="gray", alpha=0.3, lw=0)
             if "hist_vessel_count" in ds:
                 st = ds["sample_step"].values
-                for name, color in zip(ds["vessel"].values, ("tab:green", "k")):
+                for name, color in zip(ds["vessel"].values, VESSEL_COLOURS):
                     ax_n.plot(st, ds["hist_vessel_count"].sel(vessel=name), color=color,
                               label=f"{name} vessel" if stem == stems[1] else None)
                 ax_f.plot(st, ds["hist_sum_fx"], color=COMPUTED)
-            ax_m.axvline(int(ds["start_step"]), color="gray", ls=":", lw=0.8)
-            ax_m.text(int(ds["start_step"]), 1e3, f" {stem}\n {ds.attrs['variant']}", fontsize=6, va="top")
         ax_n.set_ylabel("particles")
-        ax_n.legend(fontsize=8)
-        ax_n.set_title(f"{label} chain: {' -> '.join(stems)}")
+        ax_n.legend(fontsize=8, loc="center right")
+        ax_n.set_title(f"{label} chain\n\n", fontsize=9)
         ax_f.axhline(0, color="k", lw=0.5)
         ax_f.set_ylabel("ΣF_x of wall reactions (N)")
         ax_m.set_yscale("log")
         ax_m.axhline(0.1, color="k", ls=":", lw=0.8)
         ax_m.set_ylabel("max|F| (N)")
-        ax_m.set_xlabel("algorithm step (from the start of application 1 / 2)")
-    fig.suptitle("Flow history (band: min-max of max|F| over each record stride; dotted: f_tol = 0.1 N)")
+        ax_m.set_xlabel("algorithm step, thousands (k), from the start of application 1 / 2")
+        ax_m.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v / 1000:g}k"))
+        ax_m.text(0.0, -0.22, "\n".join(key), transform=ax_m.transAxes, va="top", ha="left", fontsize=8)
+    fig.suptitle("Flow history (band: min-max of max|F| over each record stride; dotted: f_tol = 0.1 N;\n"
+                 "numbers: the runs of each chain, listed under it; shading alternates between runs)")
     save(fig, outputs)

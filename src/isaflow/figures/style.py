@@ -110,13 +110,17 @@ def surface_line(ax, ds, vessel, color, name=None):
         return None
     s = metrics.surface_measures(ds, vessel)
     depth = metrics.level_of(ds, vessel) - v["floor_y"]
-    ax.plot(x, top, "-", color=color, lw=1.3, marker="_", ms=8, zorder=4,
+    ax.plot(x, top, "-", color=color, lw=1.1, drawstyle="steps-mid", zorder=4,
             label=f"measured surface, {name or vessel} vessel (top particle per {float(ds.attrs['spacing']):g} cm strip): "
-                  f"slope {s['slope_deg']:.1f}°, range {s['surface_range_cm']:.1f} cm, mean depth {depth:.1f} cm")
+                  f"slope {s['slope_deg']:.1f}°{_falls(s['slope_deg'])}, range {s['surface_range_cm']:.1f} cm, mean depth {depth:.1f} cm")
     if len(x) > 1:
         k = np.polyfit(x, top, 1)
         ax.plot(x, np.polyval(k, x), ":", color=color, lw=1, zorder=4)
     return s
+
+
+def _falls(slope_deg):
+    return " (falls to the right)" if slope_deg < 0 else " (rises to the right)" if slope_deg > 0 else ""
 
 
 def literal_levels(calibration_csv, k_wall=2000, ratio=0.5):
