@@ -203,6 +203,12 @@ def test_reduced_study_builds_both_figures_and_the_report_fragment(tmp_path):
     # FIRE needs fewer force evaluations than the capped update and than the paper's reported 2000 steps
     ratio = pd.read_csv(tmp_path / "results" / "study" / "fire_ratio.csv").iloc[0]
     assert ratio["ratio_vs_capped"] > 1 and ratio["ratio_vs_paper_reported"] > 1
+    # the Snakemake report of those targets holds both figures with their captions
+    rep = subprocess.run([sys.executable, "-m", "snakemake", "--report", "report.html", *targets[:2]], cwd=tmp_path,
+                         env=env, capture_output=True, text=True, timeout=300)
+    assert rep.returncode == 0, rep.stdout[-2000:] + rep.stderr[-2000:]
+    html = (tmp_path / "report.html").read_text()
+    assert "error_vs_runtime.png" in html and "stability_map.png" in html and "Studies" in html
     text = (tmp_path / "results" / "report" / "30_study.md").read_text()
     assert "## Error against work, and numerical stability" in text and "Which configuration to pick" in text
     assert " s)" not in text and "wall_time" not in text  # no timing in the report text
