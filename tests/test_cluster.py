@@ -69,7 +69,7 @@ def write_run(path, pos, wall_time):
                attrs={"method": "isa", "date_created": str(wall_time)}).to_netcdf(path)
 
 
-def run_tree(root, pos, wall_time, table="a,b\n1,2\n"):
+def run_tree(root, pos, wall_time, table="level_cm,wall_time_s\n1.5,2.0\n"):
     (root / "results" / "runs").mkdir(parents=True)
     (root / "figures").mkdir()
     write_run(root / "results" / "runs" / "r.nc", pos, wall_time)
@@ -85,7 +85,8 @@ def compare(a, b):
 
 def test_outputs_equal_apart_from_timing(tmp_path):
     pos = np.arange(6.0).reshape(3, 2)
-    code, out = compare(run_tree(tmp_path / "a", pos, 1.0), run_tree(tmp_path / "b", pos, 2.5))
+    code, out = compare(run_tree(tmp_path / "a", pos, 1.0),
+                        run_tree(tmp_path / "b", pos, 2.5, table="level_cm,wall_time_s\n1.5,7.0\n"))
     assert code == 0 and "2 of 2 outputs equal" in out
 
 
@@ -94,7 +95,7 @@ def test_outputs_that_differ_are_caught(tmp_path, change):
     pos = np.arange(6.0).reshape(3, 2)
     a = run_tree(tmp_path / "a", pos, 1.0)
     b = run_tree(tmp_path / "b", pos + (np.nextafter(pos, np.inf) - pos) * (change == "position"), 1.0,
-                 table="a,b\n1,3\n" if change == "table" else "a,b\n1,2\n")
+                 table="level_cm,wall_time_s\n1.6,2.0\n" if change == "table" else "level_cm,wall_time_s\n1.5,2.0\n")
     if change == "missing":
         (b / "figures" / "t.csv").unlink()
     code, out = compare(a, b)

@@ -4,11 +4,16 @@
 
 Walks results/, figures/ and docs/ of LOCAL_CLONE (files newer than STAMP
 only, i.e. what the run wrote; results/benchmarks/ is timing, skipped) and requires the same file in SLURM_CLONE with equal content:
-run files (.nc) variable by variable, bit for bit, except wall-clock timings
-and the creation-time attributes; PNG by pixels; everything else byte for byte.
+run files (.nc) variable by variable, bit for bit, except wall-clock timings,
+the creation-time attributes and the hashes of input run files (which hold
+their own timings; those files are compared themselves); PNG by pixels; CSV
+and Markdown tables cell by cell except measured times (columns or rows that
+TIMING matches: solver/job seconds, speed-ups); everything else byte for byte.
 Prints one line per file; exit status 1 if any differs or is missing.
 """
 
+import csv
+import re
 import sys
 from pathlib import Path
 
@@ -16,6 +21,7 @@ import numpy as np
 
 SKIP_DIRS = ("results/benchmarks",)
 TIME_ATTRS = {"date_created", "time_coverage_start", "time_coverage_end", "history"}
+TIMING = re.compile(r"wall_time|_s$|speedup|computing time|\(s\)", re.IGNORECASE)
 
 
 def is_timing(var):
@@ -34,8 +40,10 @@ def netcdf_difference(a, b):
         for n in sorted(names_a):
             if not np.array_equal(da[n].values, db[n].values, equal_nan=da[n].dtype.kind == "f"):
                 return f"variable {n} differs"
-        attrs = [k for k in set(da.attrs) | set(db.attrs)
-                 if k not in TIME_ATTRS and str(da.attrs.get(k)) != str(db.attrs.get(k))]
+        run_file_hashes = {k.removesuffix("_file") + "_sha256" for k, v in da.attrs.items()
+                           if k.endswith("_file") and str(v).endswith(".nc")}
+        attrs = [k for k in set(da.attrs) | set(db.attrs) if k not in TIME_ATTRS | run_file_hashes
+                 and str(da.attrs.get(k)) != str(db.attrs.get(k))]
         return f"attributes differ: {sorted(attrs)}" if attrs else ""
 
 
@@ -44,6 +52,29 @@ def png_difference(a, b):
 
     pa, pb = imread(a), imread(b)
     return "" if pa.shape == pb.shape and np.array_equal(pa, pb) else "pixels differ"
+
+
+def csv_without_timing(path):
+    rows = list(csv.reader(path.open()))
+    keep = [i for i, name in enumerate(rows[0]) if not TIMING.search(name.strip())] if rows else []
+    return [[row[i] for i in keep if i < len(row)] for row in rows]
+
+
+def markdown_without_timing(path):
+    """Lines of a Markdown file; table rows as lists of cells without timing columns or rows."""
+    out, header = [], None
+    for line in path.read_text().splitlines():
+        if not line.startswith("|"):
+            out.append(line)
+            header = None
+            continue
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if header is None:
+            header = cells
+            out.append([c for c in cells if not TIMING.search(c)])
+        elif not TIMING.search(cells[0]):
+            out.append([c for c, h in zip(cells, header) if not TIMING.search(h)])
+    return out
 
 
 def difference(a, b):
@@ -55,6 +86,10 @@ def difference(a, b):
         return netcdf_difference(a, b)
     if a.suffix == ".png":
         return png_difference(a, b)
+    if a.suffix == ".csv":
+        return "" if csv_without_timing(a) == csv_without_timing(b) else "cells differ (not timing)"
+    if a.suffix == ".md":
+        return "" if markdown_without_timing(a) == markdown_without_timing(b) else "text differs (not timing)"
     return "bytes differ"
 
 
