@@ -2,6 +2,8 @@
 (figures/error_vs_runtime.csv, results/study/stability_map.csv, figures/stability_cases.csv),
 which isaflow.tables builds from the run files."""
 
+import textwrap
+
 import numpy as np
 import pandas as pd
 
@@ -20,13 +22,17 @@ PANELS = [
 
 
 def error_vs_runtime_figure(inputs, outputs):
-    """Every error measure against solver wall-clock time, log-log: one marker per run,
-    colour = algorithm, marker = lattice, filled = converged to f_tol."""
+    """Every error measure against solver wall-clock time, log-log: one marker per run;
+    colour = update rule, marker shape = lattice, filled = converged to f_tol, open = not;
+    a black ring marks the paper's configuration of each lattice."""
     tab = pd.read_csv(inputs[0])
+    if "residual" not in tab and "residual_N" in tab:
+        tab["residual"] = tab["residual_N"]
     fig, axes = plt.subplots(2, 3, figsize=(15, 9))
     axes = axes.ravel()
+    variants = [v for v in VARIANTS if v in set(tab["variant"])]
     for ax, (col, ylabel, title) in zip(axes, PANELS):
-        for var in [v for v in VARIANTS if v in set(tab["variant"])]:
+        for var in variants:
             for lat, marker in LATTICE_MARKER.items():
                 g = tab[(tab["variant"] == var) & (tab["lattice"] == lat)].sort_values("du_factor")
                 g = g[np.isfinite(g[col])]
@@ -38,12 +44,9 @@ def error_vs_runtime_figure(inputs, outputs):
                 ax.scatter(g["wall_time_s"][conv], y[conv], marker=marker, color=c, s=36, zorder=3)
                 ax.scatter(g["wall_time_s"][~conv], y[~conv], marker=marker, facecolors="none", edgecolors=c, s=36,
                            zorder=3)
-        paper = tab[tab["paper_config"].astype(bool)]
-        for k, (_, r) in enumerate(paper.iterrows()):
-            if np.isfinite(r[col]):
-                ax.annotate(f"paper's config\n({r['lattice']}, du {10 * r['du_cm']:g} mm)",
-                            (r["wall_time_s"], max(abs(r[col]), FLOOR)), xytext=((-80, -34), (14, 18))[k % 2],
-                            textcoords="offset points", fontsize=7, arrowprops=dict(arrowstyle="->", lw=0.6))
+        paper = tab[tab["paper_config"].astype(bool) & np.isfinite(tab[col])]
+        ax.scatter(paper["wall_time_s"], np.maximum(paper[col].abs(), FLOOR), s=230, facecolors="none",
+                   edgecolors="k", lw=1.1, zorder=4)
         if col == "residual":
             for ft in sorted(set(tab["f_tol_N"])):
                 ax.axhline(ft, color="gray", ls=":", lw=0.8)
@@ -54,23 +57,33 @@ def error_vs_runtime_figure(inputs, outputs):
         ax.set_ylabel(ylabel)
         ax.set_title(title)
         ax.grid(True, which="major", alpha=0.3)
-    # legend panel
-    leg = axes[-1]
+    _error_legend(axes[-1], tab, variants)
+    fig.subplots_adjust(hspace=0.3)
+    fig.suptitle("Error against run time, single 100 cm vessel: paper's update and two variants (not in the paper)")
+    save(fig, outputs)
+
+
+def _error_legend(leg, tab, variants):
+    """The key of error_vs_runtime: colour patches (update rule), grey filled shapes (lattice),
+    fill (outcome) shown on a shape no lattice uses, and the ring (the paper's configuration)."""
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+
     leg.axis("off")
-    for var in [v for v in VARIANTS if v in set(tab["variant"])]:
-        leg.plot([], [], "o", color=variant_style("isa", var)[0], label=variant_style("isa", var)[1])
+    h = [Patch(color=variant_style("isa", v)[0], label=variant_style("isa", v)[1]) for v in variants]
     for lat, marker in LATTICE_MARKER.items():
         g = tab[tab["lattice"] == lat]
         if len(g):
-            leg.plot([], [], marker, color="gray", label=f"{lat}: a = {g['a_cm'].iloc[0]:g} cm, "
-                                                        f"{int(g['particles'].iloc[0])} particles")
-    leg.plot([], [], "o", color="gray", label="filled: converged (max|F| < f_tol)")
-    leg.plot([], [], "o", mfc="none", color="gray", label="open: cycle / step limit / escaped")
-    leg.legend(loc="center", fontsize=8, frameon=False)
-    leg.text(0.5, 0.05, "du swept from 0.1x to 100x the paper's rule;\n"
+            h.append(Line2D([], [], ls="none", marker=marker, color="gray",
+                            label=f"shape: {lat} lattice, a = {g['a_cm'].iloc[0]:g} cm, {int(g['particles'].iloc[0])} particles"))
+    h.append(Patch(facecolor="gray", edgecolor="gray", label="filled: converged (max|F| < f_tol)"))
+    h.append(Patch(facecolor="none", edgecolor="gray", label="open: cycle / step limit / escaped"))
+    paper = tab[tab["paper_config"].astype(bool)]
+    cfg = "; ".join(f"{r['lattice']} du {10 * r['du_cm']:g} mm" for _, r in paper.iterrows())
+    h.append(Line2D([], [], ls="none", marker="o", ms=13, mfc="none", mec="k", label=f"ring: the paper's configuration\n({cfg})"))
+    leg.legend(handles=h, loc="center", fontsize=8, frameon=False)
+    leg.text(0.5, 0.0, "du swept from 0.1x to 100x the paper's rule;\n"
              f"|errors| below {FLOOR:g} are drawn at {FLOOR:g}", transform=leg.transAxes, ha="center", fontsize=7)
-    fig.suptitle("Error against run time, single 100 cm vessel: paper's update and two variants (not in the paper)")
-    save(fig, outputs)
 
 
 def stability_map_figure(inputs, outputs):
@@ -99,17 +112,18 @@ def stability_map_figure(inputs, outputs):
         for kf, kg in g.groupby("k_factor"):
             kg = kg.sort_values("du_factor")
             ax.plot(kg["k_du_over_w"], kg["du_over_a"], color="gray", lw=0.4, zorder=1)
-            ax.text(kg["k_du_over_w"].iloc[-1], kg["du_over_a"].iloc[-1] * 1.5, f"k_b = {kg['k_wall'].iloc[0]:.0e}",
-                    fontsize=6, ha="center", color="gray", rotation=60)
+            # the line's k_b under its lowest point, horizontal, inside the axes
+            ax.annotate(f"{kg['k_wall'].iloc[0]:.0e}".replace("e+0", "e"), (kg["k_du_over_w"].iloc[0], kg["du_over_a"].iloc[0]),
+                        xytext=(0, -11), textcoords="offset points", fontsize=6.5, ha="center", va="top", color="dimgray")
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_xlabel("k_b du / w (-)  [k_b: wall stiffness, N/cm; du: cm; w: N]")
         ax.set_ylabel("du / a (-)  [a: lattice spacing, cm]")
-        ax.set_ylim(top=g["du_over_a"].max() * 8)
+        ax.set_ylim(g["du_over_a"].min() / 8, g["du_over_a"].max() * 8)
         ax.set_title(f"{variant_style('isa', var)[1]}\nstep limit {int(g['max_steps'].max()):,} steps; "
-                     "lines: constant k_b (N/cm)")
+                     "grey lines: constant k_b,\nits value (N/cm) under the line's lowest point")
         ax.grid(True, alpha=0.3)
-        ax.legend(fontsize=7, loc="lower right")
+        ax.legend(fontsize=7, loc="upper left")  # the empty corner: constant-k_b lines rise to the right
     # table of extreme cases
     ax = fig.add_subplot(gs[1, :])
     ax.axis("off")
@@ -132,11 +146,14 @@ def stability_map_figure(inputs, outputs):
                 col.append("white")
         cells.append(row)
         colors.append(col)
-    table = ax.table(cellText=cells, cellColours=colors, colLabels=["extreme case"] + [variant_style("isa", v)[1] for v in cvars],
+    heads = ["extreme case"] + [textwrap.fill(variant_style("isa", v)[1], 30) for v in cvars]
+    table = ax.table(cellText=cells, cellColours=colors, colLabels=heads,
                      loc="upper center", cellLoc="left", colWidths=[0.43] + [0.19] * len(cvars))
     table.auto_set_font_size(False)
     table.set_fontsize(6.5)
     table.scale(1, 1.5)
+    for c in range(len(heads)):  # room for the two-line headers
+        table[0, c].set_height(2 * table[1, 0].get_height())
     ax.set_title("Extreme cases (figures/stability_cases.csv): outcome and steps per update rule", fontsize=9)
     fig.suptitle("Numerical stability of the single vessel: outcome classes of every run (status in its run file)")
     save(fig, outputs)
