@@ -1,8 +1,8 @@
 """MPS cost per step against N: predict (numba: explicit step, neighbour lists, number density, CSR assembly),
 pressure solve (amg, cg_jacobi, direct) and correct (numba: gradient, update), each timed separately.
 
-A liquid block at rest in a square tank scaled so that N liquid particles fill it; 20 steps after 2 warm-up
-steps, median per step.  Writes benchmarks/results/mps_step_cost.csv.  Run: python benchmarks/bench_mps.py [--quick]
+A liquid block at rest in the single tank with a spacing giving about N liquid particles (a whole number of
+columns, so the lattice is square and starts at n = n0); 20 steps after 2 warm-up steps, median per step.  Writes benchmarks/results/mps_step_cost.csv.  Run: python benchmarks/bench_mps.py [--quick]
 """
 
 import sys
@@ -23,7 +23,7 @@ def main(quick=False):
     tank = load_tank(ROOT / "config/tanks/single.yaml")
     rows = []
     for n in SIZES[:3] if quick else SIZES:
-        l0 = 100.0 / np.sqrt(n * 100.0 / 72.5)
+        l0 = 100.0 / round(np.sqrt(n * 100.0 / 72.5))  # whole columns: the lattice is square (dx = l0)
         for method in SOLVERS:
             if method == "direct" and n > 5000:
                 continue

@@ -1,16 +1,22 @@
-# Issue 11: MPS with three pressure source terms on the shared tank (single vessel, then the flow).
-# Package: src/isaflow/methods/mps/.  Runs -> summary -> figures, claims, report fragment 55.
+# Issue 11: MPS with three pressure source terms on the shared tank (single vessel, then the flow),
+# stiff and extreme cases.  Package: src/isaflow/methods/mps/.  Runs -> summary -> figures, claims,
+# report fragment 55.  Every rule calls one package function through scripts/call.py.
 import yaml as _mps_yaml
 
 MPS_CFG = "config/methods/mps.yaml"
 with open(MPS_CFG) as _fh:
     _MPS = _mps_yaml.safe_load(_fh)
 MPS_VARIANTS = ["standard", "hattori", "mixed"]
+MPS_STIFF = ["large_dt", "small_re", "no_relaxation", "on_wall"]
 MPS_DX = {case: [f"{l0:.3g}" for l0 in _MPS["runs"][f"{case}_spacings"]["value"]] for case in ("single", "flow")}
-MPS_CODE = [f"src/isaflow/methods/mps/{m}.py" for m in ("model", "boundary", "pressure", "solver", "settings", "outputs")]
-MPS_RUNS = [f"results/mps/{case}_{v}_dx{dx}.nc" for case in ("single", "flow") for v in MPS_VARIANTS for dx in MPS_DX[case]]
+MPS_CODE = code("methods/mps/model", "methods/mps/boundary", "methods/mps/pressure", "methods/mps/solver",
+                "methods/mps/settings", "methods/mps/outputs")
+MPS_SINGLE = [f"results/mps/single_{v}_dx{dx}.nc" for v in MPS_VARIANTS for dx in MPS_DX["single"]]
+MPS_FLOW = [f"results/mps/flow_{v}_dx{dx}.nc" for v in MPS_VARIANTS for dx in MPS_DX["flow"]]
+MPS_STIFF_RUNS = [f"results/mps/stiff_{c}.nc" for c in MPS_STIFF]
+MPS_RUNS = MPS_SINGLE + MPS_FLOW + MPS_STIFF_RUNS
 
-register(MPS_RUNS + ["results/mps/summary.csv"] + figure("mps_wall_loads") + figure("mps_flow"),
+register(MPS_RUNS + ["results/mps/summary.csv"] + figure("mps_wall_loads") + figure("mps_flow") + figure("mps_rest"),
          ["results/report/55_mps.md"], ["results/claims/mps.csv"])
 
 
@@ -23,30 +29,49 @@ rule mps_single:
         "results/mps/single_{variant}_dx{dx}.nc",
     wildcard_constraints:
         variant="|".join(MPS_VARIANTS),
+    params:
+        func="methods.mps.outputs.run_case",
+        kw=lambda wc: dict(case="single", variant=wc.variant, label=wc.dx),
     log:
         "logs/mps/single_{variant}_dx{dx}.log",
-    run:
-        from isaflow.methods.mps.outputs import write_run
-
-        write_run(input.cfg, "single", wildcards.variant, wildcards.dx, output[0], log[0])
+    script:
+        "../../scripts/call.py"
 
 
 rule mps_flow:
     input:
         cfg=MPS_CFG,
         tank="config/tanks/flow_step50.yaml",
-        start="results/mps/single_{variant}_dx{dx}.nc",
         code=MPS_CODE,
     output:
         "results/mps/flow_{variant}_dx{dx}.nc",
     wildcard_constraints:
         variant="|".join(MPS_VARIANTS),
+    params:
+        func="methods.mps.outputs.run_case",
+        kw=lambda wc: dict(case="flow", variant=wc.variant, label=wc.dx),
     log:
         "logs/mps/flow_{variant}_dx{dx}.log",
-    run:
-        from isaflow.methods.mps.outputs import write_run
+    script:
+        "../../scripts/call.py"
 
-        write_run(input.cfg, "flow", wildcards.variant, wildcards.dx, output[0], log[0], start=input.start)
+
+rule mps_stiff:
+    input:
+        cfg=MPS_CFG,
+        tank="config/tanks/single.yaml",
+        code=MPS_CODE,
+    output:
+        "results/mps/stiff_{case}.nc",
+    wildcard_constraints:
+        case="|".join(MPS_STIFF),
+    params:
+        func="methods.mps.outputs.run_stiff",
+        kw=lambda wc: dict(case=wc.case),
+    log:
+        "logs/mps/stiff_{case}.log",
+    script:
+        "../../scripts/call.py"
 
 
 rule mps_summary:
@@ -55,41 +80,67 @@ rule mps_summary:
         code=MPS_CODE + code("metrics", "theory"),
     output:
         "results/mps/summary.csv",
+    params:
+        func="methods.mps.outputs.summary",
     log:
         "logs/mps/summary.log",
-    run:
-        from isaflow.methods.mps.outputs import summary
-
-        summary(input.runs, output[0])
+    script:
+        "../../scripts/call.py"
 
 
-rule mps_figures:
+rule mps_figure_loads:
     input:
-        runs=MPS_RUNS,
-        code="src/isaflow/methods/mps/figures.py",
+        runs=MPS_SINGLE,
+        code=code("methods/mps/figures"),
     output:
-        loads=figure("mps_wall_loads"),
-        flow=figure("mps_flow"),
+        figure("mps_wall_loads"),
+    params:
+        func="methods.mps.figures.wall_loads",
     log:
-        "logs/mps/figures.log",
-    run:
-        from isaflow.methods.mps import figures
+        "logs/mps/figure_loads.log",
+    script:
+        "../../scripts/call.py"
 
-        figures.wall_loads([r for r in input.runs if "/single_" in r], output.loads)
-        figures.flow([f"results/mps/flow_{v}_dx{MPS_DX['flow'][-1]}.nc" for v in MPS_VARIANTS], output.flow)
+
+rule mps_figure_rest:
+    input:
+        runs=MPS_SINGLE,
+        code=code("methods/mps/figures"),
+    output:
+        figure("mps_rest"),
+    params:
+        func="methods.mps.figures.rest",
+    log:
+        "logs/mps/figure_rest.log",
+    script:
+        "../../scripts/call.py"
+
+
+rule mps_figure_flow:
+    input:
+        runs=[f"results/mps/flow_{v}_dx{MPS_DX['flow'][-1]}.nc" for v in MPS_VARIANTS],
+        code=code("methods/mps/figures"),
+    output:
+        figure("mps_flow"),
+    params:
+        func="methods.mps.figures.flow",
+    log:
+        "logs/mps/figure_flow.log",
+    script:
+        "../../scripts/call.py"
 
 
 rule mps_report:
     input:
         summary="results/mps/summary.csv",
         cfg=MPS_CFG,
-        code="src/isaflow/methods/mps/report.py",
+        code=code("methods/mps/report"),
     output:
         claims="results/claims/mps.csv",
         report="results/report/55_mps.md",
+    params:
+        func="methods.mps.report.write",
     log:
         "logs/mps/report.log",
-    run:
-        from isaflow.methods.mps.report import write
-
-        write(input.summary, input.cfg, output.claims, output.report)
+    script:
+        "../../scripts/call.py"

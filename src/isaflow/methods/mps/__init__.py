@@ -1,5 +1,5 @@
-"""MPS (moving particle semi-implicit, Koshizuka & Oka 1996) on the shared tank,
-with three source terms of its pressure Poisson equation (variants)."""
+"""MPS (moving particle semi-implicit, Koshizuka & Oka 1996, as the public MPS-Basic code implements it)
+on the shared tank, with three source terms of its pressure Poisson equation (variants)."""
 
 from isaflow.methods import Method, Variant
 
@@ -8,7 +8,7 @@ METHOD = Method(
     label="MPS (Koshizuka & Oka 1996), semi-implicit",
     paper="hattori_mps_pressure_poisson.txt",
     variants={
-        "standard": Variant("standard", "MPS, standard source rho0/dt^2 (n0 - n*)/n0 (Koshizuka & Oka 1996; not the paper's method)",
+        "standard": Variant("standard", "MPS, standard source gamma rho0/dt^2 (n0 - n*)/n0, relaxation gamma as MPS-Basic (Koshizuka & Oka 1996; not the paper's method)",
                             "tab:blue", "s"),
         "hattori": Variant("hattori", "MPS, Hattori et al. eq. (6) source, Rho* = rho0 n*/n0 (not the paper's method)",
                            "tab:red", "D"),

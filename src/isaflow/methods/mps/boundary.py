@@ -1,8 +1,9 @@
 """Wall and dummy particles of a tank, the initial liquid block, and wall loads on panels.
 
 Walls (W, 4) cm, each oriented with the liquid on its left.  Every wall gets
-``layers`` rows of particles behind it at (k + 1/2) l0 (k = 0: WALL particles
-in the pressure equation; k >= 1: DUMMY particles for the number density), so
+``layers`` rows of particles behind it at (k + 1/2) l0 (k < pressure_layers:
+WALL particles in the pressure equation and the gradient; further rows: DUMMY
+particles for the number density only, as MPS-Basic's generators), so
 that the liquid's cells [0, l0]^2 tile the vessel exactly and a first-layer
 particle faces l0 of wall.  Rows are extended past an end joined to another
 wall (corners), and candidates on the liquid side of another wall are dropped.
@@ -25,9 +26,10 @@ def _frames(walls):
     return a, L, t, np.column_stack([-t[:, 1], t[:, 0]])
 
 
-def wall_particles(walls, l0, layers=3):
+def wall_particles(walls, l0, layers=3, pressure_layers=1):
     """Boundary particles of the walls.
 
+    layers: rows in all, pressure_layers of them WALL.
     Returns dict: pos (M, 2) cm, kind (M,) WALL/DUMMY, wall (M,) wall index;
     and the stretches of wall the first row faces: face_particle (F,) the
     particle, face_wall (F,), face_arc (F,) cm centre along the wall,
@@ -51,7 +53,7 @@ def wall_particles(walls, l0, layers=3):
                 s, faces = np.concatenate([s, L[w] + ext]), np.concatenate([faces, np.zeros(layers)])
             p = a[w] + s[:, None] * t[w] - (k + 0.5) * l0 * nrm[w]
             for q, sq, f in zip(p, s, faces):
-                cand.append((q[0], q[1], WALL if k == 0 else DUMMY, w, sq, f))
+                cand.append((q[0], q[1], WALL if k < pressure_layers else DUMMY, w, sq, f))
     cand = np.array(cand)
     keep = np.ones(len(cand), bool)
     reach = layers * l0
@@ -109,17 +111,9 @@ def load_map(walls, bnd, panel_length):
     return pw, pc, M
 
 
-def dummy_sources(bnd):
-    """(M,) index (into the boundary arrays) of the WALL particle whose pressure each boundary particle carries:
-    itself for WALL particles, the nearest WALL particle for DUMMY particles."""
-    walls = np.flatnonzero(bnd["kind"] == WALL)
-    _, k = cKDTree(bnd["pos"][walls]).query(bnd["pos"])
-    return walls[k]
-
-
-def assemble_particles(fluid_pos, walls, l0, layers=3):
+def assemble_particles(fluid_pos, walls, l0, layers=3, pressure_layers=1):
     """All particles: fluid first, then the boundary.  Returns (pos, kind, bnd dict)."""
-    bnd = wall_particles(walls, l0, layers)
+    bnd = wall_particles(walls, l0, layers, pressure_layers)
     pos = np.concatenate([fluid_pos, bnd["pos"]])
     kind = np.concatenate([np.full(len(fluid_pos), FLUID, np.int64), bnd["kind"]])
     return pos, kind, bnd

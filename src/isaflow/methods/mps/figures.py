@@ -1,5 +1,6 @@
 """MPS figures from run files: wall loads per panel against hydrostatics (Fig. 6-like, with the noise band),
-and the flow (Fig. 10-like snapshots and the final state)."""
+the rms speed of the liquid at rest against time (every single-vessel run, with its rest limit), and the
+flow (Fig. 10-like snapshots and the final state)."""
 
 from pathlib import Path
 
@@ -35,9 +36,10 @@ def pick_runs(paths):
     return [best[v][1] for v in VARIANTS if v in best]
 
 
-def wall_loads(paths, out):
+def wall_loads(runs, outputs):
     """Per variant (pick_runs): |panel force| [N] along the walls (mean and +- std over the window) vs hydrostatic theory."""
-    paths = pick_runs(paths)
+    out = outputs
+    paths = pick_runs(runs)
     n = len(paths)
     fig, axes = plt.subplots(1, n, figsize=(4.2 * n, 3.6), squeeze=False, sharey=True)
     for ax, p in zip(axes[0], paths):
@@ -58,14 +60,15 @@ def wall_loads(paths, out):
         ax.set_title(f"{ds.attrs['variant']}, l0 = {float(ds.attrs['spacing']):.3g} cm\n{ds.attrs['status']}", fontsize=9)
         ax.set_xlabel("10 cm panels along the walls (left, floor, right)")
     axes[0, 0].set_ylabel("wall force per panel |F| [N]")
-    axes[0, 0].legend(fontsize=7, loc="upper left", bbox_to_anchor=(0.0, 0.9))
+    axes[0, 0].legend(fontsize=7, loc="lower center")
     fig.tight_layout()
     _save(fig, out)
 
 
-def flow(paths, out):
+def flow(runs, outputs):
     """Rows: runs; columns: position snapshots of the flow [cm] with the walls."""
-    dss = [runfile.read(p) for p in paths]
+    out = outputs
+    dss = [runfile.read(p) for p in runs]
     ncol = max(ds.sizes.get("snapshot", 1) for ds in dss)
     fig, axes = plt.subplots(len(dss), ncol, figsize=(2.6 * ncol, 1.7 * len(dss) + 0.6), squeeze=False)
     for row, ds in zip(axes, dss):
@@ -89,3 +92,23 @@ def flow(paths, out):
         ax.set_ylabel("y [cm]", fontsize=7)
     fig.tight_layout()
     _save(fig, out)
+
+
+def rest(runs, outputs):
+    """One panel per source term: rms speed [cm/s] of the liquid started at rest against time, one line per
+    spacing, dashed: that spacing's rest limit (settings time.rest_fraction)."""
+    dss = [runfile.read(p) for p in runs]
+    fig, axes = plt.subplots(1, len(VARIANTS), figsize=(4.2 * len(VARIANTS), 3.4), squeeze=False, sharey=True)
+    for ax, name in zip(axes[0], VARIANTS):
+        mine = sorted((ds for ds in dss if ds.attrs["variant"] == name), key=lambda d: -float(d.attrs["spacing"]))
+        for k, ds in enumerate(mine):
+            c = plt.cm.viridis(k / max(1, len(mine) - 1) * 0.85)
+            ax.semilogy(ds["hist_time"].values, ds["hist_rms_speed"].values, color=c, lw=1.2,
+                        label=f"l0 = {float(ds.attrs['spacing']):.3g} cm ({ds.attrs['status']})")
+            ax.axhline(float(ds.attrs["rest_speed_cm_s"]), color=c, ls="--", lw=0.8)
+        ax.set_title(f"source term: {name}", fontsize=9)
+        ax.set_xlabel("time t [s]")
+        ax.legend(fontsize=7, loc="lower right")
+    axes[0, 0].set_ylabel("rms speed of the liquid [cm/s]\n(dashed: rest limit)")
+    fig.tight_layout()
+    _save(fig, outputs)

@@ -7,8 +7,9 @@ Koshizuka & Oka (1996) / Koshizuka, Nobe & Oka (1998), 2D (d = 2):
   phi^_i = min(phi_i, phi_j over neighbours) (K&O 1996's stabilised pressure gradient);
 - Laplacian <lap phi>_i = 2 d / (lambda n0) sum_j (phi_j - phi_i) w(r_ij);
 - divergence <div u>_i = d / n0 sum_j (u_j - u_i) . r_ij / |r_ij|^2 w(r_ij).
-r_ij = r_j - r_i.  Particle kinds: FLUID, WALL (first wall layer, in the
-pressure equation) and DUMMY (further wall layers, number density only).
+r_ij = r_j - r_i.  Particle kinds: FLUID, WALL (inner wall rows, in the
+pressure equation and the gradient) and DUMMY (outer rows, number density only).
+Reference implementation followed: MPS-Basic (github.com/MPS-Basic/MPS-Basic, src/mps.cpp, implicit.cpp).
 Units: cm, s, density N s^2 / cm^4 (2D), pressure N / cm^2.
 """
 
@@ -99,14 +100,15 @@ def laplacian(pos, f, kind, pi, pj, m, re, n0, lam):
 def gradient(pos, p, kind, pi, pj, m, re, n0):
     """(N, 2) MPS pressure gradient with p^_i = min over neighbours (K&O 1996).
 
-    All particles take part (dummies carry the pressure of their wall particle,
-    see boundary.dummy_sources), so the neighbourhood of a fluid particle next
-    to a wall is complete.  ``kind`` is kept for the caller's symmetry with the other operators.
+    Fluid and wall particles take part; dummy particles (no pressure) do not,
+    neither in the sum nor in the minimum (as MPS-Basic's calPressureGradient).
     """
     n = pos.shape[0]
     pmin = p.copy()
     for k in range(m):
         i, j = pi[k], pj[k]
+        if kind[i] == DUMMY or kind[j] == DUMMY:
+            continue
         if np.hypot(pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1]) < re:
             pmin[i] = min(pmin[i], p[j])
             pmin[j] = min(pmin[j], p[i])
@@ -115,6 +117,8 @@ def gradient(pos, p, kind, pi, pj, m, re, n0):
         i, j = pi[k], pj[k]
         dx = pos[j, 0] - pos[i, 0]
         dy = pos[j, 1] - pos[i, 1]
+        if kind[i] == DUMMY or kind[j] == DUMMY:
+            continue
         r2 = dx * dx + dy * dy
         wt = weight(np.sqrt(r2), re)
         if wt == 0.0:
@@ -129,29 +133,30 @@ def gradient(pos, p, kind, pi, pj, m, re, n0):
 
 
 @njit(**JIT)
-def source_term(n_star, div_star, n0, rho0, dt, source, gamma):
+def source_term(n_star, div_star, n0, rho0, dt, source, gamma, relax=1.0):
     """Right-hand side of lap P = b [N / cm^4] per particle.
 
-    source 0 standard: rho0 / dt^2 (n0 - n*) / n0 (Koshizuka & Oka 1996);
+    source 0 standard: relax rho0 / dt^2 (n0 - n*) / n0 (Koshizuka & Oka 1996; relax: MPS-Basic's relaxation);
     1 hattori: (rho0 - Rho*) / dt^2 + (rho0 - Rho*) / dt div V*, Rho* = rho0 n* / n0
     (eq. 6 of Hattori et al.); 2 mixed: rho0 / dt div V* + gamma rho0 / dt^2 (n0 - n*) / n0
     (Tanaka & Masunaga 2010).
     """
     drho = rho0 * (n0 - n_star) / n0  # rho0 - Rho*
     if source == 0:
-        return drho / dt**2
+        return relax * drho / dt**2
     if source == 1:
         return drho / dt**2 + drho / dt * div_star
     return rho0 / dt * div_star + gamma * drho / dt**2
 
 
 @njit(**JIT)
-def assemble(pos, kind, dirichlet, b, pi, pj, m, re, n0, lam):
+def assemble(pos, kind, dirichlet, b, pi, pj, m, re, n0, lam, diag_extra=0.0):
     """Pressure equation of the non-Dirichlet fluid and wall particles as CSR.
 
-    Row of unknown i: sum_j w_ij (P_i - P_j) = -(lambda n0 / 2d) b_i, the
-    MPS Laplacian times -(lambda n0 / 2d) (symmetric positive definite when
-    every cluster touches a Dirichlet particle, P = 0).  Returns (unknown (N,)
+    Row of unknown i: diag_extra P_i + sum_j w_ij (P_i - P_j) = -(lambda n0 / 2d) b_i,
+    the MPS Laplacian times -(lambda n0 / 2d) plus the compressibility term
+    (as MPS-Basic's PressurePoissonEquation, scaled by rho0 lambda n0 / 2d): symmetric
+    positive definite when diag_extra > 0, or when every cluster touches a Dirichlet particle.  Returns (unknown (N,)
     row of each particle or -1, indptr, indices, data, rhs).
     """
     n = pos.shape[0]
@@ -176,6 +181,7 @@ def assemble(pos, kind, dirichlet, b, pi, pj, m, re, n0, lam):
     fill = indptr[:-1] + 1
     for r in range(nu):
         indices[indptr[r]] = r
+        data[indptr[r]] = diag_extra
     for k in range(m):
         i, j = pi[k], pj[k]
         if kind[i] == DUMMY or kind[j] == DUMMY or (row[i] < 0 and row[j] < 0):
@@ -205,10 +211,10 @@ def assemble(pos, kind, dirichlet, b, pi, pj, m, re, n0, lam):
 
 
 @njit(**JIT)
-def collide(ps, vs, kind, pi, pj, m, dist, restitution, dt):
-    """Collision model (Koshizuka's MPS sample code; Lee et al. 2011): pairs closer than ``dist`` that
-    approach each other exchange the normal relative velocity with restitution e (equal masses; a
-    wall or dummy particle is immovable), positions moved by dt times the velocity change.  In place."""
+def collide(ps, vs, kind, pi, pj, m, dist, restitution):
+    """Collision model of MPS-Basic (MPS::collision): every pair closer than ``dist`` [cm] with a fluid
+    particle exchanges the normal relative velocity with restitution e if it approaches, and both are
+    pushed apart to ``dist`` (equal masses; wall and dummy particles immovable).  In place."""
     for k in range(m):
         i, j = pi[k], pj[k]
         if kind[i] != FLUID and kind[j] != FLUID:
@@ -220,45 +226,37 @@ def collide(ps, vs, kind, pi, pj, m, dist, restitution, dt):
             continue
         ex = dx / r
         ey = dy / r
-        vn = (vs[i, 0] - vs[j, 0]) * ex + (vs[i, 1] - vs[j, 1]) * ey  # > 0: approaching
-        if vn <= 0.0:
-            continue
-        if kind[i] == FLUID and kind[j] == FLUID:
-            dv = 0.5 * (1.0 + restitution) * vn
-            vs[i, 0] -= dv * ex
-            vs[i, 1] -= dv * ey
-            vs[j, 0] += dv * ex
-            vs[j, 1] += dv * ey
-            ps[i, 0] -= dt * dv * ex
-            ps[i, 1] -= dt * dv * ey
-            ps[j, 0] += dt * dv * ex
-            ps[j, 1] += dt * dv * ey
-        elif kind[i] == FLUID:
-            dv = (1.0 + restitution) * vn
-            vs[i, 0] -= dv * ex
-            vs[i, 1] -= dv * ey
-            ps[i, 0] -= dt * dv * ex
-            ps[i, 1] -= dt * dv * ey
-        else:
-            dv = (1.0 + restitution) * vn
-            vs[j, 0] += dv * ex
-            vs[j, 1] += dv * ey
-            ps[j, 0] += dt * dv * ex
-            ps[j, 1] += dt * dv * ey
+        mi = 1.0 if kind[i] == FLUID else 0.0  # inverse masses (rho0 cancels)
+        mj = 1.0 if kind[j] == FLUID else 0.0
+        mass = 1.0 / (mi + mj)
+        rel = (vs[j, 0] - vs[i, 0]) * ex + (vs[j, 1] - vs[i, 1]) * ey
+        imp = -(1.0 + restitution) * rel * mass if rel < 0.0 else 0.0
+        push = (dist - r) * mass
+        vs[i, 0] -= imp * mi * ex
+        vs[i, 1] -= imp * mi * ey
+        vs[j, 0] += imp * mj * ex
+        vs[j, 1] += imp * mj * ey
+        ps[i, 0] -= push * mi * ex
+        ps[i, 1] -= push * mi * ey
+        ps[j, 0] += push * mj * ex
+        ps[j, 1] += push * mj * ey
 
 
 @njit(**JIT)
-def predict(pos, vel, kind, box, dt, gx, gy, nu, re_n, re_l, n0_n, n0_l, lam, beta, rho0, source, gamma,
-            coll_dist=0.0, restitution=0.2):
+def predict(pos, vel, kind, box, dt, gx, gy, nu, re_n, re_g, re_l, n0_n, n0_g, n0_l, lam, beta, rho0, source, gamma,
+            relax, sound, coll_dist, restitution):
     """Explicit half of a step (eq. 3) and the pressure equation at the moved positions.
 
     Fluid: V* = V + dt (nu lap V + g), U* = U + dt V* (walls fixed), then the
-    collision model if coll_dist > 0 (cm; see collide).  Then at
-    U*: n*, div V*, free surface (n* < beta n0, fluid and wall particles:
-    Dirichlet P = 0), source term and the CSR system (see assemble).
+    collision model if coll_dist > 0 (cm; see collide).  Then at U*: n* (radius
+    re_n), div V* (re_g), free surface (n* < beta n0: fluid and wall particles
+    get Dirichlet P = 0), source term (relax: relaxation of the standard
+    source) and the CSR system (see assemble) with the compressibility term
+    1 / (rho0 c^2 dt^2) of sound speed ``sound`` [cm/s] (0: none).
     Returns (pos*, vel*, n*, div*, dirichlet, (pi, pj, m) at U*, (row, indptr, indices, data, rhs)).
     """
-    pi, pj, m = build_pairs(pos, box, re_l)
+    rmax = max(re_n, re_l)
+    pi, pj, m = build_pairs(pos, box, rmax)
     lap = laplacian(pos, vel, kind, pi, pj, m, re_l, n0_l, lam)
     ps = pos.copy()
     vs = vel.copy()
@@ -268,29 +266,33 @@ def predict(pos, vel, kind, box, dt, gx, gy, nu, re_n, re_l, n0_n, n0_l, lam, be
             vs[i, 1] = vel[i, 1] + dt * (nu * lap[i, 1] + gy)
             ps[i, 0] = pos[i, 0] + dt * vs[i, 0]
             ps[i, 1] = pos[i, 1] + dt * vs[i, 1]
-    pi, pj, m = build_pairs(ps, box, re_l)
     if coll_dist > 0.0:
-        collide(ps, vs, kind, pi, pj, m, coll_dist, restitution, dt)
+        pi, pj, m = build_pairs(ps, box, rmax)
+        collide(ps, vs, kind, pi, pj, m, coll_dist, restitution)
+    pi, pj, m = build_pairs(ps, box, rmax)
     n_star = number_density(ps, pi, pj, m, re_n)
-    div = divergence(ps, vs, pi, pj, m, re_n, n0_n)
+    div = divergence(ps, vs, pi, pj, m, re_g, n0_g)
     dirichlet = np.zeros(pos.shape[0], np.bool_)
     b = np.zeros(pos.shape[0])
     for i in range(pos.shape[0]):
         if kind[i] != DUMMY:
             dirichlet[i] = n_star[i] < beta * n0_n
-            b[i] = source_term(n_star[i], div[i], n0_n, rho0, dt, source, gamma)
-    system = assemble(ps, kind, dirichlet, b, pi, pj, m, re_l, n0_l, lam)
+            b[i] = source_term(n_star[i], div[i], n0_n, rho0, dt, source, gamma, relax)
+    extra = 0.0
+    if sound > 0.0:  # alpha / dt^2 with alpha = 1 / (rho0 c^2), times the row scale lambda n0 rho0 / (2 d)
+        extra = lam * n0_l / (2.0 * DIM * sound**2 * dt**2)
+    system = assemble(ps, kind, dirichlet, b, pi, pj, m, re_l, n0_l, lam, extra)
     return ps, vs, n_star, div, dirichlet, pi, pj, m, system
 
 
 @njit(**JIT)
-def correct(pos_old, ps, vs, p, kind, pi, pj, m, re_n, n0_n, rho0, dt, walls, box):
+def correct(pos_old, ps, vs, p, kind, pi, pj, m, re_g, n0_g, rho0, dt, walls, box):
     """Pressure half of a step (eqs. 4-5): V' = -dt / rho0 grad P, U' = dt V'.
 
     Returns (pos, vel, grad P (N, 2), bad): bad = (kind of failure, particle,
     wall): 0 fine, 1 non-finite, 2 crossed a wall (from pos_old), 3 left the box.
     """
-    g = gradient(ps, p, kind, pi, pj, m, re_n, n0_n)
+    g = gradient(ps, p, kind, pi, pj, m, re_g, n0_g)
     pos = ps.copy()
     vel = vs.copy()
     bad = (0, -1, -1)

@@ -1,24 +1,29 @@
-"""Workflow entry points of the MPS runs: one run file per run, and the summary table.
+"""Workflow entry points of the MPS runs (called through workflow/scripts/call.py): one run file
+per run, the stiff and extreme cases, and the summary table.
 
-Run ids: ``single_<variant>_dx<l0>`` (liquid block at rest in the single
-tank) and ``flow_<variant>_dx<l0>`` (continues the single run's final state
-with the walls switched to flow_step50's).
+Run ids: ``single_<variant>_dx<l0>`` (liquid block at rest in the single tank),
+``flow_<variant>_dx<l0>`` (the same block at rest in flow_step50's first
+vessel: the opening appears at t = 0) and ``stiff_<case>`` (settings 'stiff').
+Every function logs to stderr (call.py sends it to the rule's log).
 """
 
 import logging
+import sys
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
 from isaflow import metrics, runfile
+from isaflow.core import units
 from isaflow.scene import load_tank
 
-from . import settings, solver
+from . import boundary, settings, solver
 
-REFERENCES = ("Koshizuka & Oka (1996), Nucl. Sci. Eng. 123, 421; Hattori, Seta, Shibata & Koshizuka, "
-              "'A new derivation of pressure Poisson equation in MPS'; Tanaka & Masunaga (2010), J. Comput. Phys. 229, 4279")
-TANKS = {"single": "config/tanks/single.yaml", "flow": "config/tanks/flow_step50.yaml"}
+REFERENCES = ("Koshizuka & Oka (1996), Nucl. Sci. Eng. 123, 421; MPS-Basic (github.com/MPS-Basic/MPS-Basic); "
+              "Hattori, Seta, Shibata & Koshizuka, 'A new derivation of pressure Poisson equation in MPS'; "
+              "Tanaka & Masunaga (2010), J. Comput. Phys. 229, 4279")
+STIFF_CASES = ("large_dt", "small_re", "no_relaxation", "on_wall")
 
 
 def run_id(case, variant, l0):
@@ -33,60 +38,81 @@ def spacing_of(cfg, case, label):
     raise KeyError(f"no {case} spacing labelled '{label}' in the MPS settings")
 
 
-def _logger(log_path):
-    log = logging.getLogger(f"mps.{log_path}")
+def _logger(name):
+    log = logging.getLogger(f"mps.{name}")
     log.setLevel(logging.INFO)
-    if log_path:
-        Path(log_path).parent.mkdir(parents=True, exist_ok=True)
-        log.addHandler(logging.FileHandler(log_path, mode="w"))
+    if not log.handlers:
+        log.addHandler(logging.StreamHandler(sys.stderr))
     return log
 
 
-def write_run(cfg_path, case, variant, label, out, log_path=None, start=None):
-    """Run one case ('single' or 'flow', the flow from run file ``start``) and write its run file."""
-    log = _logger(log_path)
-    cfg = settings.load(cfg_path)
-    l0 = spacing_of(cfg, case, label)
-    tank = load_tank(TANKS[case])
-    inputs = {"tank": TANKS[case], "settings": cfg_path}
-    first = None
-    if case == "flow":
-        ds0 = runfile.read(start)
-        first = dict(pos=ds0["pos"].values, vel=ds0["velocity"].values, steps=int(ds0["steps"]), sim_time=float(ds0["sim_time"]))
-        inputs["start"] = start
-        t_end, probes, snaps = cfg["time.flow_time"], cfg["runs.probes_flow"], 6
-    else:
-        t_end, probes, snaps = cfg["time.single_time"], cfg["runs.probes_single"], 0
-    solver.solve(tank, cfg, variant, l0, min(t_end, 5e-3), probes, log=log.info)  # compile outside the timing
+def _run_and_write(tank, tank_path, cfg, variant, l0, t_end, probes, out, name, start=None, inputs=None, snaps=0):
+    log = _logger(name)
+    solver.solve(tank, cfg, variant, l0, min(t_end, 5e-3), probes, start=start, log=log.info)  # compile outside the timing
     started = runfile.now()
-    r = solver.solve(tank, cfg, variant, l0, t_end, probes, start=first, snapshots=snaps, log=log.info)
-    log.info(f"{run_id(case, variant, l0)}: {r.status}: {r.message}; {r.force_evals} steps in {r.wall_time:.1f} s")
-    ds = runfile.to_dataset(r, tank, runfile.provenance(inputs), started, runfile.now(), l0, REFERENCES)
-    runfile.write(ds, out)
+    r = solver.solve(tank, cfg, variant, l0, t_end, probes, start=start, snapshots=snaps, log=log.info)
+    log.info(f"{name}: {r.status}: {r.message}; {r.force_evals} steps in {r.wall_time:.1f} s")
+    prov = runfile.provenance({"tank": tank_path, "settings": cfg.path, **(inputs or {})})
+    runfile.write(runfile.to_dataset(r, tank, prov, started, runfile.now(), l0, REFERENCES), out)
+    return r
 
 
-def surface_slope(ds, vessel):
-    """Slope [1] of a straight line through the strip tops of a vessel's liquid (belongs in metrics)."""
-    x0, x1 = ds["vessel_x"].sel(vessel=vessel).values
-    pos = ds["pos"].values
-    pos = pos[(pos[:, 0] >= x0) & (pos[:, 0] < x1)]
-    a = float(ds.attrs["spacing"])
-    strip = np.floor((pos[:, 0] - x0) / a).astype(int)
-    s = np.unique(strip)
-    if len(s) < 2:
-        return np.nan
-    tops = np.array([pos[strip == k, 1].max() for k in s])
-    return float(np.polyfit(x0 + (s + 0.5) * a, tops, 1)[0])
+def run_case(cfg, tank, outputs, case, variant, label):
+    """Run one case from the liquid block at rest in the tank's first vessel ('single': the single tank;
+    'flow': the flow tank, i.e. the opening appears at t = 0) and write outputs[0].
+
+    The flow starts from the lattice at rest, not from the single run's final state: no MPS single run
+    comes to rest (see the report), and its residual motion would be inherited by the flow."""
+    settings_ = settings.load(cfg)
+    l0 = spacing_of(settings_, case, label)
+    if case == "flow":
+        t_end, probes, snaps = settings_["time.flow_time"], settings_["runs.probes_flow"], 6
+    else:
+        t_end, probes, snaps = settings_["time.single_time"], settings_["runs.probes_single"], 0
+    _run_and_write(load_tank(tank), tank, settings_, variant, l0, t_end, probes, outputs[0], run_id(case, variant, l0),
+                   snaps=snaps)
+
+
+def stiff_settings(cfg, case):
+    """(settings, start) of a stiff or extreme case (STIFF_CASES); start None or a dict for solver.solve."""
+    if case == "large_dt":
+        return cfg.with_overrides(**{"time.courant": cfg["stiff.courant_large"]}), None
+    if case == "small_re":
+        r = cfg["stiff.re_small"]
+        return cfg.with_overrides(**{"model.re_density": r, "model.re_gradient": r, "model.re_laplacian": r}), None
+    if case == "no_relaxation":
+        return cfg.with_overrides(**{"model.relaxation": cfg["stiff.relaxation_none"]}), None
+    if case == "on_wall":
+        return cfg, "on_wall"
+    raise KeyError(f"unknown MPS stiff case '{case}' (choose from {', '.join(STIFF_CASES)})")
+
+
+def run_stiff(cfg, tank, outputs, case):
+    """Run stiff case ``case`` (source term standard, settings 'stiff') in the single tank; write outputs[0]."""
+    base = settings.load(cfg)
+    settings_, start = stiff_settings(base, case)
+    tank_ = load_tank(tank)
+    l0 = base["stiff.spacing"]
+    if start == "on_wall":
+        xr, floor = solver.first_vessel(tank_)
+        fluid = boundary.liquid_block(xr, floor, tank_.depth, l0)
+        k = int(np.argmin(np.hypot(*(fluid - np.asarray(base["stiff.on_wall_point"]) - [0, l0 / 2]).T)))
+        fluid[k] = base["stiff.on_wall_point"]
+        start = dict(pos=fluid, vel=np.zeros_like(fluid), steps=0, sim_time=0.0)
+    _run_and_write(tank_, tank, settings_, "standard", l0, base["stiff.duration"], base["runs.probes_single"],
+                   outputs[0], f"stiff_{case}", start=start)
 
 
 def noise(ds):
     """Wall-load and probe noise over the averaging window: mean over wetted panels of the std of |panel force|
-    divided by its mean (1), and the std of each probe's pressure (N/cm^2)."""
+    divided by its mean (1), the same std in N, and the std of each probe's pressure (N/cm^2)."""
     win = ds["in_window"].values.astype(bool)
     mag = np.hypot(*np.moveaxis(ds["hist_panel_force"].values[win], -1, 0))
     mean, std = mag.mean(0), mag.std(0)
-    wet = mean > 0.01 * mean.max()
+    wet = mean > 0.01 * mean.max() if mean.max() > 0 else mean > 0
     probe = ds["hist_probe_pressure"].values[win]
+    if not wet.any():
+        return np.nan, np.nan, np.nanstd(probe, axis=0)
     return float(np.mean(std[wet] / mean[wet])), float(np.mean(std[wet])), np.nanstd(probe, axis=0)
 
 
@@ -100,37 +126,49 @@ def time_to_rest(ds):
     return float(t[last[-1] + 1]) if len(last) else float(t[0])
 
 
+def growth_rate(ds):
+    """(rate [1/s], rate x sqrt(l0 / g) [1]) of the exponential growth of the rms speed from its minimum to the
+    first sample 10 times larger (least squares on log rms); NaN if it never grows tenfold.  A lattice
+    instability driven by the neighbourhood-minimum term of the gradient (p_i - p^_i ~ 2 l0 rho g) grows at a
+    rate ~ sqrt(g / l0), so the second number is about constant over spacings."""
+    t, u = ds["hist_time"].values, ds["hist_rms_speed"].values
+    k0 = int(np.argmin(u[: max(1, len(u) // 2)]))
+    up = np.flatnonzero(u[k0:] > 10 * u[k0])
+    if not len(up) or up[0] < 3 or u[k0] <= 0:
+        return np.nan, np.nan
+    sl = slice(k0, k0 + up[0] + 1)
+    rate = float(np.polyfit(t[sl], np.log(u[sl]), 1)[0])
+    return rate, rate * float(np.sqrt(float(ds.attrs["spacing"]) / units.G))
+
+
 def summary_row(path):
-    """One summary row of a run file."""
+    """One summary row of a run file: metrics.run_row plus MPS noise, cost and rest measures."""
     ds = runfile.read(path)
     a = ds.attrs
-    case = Path(path).stem.split("_")[0]
-    row = dict(run=Path(path).stem, case=case, source_term=a["variant"], spacing_cm=float(a["spacing"]),
-               particles=int(ds.sizes["particle"]), wall_time_s=float(ds["wall_time"]), pressure_solves=int(ds["force_evals"]),
-               steps=int(ds["steps"]), sim_time_s=float(ds["sim_time"]), dt_s=float(a["dt_s"]), status=a["status"],
-               max_solve_residual=float(a["max_solve_residual"]), ms_per_step=1e3 * float(ds["wall_time"]) / int(ds["force_evals"]),
-               rms_speed_cm_s=float(ds["residual"]), time_to_rest_s=time_to_rest(ds))
+    stem = Path(path).stem
+    case = stem.split("_")[0]
+    row = dict(run=stem, case=case, source_term=a["variant"], dt_s=float(a["dt_s"]), sim_time_s=float(ds["sim_time"]),
+               max_solve_residual=float(a["max_solve_residual"]), rms_speed_cm_s=float(ds["residual"]),
+               rest_speed_cm_s=float(a["rest_speed_cm_s"]), time_to_rest_s=time_to_rest(ds),
+               max_speed_cm_s=float(ds["hist_max_speed"].values[-1]), message=a.get("message", ""),
+               ms_per_step=1e3 * float(ds["wall_time"]) / max(1, int(ds["force_evals"])))
     rel, absn, probe = noise(ds)
-    row.update(panel_noise_rel=rel, panel_noise_N=absn)
+    rate, rate_scaled = growth_rate(ds)
+    row.update(panel_noise_rel=rel, panel_noise_N=absn, rms_growth_per_s=rate, rms_growth_x_sqrt_l0_g=rate_scaled,
+               min_rms_speed_cm_s=float(ds["hist_rms_speed"].values.min()))
     for k, p in enumerate(probe):
         row[f"probe{k}_std_N_cm2"] = float(p)
-    vessel = None
+    m = metrics.run_row(ds)
+    row.update({k: v for k, v in m.items() if k not in row})
     if "vessel" in ds.coords:
-        names = [str(v) for v in ds["vessel"].values]
-        vessel = names[-1]
-        fm = metrics.flow_measures(ds)
         w = float(ds["weight"].values[0])
-        row.update(mass_left_N=fm["particles_left"] * w, mass_left_frac=fm["particles_left"] / ds.sizes["particle"],
-                   second_level_cm=metrics.load_errors(ds, vessel)["level"], second_slope=surface_slope(ds, vessel),
-                   mass_conserved=fm["mass_conserved"])
-    if case == "single" or (vessel and row["mass_left_frac"] < 0.5):
-        row.update(metrics.hydrostatic_errors(ds, vessel=vessel))
+        row.update(mass_left_N=m["particles_left"] * w, mass_left_frac=m["particles_left"] / ds.sizes["particle"])
     return row
 
 
-def summary(paths, out):
-    """results/mps/summary.csv: one row per run file."""
-    df = pd.DataFrame([summary_row(p) for p in paths])
-    Path(out).parent.mkdir(parents=True, exist_ok=True)
-    df.to_csv(out, index=False, float_format="%.6g")
+def summary(runs, outputs):
+    """outputs[0] (results/mps/summary.csv): one row per run file."""
+    df = pd.DataFrame([summary_row(p) for p in runs])
+    Path(outputs[0]).parent.mkdir(parents=True, exist_ok=True)
+    df.to_csv(outputs[0], index=False, float_format="%.6g")
     return df

@@ -49,19 +49,22 @@ class State:
         self.l0 = l0
         self.walls = tank.walls
         self.nf = len(fluid_pos)
-        self.pos, self.kind, self.bnd = boundary.assemble_particles(fluid_pos, self.walls, l0, cfg["model.wall_layers"])
+        layers = cfg["model.pressure_layers"] + cfg["model.dummy_layers"]
+        self.pos, self.kind, self.bnd = boundary.assemble_particles(fluid_pos, self.walls, l0, layers,
+                                                                    cfg["model.pressure_layers"])
         self.vel = np.zeros_like(self.pos)
         self.vel[: self.nf] = fluid_vel
         self.p = np.zeros(len(self.pos))
-        self.pressure_source = np.concatenate([np.arange(self.nf), self.nf + boundary.dummy_sources(self.bnd)])
         self.re_n = cfg["model.re_density"] * l0
+        self.re_g = cfg["model.re_gradient"] * l0
         self.re_l = cfg["model.re_laplacian"] * l0
         self.n0_n, _ = model.lattice_constants(cfg["model.re_density"], l0)
+        self.n0_g, _ = model.lattice_constants(cfg["model.re_gradient"], l0)
         self.n0_l, self.lam = model.lattice_constants(cfg["model.re_laplacian"], l0)
         self.weight = tank.weight / self.nf  # N per particle
         self.rho0 = self.weight / units.G / l0**2  # N s^2 / cm^4
         box = bounding_box(self.walls)
-        pad = (cfg["model.wall_layers"] + 1) * l0
+        pad = (layers + 1) * l0
         self.grid_box = box + np.array([-pad, -pad, pad, pad])
         self.escape_box = box
         self.panel_wall, self.panel_centre, self.load_matrix = boundary.load_map(self.walls, self.bnd, cfg["walls.panel_length"])
@@ -72,26 +75,36 @@ class State:
 
 
 def step(s, dt, source, cfg, timers=None):
-    """Advance State s by one step.  Returns (bad, residual, iterations); bad as model.correct."""
+    """Advance State s by one step.  Returns (bad, residual, iterations); bad as model.correct
+    (kind 4: the pressure solve failed outright or gave a non-finite pressure; residual inf)."""
     t0 = time.perf_counter()
     ps, vs, n_star, div, dirichlet, pi, pj, m, system = model.predict(
-        s.pos, s.vel, s.kind, s.grid_box, dt, 0.0, -units.G, cfg["model.kinematic_viscosity"], s.re_n, s.re_l,
-        s.n0_n, s.n0_l, s.lam, cfg["model.beta"], s.rho0, model.SOURCES[source], cfg["model.gamma_mixed"],
-        cfg["model.collision_distance"] * s.l0, cfg["model.restitution"])
+        s.pos, s.vel, s.kind, s.grid_box, dt, 0.0, -units.G, cfg["model.kinematic_viscosity"], s.re_n, s.re_g, s.re_l,
+        s.n0_n, s.n0_g, s.n0_l, s.lam, cfg["model.beta"], s.rho0, model.SOURCES[source], cfg["model.gamma_mixed"],
+        cfg["model.relaxation"], cfg["model.sound_speed"], cfg["model.collision_distance"] * s.l0, cfg["model.restitution"])
     row, indptr, indices, data, rhs = system
     t1 = time.perf_counter()
     A = pressure.csr(indptr, indices, data)
     unk = row >= 0
-    x0 = np.empty(A.shape[0])
+    x0 = np.zeros(A.shape[0])
     x0[row[unk]] = s.p[unk]
-    x, resid, its = pressure.solve(A, rhs, cfg["pressure.solver"], cfg["pressure.rtol"], cfg["pressure.maxiter"], x0)
+    try:
+        x, resid, its = pressure.solve(A, rhs, cfg["pressure.solver"], cfg["pressure.rtol"], cfg["pressure.maxiter"], x0)
+    except (RuntimeError, ValueError, ArithmeticError) as err:  # e.g. SuperLU "matrix is exactly singular"
+        x, resid, its = np.full(A.shape[0], np.nan), np.inf, 0
+        s.solve_error = str(err)
+    if not np.all(np.isfinite(x)):
+        resid = np.inf
+    t2 = time.perf_counter()
+    if not np.isfinite(resid):
+        if timers is not None:
+            timers += (t1 - t0, t2 - t1, 0.0)
+        return (4, -1, -1), resid, its
     p = np.zeros(len(s.pos))
     p[unk] = x[row[unk]]
     if cfg["model.clip_negative"]:
         p = np.maximum(p, 0.0)
-    p = p[s.pressure_source]  # dummies carry their wall particle's pressure
-    t2 = time.perf_counter()
-    pos, vel, _, bad = model.correct(s.pos, ps, vs, p, s.kind, pi, pj, m, s.re_n, s.n0_n, s.rho0, dt, s.walls, s.escape_box)
+    pos, vel, _, bad = model.correct(s.pos, ps, vs, p, s.kind, pi, pj, m, s.re_g, s.n0_g, s.rho0, dt, s.walls, s.escape_box)
     s.pos, s.vel, s.p = pos, vel, p
     if timers is not None:
         timers += (t1 - t0, t2 - t1, time.perf_counter() - t2)
@@ -148,7 +161,7 @@ def solve(tank, cfg, variant, spacing, t_end, probes, start=None, snapshots=0, l
             status, message = "escaped", f"step {step0 + k}: particle {bad[1]} crossed wall '{tank.wall_names[bad[2]]}'"
         elif bad[0] == 3:
             status, message = "escaped", f"step {step0 + k}: particle {bad[1]} left the walls' bounding box"
-        elif not resid <= fail_tol:
+        elif bad[0] == 4 or not resid <= fail_tol:
             status, message = "solver_failed", f"step {step0 + k}: pressure solve residual {resid:.3g} > {fail_tol:.3g} after {its} iterations"
         v = s.vel[: s.nf]
         speed2 = (v**2).sum(1)
@@ -202,8 +215,9 @@ def solve(tank, cfg, variant, spacing, t_end, probes, start=None, snapshots=0, l
     nb = np.bincount(s.kind, minlength=3)
     params = {
         "source_term": variant, "spacing_cm": l0, "dt_s": dt, "rho0_N_s2_cm4": s.rho0, "particle_weight_N": s.weight,
-        "re_density_cm": s.re_n, "re_laplacian_cm": s.re_l, "n0_density": s.n0_n, "n0_laplacian": s.n0_l,
-        "lambda_cm2": s.lam, "beta": cfg["model.beta"], "kinematic_viscosity_cm2_s": cfg["model.kinematic_viscosity"],
+        "re_density_cm": s.re_n, "re_gradient_cm": s.re_g, "re_laplacian_cm": s.re_l, "n0_density": s.n0_n, "n0_laplacian": s.n0_l,
+        "lambda_cm2": s.lam, "beta": cfg["model.beta"], "relaxation": cfg["model.relaxation"],
+        "sound_speed_cm_s": cfg["model.sound_speed"], "n0_gradient": s.n0_g, "kinematic_viscosity_cm2_s": cfg["model.kinematic_viscosity"],
         "gamma_mixed": cfg["model.gamma_mixed"], "courant": cfg["time.courant"], "pressure_solver": cfg["pressure.solver"],
         "pressure_rtol": cfg["pressure.rtol"], "max_solve_residual": max_resid, "mean_solve_iterations": float(np.mean(iters)),
         "rest_speed_cm_s": u_rest, "average_window_s": cfg["time.average_window"], "wall_particles": int(nb[model.WALL]),
