@@ -4,9 +4,11 @@
 is one), anything that is not a small, plain YAML mapping: unreadable or
 non-UTF-8 files, files over MAX_BYTES, empty or non-mapping documents,
 several documents, anchors and aliases (no alias bombs), explicit tags,
-duplicate keys, nesting deeper than MAX_DEPTH.  :func:`validate` checks a
-mapping against a JSON schema whose ``integer`` means a YAML integer (19.0 is
-refused, not truncated) and refuses NaN and infinite numbers anywhere.
+duplicate keys, keys that are not plain names, nesting deeper than
+MAX_DEPTH.  :func:`validate` checks a mapping against a JSON schema whose
+``integer`` means a YAML integer (19.0 is refused, not truncated) and refuses
+anywhere: NaN and infinite numbers, integers beyond 64 bits, strings with
+control characters or lone surrogates or longer than MAX_STRING.
 """
 
 import math
@@ -17,6 +19,7 @@ import yaml
 
 MAX_BYTES = 1_000_000
 MAX_DEPTH = 32
+MAX_STRING = 100_000  # characters of any one string value
 
 
 class InputError(ValueError):
@@ -29,7 +32,11 @@ class _StrictLoader(yaml.SafeLoader):
     def construct_mapping(self, node, deep=False):
         seen = set()
         for key_node, _ in node.value:
+            if not isinstance(key_node, yaml.ScalarNode):
+                raise InputError(f"a mapping key must be a plain name (line {key_node.start_mark.line + 1})")
             key = self.construct_object(key_node, deep=deep)
+            if not isinstance(key, str):
+                raise InputError(f"mapping key {key!r} is not a name (line {key_node.start_mark.line + 1})")
             if key in seen:
                 raise InputError(f"duplicate key '{key}' (line {key_node.start_mark.line + 1})")
             seen.add(key)
@@ -67,8 +74,17 @@ def parse_yaml(text):
         return yaml.load(text, Loader=_StrictLoader)  # noqa: S506 (a SafeLoader subclass)
     except yaml.YAMLError as err:
         mark = getattr(err, "problem_mark", None)
-        where = f" (line {mark.line + 1})" if mark else ""
-        raise InputError(f"not valid YAML: {getattr(err, 'problem', None) or err}{where}") from None
+        if mark is not None:
+            line = mark.line + 1
+        elif isinstance(getattr(err, "position", None), int):  # reader errors: special characters
+            line = text.count("\n", 0, err.position) + 1
+        else:
+            line = None
+        why = getattr(err, "problem", None) or getattr(err, "reason", None) or str(err)
+        if isinstance(err, yaml.reader.ReaderError):
+            why = f"character {err.character!r} is not allowed in YAML"
+        where = f" (line {line})" if line else ""
+        raise InputError(f"not valid YAML: {' '.join(str(why).split())}{where}") from None
 
 
 def read_yaml(path, what="file"):
@@ -77,7 +93,8 @@ def read_yaml(path, what="file"):
     p = Path(path)
     try:
         if not p.is_file():
-            raise InputError(f"{path}: cannot read {what}: {'a directory' if p.is_dir() else 'no such file'}")
+            kind = "a directory" if p.is_dir() else "not a regular file" if p.exists() else "no such file"
+            raise InputError(f"{path}: cannot read {what}: {kind}")
         if p.stat().st_size > MAX_BYTES:
             raise InputError(f"{path}: {what} is larger than {MAX_BYTES} bytes")
         text = p.read_bytes().decode("utf-8")
@@ -95,13 +112,40 @@ def read_yaml(path, what="file"):
     return text, spec
 
 
-def _non_finite(node, where=()):
-    """Dotted path of the first NaN or infinite number in a nested structure, or None."""
+def bad_string(text):
+    """Why a string cannot be accepted (control characters, lone surrogates, over MAX_STRING), or None."""
+    if len(text) > MAX_STRING:
+        return f"text longer than {MAX_STRING} characters"
+    if any((ord(c) < 32 and c not in "\t\n\r") or ord(c) == 127 for c in text):
+        return "control characters are not accepted"
+    try:
+        text.encode("utf-8")
+    except UnicodeEncodeError:
+        return "text is not valid Unicode (lone surrogates or undecodable bytes)"
+    return None
+
+
+def printable(text, n=60):
+    """A short, safe rendering of untrusted text for an error message."""
+    r = repr(text)[1:-1]
+    return r if len(r) <= n else r[:n] + "..."
+
+
+def _bad_value(node, where=()):
+    """(dotted path, reason) of the first non-finite or out-of-range number or bad string, or None."""
+    here = ".".join(map(str, where)) or "(top level)"
     if isinstance(node, float) and not math.isfinite(node):
-        return ".".join(map(str, where)) or "(top level)"
+        return here, "numbers must be finite (NaN and infinity are not accepted)"
+    if isinstance(node, int) and not isinstance(node, bool) and abs(node) >= 2**63:
+        return here, "integer out of range (|value| >= 2^63)"
+    if isinstance(node, str):
+        bad = bad_string(node)
+        return (here, bad) if bad else None
     items = node.items() if isinstance(node, dict) else enumerate(node) if isinstance(node, list) else ()
     for k, v in items:
-        found = _non_finite(v, (*where, k))
+        if isinstance(k, str) and bad_string(k):
+            return here, f"field name '{printable(k)}': {bad_string(k)}"
+        found = _bad_value(v, (*where, k))
         if found:
             return found
     return None
@@ -114,14 +158,14 @@ Validator = jsonschema.validators.extend(jsonschema.Draft202012Validator, type_c
 
 def validate(spec, schema, path):
     """Check a mapping against a JSON schema; InputError naming the file and the first bad field."""
-    bad = _non_finite(spec)
+    bad = _bad_value(spec)
     if bad:
-        raise InputError(f"{path}: field '{bad}': numbers must be finite (NaN and infinity are not accepted)")
+        raise InputError(f"{path}: field '{printable(bad[0])}': {bad[1]}")
     errors = sorted(Validator(schema).iter_errors(spec), key=lambda e: [str(p) for p in e.absolute_path])
     if errors:
         e = errors[0]
         where = ".".join(str(p) for p in e.absolute_path) or "(top level)"
-        raise InputError(f"{path}: field '{where}': {e.message}")
+        raise InputError(f"{path}: field '{printable(where)}': {printable(e.message, 200)}")
 
 
 def load(path, schema, what="file"):

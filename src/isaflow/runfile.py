@@ -1,17 +1,22 @@
 """One netCDF file per run of any method: results, diagnostics and provenance (pure I/O).
 
 :func:`to_dataset` turns a contract.Result into the same variables for every
-method; :func:`write` writes it to a temporary name and renames it, so a
-killed run leaves no file that looks complete.  Every variable carries
+method; :func:`write` writes it to a temporary name (.NAME.partial-PID,
+marked incomplete until written) and renames it over a regular file only, so
+a killed run leaves no file that :func:`read` accepts; :func:`check_output`
+refuses unusable output paths before any work.  Every variable carries
 ``units``.
 """
 
 import datetime as dt
+import glob
 import hashlib
 import os
+import stat
 import platform
 import subprocess
 import sys
+import time
 from importlib import metadata
 from pathlib import Path
 
@@ -60,7 +65,7 @@ def provenance(inputs, argv=None):
     }
     for name, path in inputs.items():
         out[f"{name}_file"] = str(path) if path else "none"
-        out[f"{name}_sha256"] = hashlib.sha256(Path(path).read_bytes()).hexdigest() if path else "none"
+        out[f"{name}_sha256"] = sha256(path) if path else "none"
     return out
 
 
@@ -138,20 +143,133 @@ def now():
     return dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")
 
 
-def write(ds, path):
-    """Write ds to path via a temporary file and an atomic rename."""
+class RunFileError(ValueError):
+    """A path that cannot be read as, or written to as, a run file (the message says why)."""
+
+
+PARTIAL = ".partial-"  # temporary names: .NAME.partial-PID (never *.nc; read() refuses them)
+PAUSE_HOOK = "ISAFLOW_TEST_PAUSE_WRITE"  # test hook: seconds to pause mid-write (after the data, before the rename)
+
+
+def sha256(path):
+    """sha256 hex digest of a file, read in blocks."""
+    h = hashlib.sha256()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            h.update(block)
+    return h.hexdigest()
+
+
+def _partial_name(path, pid):
+    return path.with_name(f".{path.name}{PARTIAL}{pid}")
+
+
+def check_output(path):
+    """Refuse, before any work, an output path the final rename could not or must not use.
+
+    Refused: an existing directory, device, FIFO, socket or symbolic link (the
+    rename would replace it: only a regular file is ever replaced), a parent
+    that is a file, a directory where a file cannot be created (probed by
+    creating and removing this run's temporary file).  Missing parent
+    directories are created.  Raises RunFileError.
+    """
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_name(f".{path.name}.tmp{os.getpid()}")
+    if not path.name or path.name in (".", ".."):
+        raise RunFileError(f"{path}: output path names no file")
+    if os.path.lexists(path):
+        st = os.lstat(path)
+        if not stat.S_ISREG(st.st_mode):
+            kind = ("a directory" if stat.S_ISDIR(st.st_mode) else "a symbolic link" if stat.S_ISLNK(st.st_mode)
+                    else "a device, FIFO or socket")
+            raise RunFileError(f"{path}: output path is {kind}, not a regular file; refusing to replace it")
+    parent = path.parent
+    for anc in (parent, *parent.parents):
+        if os.path.lexists(anc):
+            if not anc.is_dir():
+                raise RunFileError(f"{path}: cannot create the output: '{anc}' is not a directory")
+            break
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+        probe = _partial_name(path, os.getpid())
+        fd = os.open(probe, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as err:
+        raise RunFileError(f"{path}: cannot write the output: {err.strerror or err}") from None
+
+
+def _remove_stale(path):
+    """Remove temporary files of earlier writers of path whose process is gone."""
+    for tmp in path.parent.glob(f".{glob.escape(path.name)}{PARTIAL}*"):
+        pid = tmp.name.rsplit(PARTIAL, 1)[1]
+        alive = pid.isdigit() and pid != str(os.getpid())
+        if alive:
+            try:
+                os.kill(int(pid), 0)
+            except ProcessLookupError:
+                alive = False
+            except OSError:
+                pass
+        if not alive:
+            try:
+                tmp.unlink()
+            except OSError:
+                pass
+
+
+def write(ds, path):
+    """Write ds to path: a temporary file .NAME.partial-PID marked incomplete, marked
+    complete once written, then renamed over path (which must be a regular
+    file or absent).  A killed writer leaves at most a temporary file that
+    read() refuses and a later write() removes; SIGTERM/SIGINT (as
+    SystemExit/KeyboardInterrupt, see cli) remove it on the way out."""
+    path = Path(path)
+    check_output(path)
+    _remove_stale(path)
+    tmp = _partial_name(path, os.getpid())
+    ds = ds.copy()
+    ds.attrs["isaflow_complete"] = "no"
     try:
         ds.to_netcdf(tmp, engine="netcdf4")
+        pause = os.environ.get(PAUSE_HOOK)
+        if pause:
+            print(f"isaflow test hook: pausing {pause} s while writing {tmp}", file=sys.stderr, flush=True)
+            time.sleep(float(pause))
+        import netCDF4
+
+        with netCDF4.Dataset(tmp, "a") as nc:
+            nc.setncattr("isaflow_complete", "yes")
+        if os.path.lexists(path) and not stat.S_ISREG(os.lstat(path).st_mode):
+            raise RunFileError(f"{path}: output path became a non-regular file; refusing to replace it")
         os.replace(tmp, path)
     finally:
-        if tmp.exists():
+        if os.path.lexists(tmp):
             tmp.unlink()
 
 
+def open_run(path):
+    """Open a run file lazily (caller closes); RunFileError if it is not a complete netCDF run file."""
+    p = Path(path)
+    if PARTIAL in p.name:
+        raise RunFileError(f"'{path}' is the temporary file of an unfinished write, not a run file")
+    if not p.is_file():
+        kind = "a directory" if p.is_dir() else "not a regular file" if p.exists() else "no such file"
+        raise RunFileError(f"'{path}': {kind}")
+    with open(p, "rb") as f:
+        magic = f.read(8)
+    if not (magic.startswith(b"CDF") or magic.startswith(b"\x89HDF")):
+        raise RunFileError(f"'{path}' is not a netCDF file")
+    try:
+        ds = xr.open_dataset(p, engine="netcdf4")
+    except Exception as err:  # netCDF4/HDF5 raise assorted errors for corrupt files
+        raise RunFileError(f"'{path}' cannot be opened as netCDF ({type(err).__name__})") from None
+    if ds.attrs.get("isaflow_complete", "yes") != "yes":
+        ds.close()
+        raise RunFileError(f"'{path}' is an incomplete write (killed before it finished)")
+    return ds
+
+
 def read(path):
-    """Open a run file fully into memory (the file is closed on return)."""
-    with xr.open_dataset(path, engine="netcdf4") as ds:
+    """Open a complete run file fully into memory (the file is closed on return); RunFileError otherwise."""
+    with open_run(path) as ds:
         return ds.load()

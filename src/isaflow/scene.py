@@ -17,6 +17,7 @@ from .inputs import InputError
 SCHEMA = json.loads(resources.files("isaflow").joinpath("scene.schema.json").read_text())
 
 SceneError = InputError  # invalid scene, tank or settings: the message names the file and the field
+MAX_COORD = 1e7  # cm: largest accepted |coordinate| of a wall (100 km)
 
 
 @dataclass
@@ -84,16 +85,36 @@ def rhombic_lattice(a, rows, row_lengths, center_x, bottom_y):
     return np.concatenate(pts)
 
 
-def _set(spec, dotted, value, path):
+def _set(spec, dotted, value, path, shown):
     keys = dotted.split(".")
+    if not all(keys):
+        raise SceneError(f"{path}: override '{shown}': empty field name")
     node = spec
-    for k in keys[:-1]:
-        if not isinstance(node, dict) or k not in node:
-            raise SceneError(f"{path}: override '{dotted}': no field '{k}'")
+    for i, k in enumerate(keys[:-1]):
+        if not isinstance(node, dict):
+            raise SceneError(f"{path}: override '{shown}': field '{'.'.join(keys[:i])}' is not a mapping")
+        if k not in node:
+            raise SceneError(f"{path}: override '{shown}': no field '{k}'")
         node = node[k]
     if not isinstance(node, dict):
-        raise SceneError(f"{path}: override '{dotted}': field '{'.'.join(keys[:-1])}' is not a mapping")
+        raise SceneError(f"{path}: override '{shown}': field '{'.'.join(keys[:-1])}' is not a mapping")
     node[keys[-1]] = value
+
+
+def apply_overrides(spec, overrides, path):
+    """Set every 'dotted.key=value' override (value parsed as hardened YAML) in spec, in order."""
+    for item in overrides:
+        if not isinstance(item, str) or "=" not in item:
+            raise SceneError(f"{path}: override '{inputs.printable(str(item))}' is not of the form key=value")
+        key, value = item.split("=", 1)
+        bad = inputs.bad_string(key) or inputs.bad_string(value)
+        if bad:
+            raise SceneError(f"{path}: override '{inputs.printable(item)}': {bad}")
+        try:
+            parsed = inputs.parse_yaml(value)
+        except InputError as err:
+            raise SceneError(f"{path}: override '{inputs.printable(item)}': {err}") from None
+        _set(spec, key.strip(), parsed, path, inputs.printable(key.strip()))
 
 
 def load(path, overrides=()):
@@ -101,49 +122,63 @@ def load(path, overrides=()):
 
     overrides: strings 'dotted.key=value' (value parsed as YAML), e.g.
     'forces.pair.r_u=1000'.  Raises SceneError naming the file and field.
+    Nothing large is allocated before the particle count and the memory the
+    run needs are checked (methods.isa.budget).
     """
     path = str(path)
     text, spec = inputs.read_yaml(path, "scene")
-    for item in overrides:
-        if "=" not in item:
-            raise SceneError(f"{path}: override '{item}' is not of the form key=value")
-        key, value = item.split("=", 1)
-        try:
-            parsed = inputs.parse_yaml(value)
-        except InputError as err:
-            raise SceneError(f"{path}: override '{item}': {err}") from None
-        _set(spec, key.strip(), parsed, path)
+    apply_overrides(spec, overrides, path)
     inputs.validate(spec, SCHEMA, path)
     scene = Scene(path, spec, text, list(overrides))
     _check_geometry(scene)
     return scene
 
 
-def _check_geometry(scene):
-    """Physical checks the schema cannot express."""
-    path = scene.path
-    walls = scene.walls
-    if not np.isfinite(walls).all():
-        raise SceneError(f"{path}: field 'walls': coordinates must be finite")
-    for name, w in zip(scene.wall_names, walls):
+def check_walls(path, spec):
+    """Wall segments finite, of non-zero length, uniquely named, within MAX_COORD cm."""
+    walls = np.array([w["from"] + w["to"] for w in spec["walls"]], float)
+    names = [w["name"] for w in spec["walls"]]
+    if not np.isfinite(walls).all() or (np.abs(walls) > MAX_COORD).any():
+        raise SceneError(f"{path}: field 'walls': coordinates must be finite and within +-{MAX_COORD:g} cm")
+    for name, w in zip(names, walls):
         if np.hypot(w[2] - w[0], w[3] - w[1]) == 0:
             raise SceneError(f"{path}: field 'walls' ({name}): segment has zero length")
-    if len(set(scene.wall_names)) != len(scene.wall_names):
+    if len(set(names)) != len(names):
         raise SceneError(f"{path}: field 'walls': wall names must be unique")
-    part = scene.spec["particles"]
-    if "from_run" in part:
-        return
-    pos = scene.pos0 = initial_positions(scene)
+    for v in spec.get("vessels", []):
+        if not v["x"][0] < v["x"][1]:
+            raise SceneError(f"{path}: field 'vessels' ({v['name']}): x must be [xmin, xmax] with xmin < xmax")
+    return walls
+
+
+def check_positions(path, field, pos, walls):
+    """Refuse positions that are non-finite or outside the walls' bounding box (NaN counts as outside)."""
     if not np.isfinite(pos).all():
-        raise SceneError(f"{path}: field 'particles': positions must be finite")
+        raise SceneError(f"{path}: field '{field}': positions must be finite")
     lo, hi = walls.reshape(-1, 2).min(0), walls.reshape(-1, 2).max(0)
-    out = ((pos < lo) | (pos > hi)).any(1)
+    out = ~((pos >= lo) & (pos <= hi)).all(1)  # NaN counts as outside
     if out.any():
         x, y = pos[np.argmax(out)]
         raise SceneError(
-            f"{path}: field 'particles': {out.sum()} particle(s) lie outside the walls' "
+            f"{path}: field '{field}': {out.sum()} particle(s) lie outside the walls' "
             f"bounding box [{lo[0]}, {hi[0]}] x [{lo[1]}, {hi[1]}] cm, e.g. ({x:g}, {y:g})"
         )
+
+
+def _check_geometry(scene):
+    """Physical checks the schema cannot express, and the memory the run needs, before any allocation."""
+    from .methods.isa import budget
+
+    path = scene.path
+    walls = check_walls(path, scene.spec)
+    budget.check_settings(scene)
+    part = scene.spec["particles"]
+    if "from_run" in part:
+        return
+    budget.check_count(scene, budget.particle_count(part), "particles")
+    pos = scene.pos0 = initial_positions(scene)
+    check_positions(path, "particles", pos, walls)
+    budget.check_memory(scene, pos)
 
 
 def initial_state(scene):
@@ -151,23 +186,114 @@ def initial_state(scene):
 
     A ``from_run`` scene continues the final state of that run file.
     """
+    if "from_run" in scene.spec["particles"]:
+        st = start_file(scene)
+        return st["pos"], st["weight"], st["steps"], st["spacing"]
     part = scene.spec["particles"]
-    if "from_run" in part:
-        from . import runfile
-
-        src = part["from_run"]
-        if not Path(src).is_file():
-            raise SceneError(f"{scene.path}: field 'particles.from_run': no such file '{src}'")
-        ds = runfile.read(src)
-        if ds.attrs.get("status") == "escaped" or not np.isfinite(ds["pos"].values).all():
-            raise SceneError(f"{scene.path}: field 'particles.from_run': '{src}' holds no valid state")
-        pos = ds["pos"].values
-        lo, hi = scene.walls.reshape(-1, 2).min(0), scene.walls.reshape(-1, 2).max(0)
-        if ((pos < lo) | (pos > hi)).any():
-            raise SceneError(f"{scene.path}: field 'particles.from_run': particles of '{src}' lie outside the walls")
-        return pos, ds["weight"].values, int(ds["steps"]), float(ds.attrs["spacing"])
     pos = scene.pos0 if scene.pos0 is not None else initial_positions(scene)
     return pos, np.full(len(pos), float(part["weight"])), 0, scene.spacing or np.nan
+
+
+def start_file(scene):
+    """The state a ``from_run`` scene continues, checked before any work.
+
+    Returns {pos, weight, steps, spacing, path, sha256, state, restart}:
+    state is the solver's restart state (solver.STATE_VARS) when the run file
+    was made under the same dynamics (walls, force laws, update rule and its
+    numbers, chunk), so the continued run repeats the uninterrupted one bit
+    for bit; otherwise None (positions only: a new problem started from a
+    previous state, e.g. application 3 from application 1), and restart
+    says why.  Refused (SceneError naming 'particles.from_run' or the
+    conflicting field): missing, a directory or other non-regular file, not
+    netCDF, an incomplete write, not an ISA run, missing or malformed
+    variables, non-finite or escaped states, particles outside this scene's
+    walls, another particle weight, or a step at or past solver.max_steps.
+    """
+    from . import runfile
+    from .methods.isa import budget, solver
+
+    field = "particles.from_run"
+    src = scene.spec["particles"]["from_run"]
+    where = f"{scene.path}: field '{field}'"
+    try:
+        ds = runfile.open_run(src)
+    except runfile.RunFileError as err:
+        raise SceneError(f"{where}: {err}") from None
+    with ds:
+        if ds.attrs.get("method", "isa") != "isa":
+            raise SceneError(f"{where}: '{src}' is a run of method '{ds.attrs['method']}', not an ISA run")
+        shapes = {"pos": ("particle", "xy"), "weight": ("particle",), "steps": ()}
+        for name, dims in shapes.items():
+            if name not in ds.variables or ds[name].dims != dims:
+                raise SceneError(f"{where}: '{src}' has no variable '{name}' with dimensions {dims}")
+        n = ds.sizes["particle"]
+        if ds.sizes["xy"] != 2 or n == 0:
+            raise SceneError(f"{where}: '{src}' holds no particles in 2D")
+        budget.check_count(scene, n, field)
+        if ds.attrs.get("status") in ("escaped", "nonfinite"):
+            raise SceneError(f"{where}: '{src}' holds no valid state (status {ds.attrs['status']})")
+        pos = np.asarray(ds["pos"].values, float)
+        weight = np.asarray(ds["weight"].values, float)
+        steps = ds["steps"].values
+        try:
+            spacing = float(ds.attrs.get("spacing", np.nan))
+        except (TypeError, ValueError):
+            spacing = np.nan
+        state = _restart_state(scene, ds, n, where)
+    if not np.issubdtype(steps.dtype, np.integer) or not 0 <= int(steps) < 2**62:
+        raise SceneError(f"{where}: '{src}' has no valid step count")
+    steps = int(steps)
+    check_positions(scene.path, field, pos, scene.walls)
+    if not (np.isfinite(weight).all() and (weight > 0).all()):
+        raise SceneError(f"{where}: '{src}' has non-finite or non-positive particle weights")
+    w = float(scene.spec["particles"]["weight"])
+    if not np.all(weight == w):
+        raise SceneError(f"{scene.path}: field 'particles.weight': {w:g} N, but the particles of '{src}' weigh "
+                         f"{weight.min():g}-{weight.max():g} N (a run of another scene)")
+    max_steps = scene.spec["solver"]["max_steps"]
+    if steps >= max_steps:
+        raise SceneError(f"{scene.path}: field 'solver.max_steps': {max_steps} steps, but '{src}' is already at "
+                         f"step {steps} (counted from the chain's start): nothing to do")
+    budget.check_memory(scene, pos)
+    state, restart = state
+    return dict(pos=pos, weight=weight, steps=steps, spacing=spacing, path=src, sha256=runfile.sha256(src),
+                state=state, restart=restart)
+
+
+DYNAMICS = ("du", "f_tol", "f_ref", "dt_max", "skin", "chunk", "wall_l_u", "wall_r_u", "pair_l_u", "pair_r_u")
+
+
+def _restart_state(scene, ds, n, where):
+    """(state or None, why) of an open run file: its solver state if its dynamics equal this scene's."""
+    from .methods.isa import solver
+    from .methods.isa.settings import settings
+
+    s = settings(scene)
+    differ = ["variant"] if ds.attrs.get("variant") != s["variant"] else []
+    for k in DYNAMICS + ("stop_on_cycle",):
+        try:
+            if float(ds.attrs[k]) != float(s[k]):
+                differ.append(k)
+        except (KeyError, TypeError, ValueError):
+            differ.append(k)
+    if "wall_segment" not in ds or ds["wall_segment"].shape != scene.walls.shape or \
+            not np.array_equal(ds["wall_segment"].values, scene.walls):
+        differ.append("walls")
+    if differ:
+        return None, f"positions only (the run differs from this scene in {', '.join(differ)})"
+    present = [k for k in solver.STATE_VARS if k in ds.variables]
+    if not present:
+        return None, "positions only (the run file holds no solver state)"
+    state = {}
+    for name, (dims, _, _) in solver.STATE_VARS.items():
+        ok = name in ds.variables and ds[name].dims == dims
+        ok = ok and (dims[:1] != ("particle",) or ds[name].shape == (n, 2))
+        ok = ok and (dims != ("cycle_window",) or ds[name].size <= 10**6)
+        v = np.asarray(ds[name].values, float) if ok else None
+        if not ok or not np.isfinite(v).all():
+            raise SceneError(f"{where}: the run file's solver state '{name}' is missing, malformed or not finite")
+        state[name] = v
+    return state, "solver state restored (bit-identical continuation)"
 
 
 def initial_positions(scene):
@@ -215,6 +341,5 @@ def load_tank(path):
     path = str(path)
     text, spec = inputs.load(path, TANK_SCHEMA, "tank")
     tank = Tank(path, spec, text)
-    if not np.isfinite(tank.walls).all():
-        raise SceneError(f"{path}: field 'walls': coordinates must be finite")
+    check_walls(path, spec)
     return tank

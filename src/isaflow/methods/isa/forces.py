@@ -69,7 +69,7 @@ def forces(pos, weight, walls, wall_l_u, wall_r_u, pair_l_u, pair_r_u, pi, pj, m
 
     Pairs are taken from the first m entries of the neighbour list (pi, pj).
     Returns max|F| = max over particles of max(|Fx|, |Fy|) (paper §3.3);
-    NaN if any force is non-finite.
+    NaN if any force or position is non-finite.
     """
     n = pos.shape[0]
     for i in range(n):
@@ -94,7 +94,7 @@ def forces(pos, weight, walls, wall_l_u, wall_r_u, pair_l_u, pair_r_u, pi, pj, m
     fmax = 0.0
     finite = True
     for i in range(n):
-        fmax, finite = track_max(f[i, 0], f[i, 1], fmax, finite)
+        fmax, finite = track_max(f[i, 0], f[i, 1], fmax, finite & (abs(pos[i, 0]) < np.inf) & (abs(pos[i, 1]) < np.inf))
     if not finite:
         return np.nan
     return fmax

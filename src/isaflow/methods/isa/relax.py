@@ -6,8 +6,10 @@ Update rules (``rule`` argument of :func:`relax`):
            growing in force units once max|F| < f_ref)
 - FIRE   : FIRE (Bitzek et al., PRL 97, 170201, 2006) with unit masses, each
            move capped at du (variant).
-Status codes: RUNNING, CONVERGED (max|F| < f_tol), NONFINITE, CROSSED (a step
-would carry a particle across a wall; the step is not taken).
+Status codes: RUNNING, CONVERGED (max|F| < f_tol), NONFINITE (a position or
+force is NaN or infinite), CROSSED (a step would carry a particle across a
+wall; the step is not taken).  :func:`relax_resume` takes and returns the
+restart state (list-build positions, moved bound, FIRE dt/alpha/n_pos).
 """
 
 import numpy as np
@@ -74,7 +76,12 @@ def _move_and_wall_forces(pos, direction, scale, move, weight, walls, wall_l_u, 
 
 @njit(**JIT)
 def _pair_forces(pos, pair_l_u, pair_r_u, row_start, nbr, force):
-    """Add the pair forces of the row list to force; returns max|F| as forces.forces does.
+    """Add the pair forces of the row list to force; returns (max|F| as forces.forces does, bad).
+
+    bad: the first particle (cell order) whose position or force is NaN or
+    infinite (then max|F| is NaN), else -1.  Positions are checked too: the
+    force laws return finite forces for NaN distances (their "coincident"
+    branch), so a force check alone would miss them.
 
     Row q holds particle q's pairs (q, nbr[k]) for row_start[q] <= k <
     row_start[q + 1], in the order of core.neighbours.build_pairs, so every
@@ -84,7 +91,7 @@ def _pair_forces(pos, pair_l_u, pair_r_u, row_start, nbr, force):
     SW, S, SE, which all come first), so max|F| is taken on the fly.
     """
     fmax = 0.0
-    finite = True
+    bad = -1
     for q in range(pos.shape[0]):
         xi = pos[q, 0]
         yi = pos[q, 1]
@@ -99,10 +106,12 @@ def _pair_forces(pos, pair_l_u, pair_r_u, row_start, nbr, force):
             force[j, 1] -= gy
         force[q, 0] = fx
         force[q, 1] = fy
-        fmax, finite = track_max(fx, fy, fmax, finite)
-    if not finite:
-        return np.nan
-    return fmax
+        fmax, finite = track_max(fx, fy, fmax, (abs(xi) < np.inf) & (abs(yi) < np.inf))
+        if not finite and bad < 0:
+            bad = q
+    if bad >= 0:
+        return np.nan, bad
+    return fmax, bad
 
 
 @njit(**JIT)
@@ -189,6 +198,18 @@ def _fire_velocities(vel, force, rank, dt, dt_max, alpha, n_pos):
 @njit(**JIT)
 def relax(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pair_r_u, rule, du, f_ref,
           dt_max, f_tol, n_steps, skin, force, fmax_hist):
+    """One chunk from a fresh start (neighbour list built from pos, FIRE reset); see :func:`relax_resume`.
+
+    Returns (steps_done, status, crossing).
+    """
+    state = np.zeros(4)
+    return relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pair_r_u, rule, du, f_ref,
+                        dt_max, f_tol, n_steps, skin, force, fmax_hist, np.empty_like(pos), state, False)
+
+
+@njit(**JIT)
+def relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pair_r_u, rule, du, f_ref,
+                 dt_max, f_tol, n_steps, skin, force, fmax_hist, pos_build, state, resume):
     """Run up to n_steps relaxation steps in place; the whole loop is compiled.
 
     pos (N, 2) cm, vel (N, 2) (FIRE velocities), weight (N,) N, walls (W, 4) cm,
@@ -196,7 +217,15 @@ def relax(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pair_r_u, 
     out-of-balance forces [N]; fmax_hist[k] the max|F| [N] *before* step k.
     A neighbour list with cutoff pair_l_u + skin is rebuilt whenever particles
     may have moved skin / 2 since the last build.  Returns (steps_done,
-    status, crossing): crossing = particle * W + wall for CROSSED, else -1.
+    status, crossing): crossing = particle * W + wall for CROSSED, the first
+    non-finite particle for NONFINITE, else -1.
+
+    Restart state (in and out): pos_build (N, 2) cm, the positions at the
+    last list build, and state (4,) = (moved bound since that build [cm],
+    FIRE dt [s], alpha, n_pos).  resume=False is a fresh start: the list is
+    built from pos, moved = 0 and FIRE is reset (dt = dt_max / 10).
+    resume=True rebuilds the list from pos_build and continues with the
+    given state, so a run split anywhere repeats the unsplit run bit for bit.
 
     Implementation (results identical, to the last bit, to the plain loop
     "move; rebuild with build_pairs if due; forces.forces"): the pair list is
@@ -220,24 +249,34 @@ def relax(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pair_r_u, 
     vel_c = np.empty((n, 2))
     force_c = np.empty((n, 2))
     weight_c = np.empty(n)
-    nbr, cstart = cell_rows(pos, box, rc, order, np.empty(1, np.int32), row_start, np.empty(4 * n + 16, np.int32))
-    _to_cell_order(pos, vel, weight, order, nbr, row_start[n], rank, pos_c, vel_c, weight_c)
+    if not resume:
+        pos_build[:, :] = pos
+    nbr, cstart = cell_rows(pos_build, box, rc, order, np.empty(1, np.int32), row_start,
+                            np.empty(4 * n + 16, np.int32))
+    _to_cell_order(pos_build, vel, weight, order, nbr, row_start[n], rank, pos_c, vel_c, weight_c)
     near_part, near_wall = _near_walls(pos_c, walls, reach)
-    moved = 0.0  # bound on any displacement since the last build, cm
+    if resume:
+        for q in range(n):
+            pos_c[q, 0] = pos[order[q], 0]
+            pos_c[q, 1] = pos[order[q], 1]
+        moved, dt, alpha, n_pos = state[0], state[1], state[2], int(state[3])
+    else:
+        moved, dt, alpha, n_pos = 0.0, 0.1 * dt_max, FIRE_ALPHA0, 0  # moved: bound on any displacement, cm
     _move_and_wall_forces(pos_c, force_c, 0.0, False, weight_c, walls, wall_l_u, wall_r_u, near_part, near_wall,
                           force_c)
-    fmax = _pair_forces(pos_c, pair_l_u, pair_r_u, row_start, nbr, force_c)
-    dt = 0.1 * dt_max
-    alpha = FIRE_ALPHA0
-    n_pos = 0
+    fmax, bad = _pair_forces(pos_c, pair_l_u, pair_r_u, row_start, nbr, force_c)
     status = RUNNING
     crossing = -1
     done = n_steps
-    for step in range(n_steps):
-        fmax_hist[step] = fmax
-        if not np.isfinite(fmax):
+    for step in range(n_steps + 1):
+        if step < n_steps:
+            fmax_hist[step] = fmax
+        if bad >= 0:
             status = NONFINITE
+            crossing = order[bad]
             done = step
+            break
+        if step == n_steps:
             break
         if fmax < f_tol:
             status = CONVERGED
@@ -274,6 +313,7 @@ def relax(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pair_r_u, 
                 pos_c[q, 1] = pos_c[q, 1] + scale * direction[q, 1]
             _to_caller_order(order, pos_c, pos)
             _to_caller_order(order, vel_c, vel)
+            pos_build[:, :] = pos
             nbr, cstart = cell_rows(pos, box, rc, order, cstart, row_start, nbr)
             _to_cell_order(pos, vel, weight, order, nbr, row_start[n], rank, pos_c, vel_c, weight_c)
             near_part, near_wall = _near_walls(pos_c, walls, reach)
@@ -283,8 +323,9 @@ def relax(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pair_r_u, 
         else:
             _move_and_wall_forces(pos_c, direction, scale, True, weight_c, walls, wall_l_u, wall_r_u, near_part,
                                   near_wall, force_c)
-        fmax = _pair_forces(pos_c, pair_l_u, pair_r_u, row_start, nbr, force_c)
+        fmax, bad = _pair_forces(pos_c, pair_l_u, pair_r_u, row_start, nbr, force_c)
     _to_caller_order(order, pos_c, pos)
     _to_caller_order(order, vel_c, vel)
     _to_caller_order(order, force_c, force)
+    state[0], state[1], state[2], state[3] = moved, dt, alpha, n_pos
     return done, status, crossing

@@ -82,8 +82,9 @@ class _History:
         self.rec = {k: [] for k in ("hist_step", "hist_fmax", "hist_fmax_lo", "hist_fmax_hi",
                                     "sample_step", "hist_wall_resultant", "hist_vessel_count", "snap_step", "snap_pos")}
 
-    def steps(self, step, h):
-        for k0 in range(0, len(h), self.every):
+    def steps(self, step, h, origin):
+        """Record h (max|F| before steps step, step + 1, ...) in strides counted from step origin <= step."""
+        for k0 in range((origin - step) % self.every, len(h), self.every):
             seg = h[k0:k0 + self.every]
             self.rec["hist_step"].append(step + k0)
             self.rec["hist_fmax"].append(seg[0])
@@ -123,12 +124,35 @@ class _History:
         return out
 
 
-def solve(scene, pos0, weight, start_step=0, progress=None):
+STATE_VARS = {  # restart state written to every run file: name -> (dims, units, long_name)
+    "state_vel": (("particle", "xy"), "cm s-1", "FIRE velocity (unit masses) at the end of the run"),
+    "state_pos_build": (("particle", "xy"), "cm", "positions at the last neighbour-list build"),
+    "state_chunk_start": (("particle", "xy"), "cm", "positions at the start of the last chunk (cycle test)"),
+    "state_moved": ((), "cm", "bound on any displacement since the last neighbour-list build"),
+    "state_fire_dt": ((), "s", "FIRE time step"),
+    "state_fire_alpha": ((), "1", "FIRE mixing parameter alpha"),
+    "state_fire_n_pos": ((), "1", "FIRE steps since the power was last negative"),
+    "state_recent_fmax": (("cycle_window",), "N", "last max|F| values (cycle-detection window)"),
+}
+
+
+def _state_fields(vel, pos_build, chunk_start, kernel, recent):
+    arrays = dict(state_vel=vel, state_pos_build=pos_build, state_chunk_start=chunk_start,
+                  state_moved=kernel[0], state_fire_dt=kernel[1], state_fire_alpha=kernel[2],
+                  state_fire_n_pos=kernel[3], state_recent_fmax=recent)
+    return {k: (d, np.asarray(arrays[k]), u, ln) for k, (d, u, ln) in STATE_VARS.items()}
+
+
+def solve(scene, pos0, weight, start_step=0, progress=None, state=None):
     """Relax ``pos0`` (N, 2) cm with per-particle ``weight`` (N,) N under an ISA scene.
 
     start_step: steps already taken (a continued run counts from there up to
     solver.max_steps).  progress(step, fmax) is called after each chunk.
-    Returns a contract.Result (method 'isa', variant = the update rule).
+    state: {STATE_VARS name: array} of the run this one continues (same
+    scene dynamics), or None for a fresh start; with it the continued run
+    repeats the uninterrupted one bit for bit, at any start_step.
+    Returns a contract.Result (method 'isa', variant = the update rule);
+    its fields hold the restart state (STATE_VARS).
     """
     s = settings(scene)
     walls = scene.walls
@@ -136,35 +160,50 @@ def solve(scene, pos0, weight, start_step=0, progress=None):
     vessels = [(v["name"], v["x"]) for v in scene.spec.get("vessels", [])]
     pos = np.array(pos0, float, copy=True)
     weight = np.asarray(weight, float)
-    vel = np.zeros_like(pos)
     force = np.zeros_like(pos)
     chunk = s["chunk"]
+    restored = state is not None
+    vel = np.array(state["state_vel"], float) if restored else np.zeros_like(pos)
+    pos_build = np.array(state["state_pos_build"], float) if restored else pos.copy()
+    kernel = np.array([float(state[k]) for k in ("state_moved", "state_fire_dt", "state_fire_alpha",
+                                                 "state_fire_n_pos")]) if restored else np.zeros(4)
+    recent = np.array(state["state_recent_fmax"], float) if restored else np.zeros(0)
+    resume = restored and start_step % chunk != 0  # inside a chunk: continue its list and FIRE state
+    chunk_start = np.array(state["state_chunk_start"], float) if resume else pos.copy()
     buf = np.zeros(chunk)
     hist = _History(s["history"], len(walls), vessels)
     snap_every = max(1, round((s["max_steps"] - start_step) / max(hist.n_snap, 1) / chunk))
-    recent = np.zeros(0)
     warm_up()
     step = start_step
-    status, message, period = "step_limit", "", 0
+    status, message, period, bad_particle = "step_limit", "", 0, -1
     evals = 0
     t0 = time.perf_counter()
     n_chunk = 0
-    while step < s["max_steps"]:
+    while True:
         # chunks end on multiples of `chunk` counted from the chain's start, so
         # a run continued from a state file repeats an uninterrupted run exactly
-        n = min(chunk - step % chunk, s["max_steps"] - step)
-        chunk_start = pos.copy()
-        done, code, crossing = R.relax(
+        n = min(chunk - step % chunk, s["max_steps"] - step) if step < s["max_steps"] else 0
+        origin = step - step % chunk if resume else step  # history strides count from here
+        if not resume:
+            chunk_start = pos.copy()
+        done, code, crossing = R.relax_resume(
             pos, vel, weight, walls, box, s["wall_l_u"], s["wall_r_u"], s["pair_l_u"], s["pair_r_u"],
             RULES[s["variant"]], s["du"], s["f_ref"], s["dt_max"], s["f_tol"], n, s["skin"], force, buf,
+            pos_build, kernel, resume,
         )
+        resume = False
         evals += done + 1  # one evaluation per step taken, plus the chunk's initial one
         h = buf[:done]
         if hist.every:
-            hist.steps(step, h)
+            hist.steps(step, h, origin)
         step += done
         n_chunk += 1
         recent = np.concatenate([recent, h])[-2000:]
+        if n == 0:  # started at or past max_steps: forces evaluated once, nothing moved
+            if code != R.NONFINITE and np.abs(force).max(initial=0.0) < s["f_tol"]:
+                status = "converged"
+            if code != R.NONFINITE:
+                break
         hist.chunk(step, pos, s, walls, hist.n_snap and n_chunk % snap_every == 0)
         if progress:
             progress(step, float(h[-1]) if done else np.nan)
@@ -172,7 +211,10 @@ def solve(scene, pos0, weight, start_step=0, progress=None):
             status = "converged"
             break
         if code == R.NONFINITE:
-            status, message = "nonfinite", f"non-finite forces at step {step}"
+            status = "nonfinite"
+            bad_particle = crossing
+            message = (f"non-finite position of particle {crossing} at step {step}"
+                       if not np.isfinite(pos[crossing]).all() else f"non-finite forces at step {step}")
             break
         if code == R.CROSSED:
             i, w = divmod(crossing, walls.shape[0])
@@ -197,6 +239,8 @@ def solve(scene, pos0, weight, start_step=0, progress=None):
                 message = (f"max|F| repeats with period {period} steps between {tail.min():.4g} and "
                            f"{tail.max():.4g} N (f_tol {s['f_tol']:g} N) by step {step}")
                 break
+        if step >= s["max_steps"]:
+            break
     wall_time = time.perf_counter() - t0
     fmax = float(np.abs(force).max()) if len(force) else 0.0
     if status == "step_limit":
@@ -205,14 +249,14 @@ def solve(scene, pos0, weight, start_step=0, progress=None):
         message = f"max|F| = {fmax:.4g} N < f_tol = {s['f_tol']:g} N after {step} steps"
     part, wall, point, cforce = contacts(pos, walls, s)
     params = {k: v for k, v in s.items() if k not in ("accept", "history", "variant", "stop_on_cycle")}
-    params.update(cycle_period=int(period), stop_on_cycle=int(s["stop_on_cycle"]))
+    params.update(cycle_period=int(period), stop_on_cycle=int(s["stop_on_cycle"]), nonfinite_particle=int(bad_particle))
+    fields = {"force": (("particle", "xy"), force, "N", "final out-of-balance force on particle"),
+              "contact_particle": (("contact",), part.astype(np.int32), "1", "particle index of wall contact")}
+    fields.update(_state_fields(vel, pos_build, chunk_start, kernel, recent))
     return Result(
         method="isa", variant=s["variant"], pos0=np.array(pos0, float), pos=pos, weight=weight,
         contact_wall=wall, contact_point=point, contact_force=cforce, status=status, message=message,
         steps=step, start_step=start_step, wall_time=wall_time, force_evals=evals, residual=fmax,
         residual_name="max|F|", residual_units="N",
-        history=hist.variables(len(pos)),
-        fields={"force": (("particle", "xy"), force, "N", "final out-of-balance force on particle"),
-                "contact_particle": (("contact",), part.astype(np.int32), "1", "particle index of wall contact")},
-        params=params,
+        history=hist.variables(len(pos)), fields=fields, params=params,
     )

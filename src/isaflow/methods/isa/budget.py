@@ -1,0 +1,143 @@
+"""What an ISA run will need, checked before anything large is allocated (cm, N, bytes).
+
+:func:`check_settings` refuses settings whose derived numbers (stiffness,
+f_ref, dt_max, skin) are not finite and positive; :func:`check_count` and
+:func:`check_memory` estimate the run's memory (particles, neighbour pairs,
+cell grid, history records, snapshots, chunk buffer) and refuse, with the
+estimate, a run that cannot fit the memory available.  The limit is the
+machine's available memory (/proc/meminfo MemAvailable) or, if set, the
+environment variable ISAFLOW_MEMORY_LIMIT_MB.
+"""
+
+import math
+import os
+
+import numpy as np
+
+from ...inputs import InputError
+from .settings import settings
+
+BYTES_PER_PARTICLE = 640  # solver + compiled loop + contacts + the run file's copy (measured order, rounded up)
+BYTES_PER_PAIR = 12  # int32 neighbour entry with its doubling growth
+BYTES_PER_RECORD = 4 * 56  # hist_fmax/lo/hi/step records held as Python lists, then arrays
+MAX_GRID_CELLS = 10**9  # cells of the neighbour grid (int32 cell starts)
+
+
+def memory_limit():
+    """Bytes a run may use: ISAFLOW_MEMORY_LIMIT_MB if set, else MemAvailable, else 8 GB."""
+    env = os.environ.get("ISAFLOW_MEMORY_LIMIT_MB")
+    if env:
+        try:
+            return float(env) * 2**20
+        except ValueError:
+            raise InputError(f"environment variable ISAFLOW_MEMORY_LIMIT_MB: '{env}' is not a number") from None
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return float(line.split()[1]) * 1024
+    except OSError:
+        pass
+    return 8.0 * 2**30
+
+
+def _gb(b):
+    return f"{b / 2**30:.3g} GB"
+
+
+def check_settings(scene):
+    """Refuse derived solver numbers that are not finite and positive (naming the field they come from)."""
+    s = settings(scene)
+    checks = [("forces.wall", s["wall_r_u"] / s["wall_l_u"]), ("forces.pair", s["pair_r_u"] / s["pair_l_u"]),
+              ("solver.f_ref", s["f_ref"]), ("solver.dt_max", s["dt_max"]), ("solver.skin", s["skin"])]
+    for field, value in checks:
+        if not (math.isfinite(value) and value > 0):
+            raise InputError(f"{scene.path}: field '{field}': the derived value {value!r} is not a finite positive "
+                             f"number (over- or underflow); choose less extreme numbers")
+    return s
+
+
+def particle_count(part):
+    """Particles a lattice or points block will create, without creating them."""
+    if "points" in part:
+        return len(part["points"])
+    lat = part["lattice"]
+    rows, lengths = lat["rows"], lat["row_lengths"]
+    full, rest = divmod(rows, len(lengths))
+    return full * sum(lengths) + sum(lengths[:rest])
+
+
+def _refuse(scene, field, need, limit, what):
+    raise InputError(f"{scene.path}: field '{field}': the run needs about {_gb(need)} of memory ({what}); "
+                     f"{_gb(limit)} available")
+
+
+def _fixed_bytes(scene, n):
+    """(bytes, field, what) of the history records, snapshots and chunk buffer of a run of n particles."""
+    s = settings(scene)
+    hist = s["history"]
+    steps = s["max_steps"]
+    chunks = steps // s["chunk"] + 2
+    records = steps // hist["every"] + chunks if hist.get("every") else 0
+    snaps = min(hist.get("snapshots", 0), chunks)
+    samples = chunks * (len(scene.walls) * 48 + len(scene.spec.get("vessels", [])) * 24 + 64) \
+        if hist.get("walls") or hist.get("vessels") else 0
+    parts = [(records * BYTES_PER_RECORD, "solver.history.every", f"{records:.3g} max|F| records"),
+             (snaps * n * 32, "solver.history.snapshots", f"{snaps} snapshots of {n} particles"),
+             (samples, "solver.chunk", f"{chunks:.3g} chunk-end samples"),
+             (s["chunk"] * 8, "solver.chunk", f"a chunk buffer of {s['chunk']:.3g} steps")]
+    return parts
+
+
+def check_count(scene, n, field):
+    """Refuse a particle count (before the particles exist) whose run cannot fit in memory."""
+    limit = memory_limit()
+    parts = [(n * BYTES_PER_PARTICLE, field, f"{n:.3g} particles")] + _fixed_bytes(scene, n)
+    need = sum(p[0] for p in parts)
+    if need > limit:
+        big = max(parts)
+        _refuse(scene, big[1], need, limit, big[2])
+
+
+def pair_bound(pos, box, rc):
+    """Upper bound on the neighbour pairs within rc: all pairs in the same or adjacent cells of the rc grid."""
+    ncx = max(1, int((box[2] - box[0]) / rc))
+    ncy = max(1, int((box[3] - box[1]) / rc))
+    cx = np.clip(((pos[:, 0] - box[0]) / ((box[2] - box[0]) / ncx)).astype(np.int64), 0, ncx - 1)
+    cy = np.clip(((pos[:, 1] - box[1]) / ((box[3] - box[1]) / ncy)).astype(np.int64), 0, ncy - 1)
+    keys, counts = np.unique(cy * ncx + cx, return_counts=True)
+    counts = counts.astype(float)
+    total = float((counts * (counts - 1) / 2).sum())
+    kx, ky = keys % ncx, keys // ncx
+    for ox, oy in ((1, 0), (-1, 1), (0, 1), (1, 1)):
+        nx, ny = kx + ox, ky + oy
+        ok = (nx >= 0) & (nx < ncx) & (ny < ncy)
+        nb = ny * ncx + nx
+        j = np.clip(np.searchsorted(keys, nb), 0, len(keys) - 1)
+        hit = ok & (keys[j] == nb)
+        total += float((counts * np.where(hit, counts[j], 0.0)).sum())
+    return total
+
+
+def check_memory(scene, pos):
+    """Refuse a run whose particles, pairs, grid and records cannot fit in memory (pos (N, 2) cm)."""
+    s = settings(scene)
+    walls = scene.walls
+    lo, hi = walls.reshape(-1, 2).min(0), walls.reshape(-1, 2).max(0)
+    rc = s["pair_l_u"] + s["skin"]
+    cells = max(1.0, (hi[0] - lo[0]) / rc) * max(1.0, (hi[1] - lo[1]) / rc)
+    if not cells <= MAX_GRID_CELLS:
+        raise InputError(f"{scene.path}: field 'forces.pair.l_u': the neighbour grid over the walls' bounding box "
+                         f"would have {cells:.3g} cells of {rc:.3g} cm (limit {MAX_GRID_CELLS:.0e}); the walls are "
+                         f"too far apart for this pair range")
+    n = len(pos)
+    pairs = pair_bound(pos, np.array([lo[0], lo[1], hi[0], hi[1]]), rc)
+    parts = [(n * BYTES_PER_PARTICLE, "particles", f"{n} particles"),
+             (pairs * BYTES_PER_PAIR, "particles", f"up to {pairs:.3g} neighbour pairs"),
+             (cells * 4, "forces.pair.l_u", f"{cells:.3g} grid cells")] + _fixed_bytes(scene, n)
+    need = sum(p[0] for p in parts)
+    limit = memory_limit()
+    if need > limit:
+        big = max(parts)
+        _refuse(scene, big[1], need, limit, big[2])
+    return need

@@ -1,0 +1,411 @@
+"""Hostile input (issue 9, item 1): every bad scene, override, start file and output path is refused
+before any work with exit code 2, one line naming the file and the field, and nothing written.
+
+Cases run in process through ``cli.main`` (argument parsing, checks, exit code) with stderr captured;
+two run through a real subprocess to show that no traceback reaches the user.  The corpus of small
+malformed files is tests/data/hostile/; large files and field-level cases are built here from a
+valid scene (conftest.TINY).  Accepted on purpose (documented in docs/hostile_input.md): hostile but
+well-formed physics (coincident particles, particles on walls, R_u = 1e308) - those are outcomes, not
+bad input.
+"""
+
+import copy
+import os
+import stat
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from isaflow import cli, runfile
+
+from conftest import ROOT, TINY
+
+CORPUS = Path(__file__).parent / "data" / "hostile"
+
+
+def write_scene(tmp_path, spec, name="scene.yaml"):
+    path = tmp_path / name
+    path.write_text(yaml.safe_dump(spec))
+    return path
+
+
+def refused(tmp_path, capsys, scene, *args, out=None, field=None):
+    """Run the CLI; assert exit 2, one 'error:' line naming the scene file and field, and no output."""
+    out = tmp_path / "out" / "run.nc" if out is None else out
+    argv = ["run", str(scene), "-o", str(out), "-q", *args]
+    existed = os.path.lexists(out)
+    t0 = time.perf_counter()
+    code = cli.main(argv)
+    elapsed = time.perf_counter() - t0
+    err = capsys.readouterr().err
+    lines = err.strip().splitlines()
+    assert code == 2, err
+    assert len(lines) == 1 and lines[0].startswith("error: "), err
+    assert "Traceback" not in err
+    if field is not None:
+        assert field in lines[0], (field, lines[0])
+    assert existed or not os.path.lexists(out), f"{out} was written"
+    parent = Path(out).parent
+    if parent.is_dir():
+        assert not [p for p in parent.glob(".*partial*")], "a temporary file was left"
+    return lines[0], elapsed
+
+
+
+def mutate(path_value_pairs):
+    spec = copy.deepcopy(TINY)
+    for dotted, value in path_value_pairs:
+        node = spec
+        keys = dotted.split(".")
+        for k in keys[:-1]:
+            node = node[int(k)] if isinstance(node, list) else node[k]
+        if value is DELETE:
+            del node[keys[-1]]
+        elif isinstance(node, list):
+            node[int(keys[-1])] = value
+        else:
+            node[keys[-1]] = value
+    return spec
+
+
+DELETE = object()
+
+# ---- files that are not a small plain YAML mapping --------------------------------------------
+FILE_CASES = {
+    "empty.yaml": "(top level)", "comment_only.yaml": "(top level)", "latin1.yaml": "not UTF-8",
+    "binary.yaml": "not UTF-8", "utf16_bom.yaml": "not UTF-8", "top_list.yaml": "(top level)",
+    "top_scalar.yaml": "(top level)", "two_documents.yaml": "more than one YAML document",
+    "alias_bomb.yaml": "anchors and aliases", "anchor_alias.yaml": "anchors and aliases",
+    "python_tag.yaml": "explicit YAML tags", "str_tag.yaml": "explicit YAML tags",
+    "custom_tag.yaml": "explicit YAML tags", "duplicate_top.yaml": "duplicate key 'name'",
+    "duplicate_nested.yaml": "duplicate key 'du'", "complex_key.yaml": "mapping key",
+    "int_key.yaml": "mapping key", "merge_key.yaml": "line 3", "unclosed_bracket.yaml": "line",
+    "tab_indent.yaml": "line 3", "deep_block.yaml": "nesting deeper than 32", "nul_char.yaml": "line 1",
+}
+
+
+@pytest.mark.parametrize("name", sorted(FILE_CASES))
+def test_malformed_files_are_refused(tmp_path, capsys, name):
+    line, elapsed = refused(tmp_path, capsys, CORPUS / name, field=FILE_CASES[name])
+    assert name in line
+    # the alias bomb expands to 9^9 strings; it is refused at its first anchor (it took > 30 s before)
+    assert elapsed < 5.0
+
+
+@pytest.mark.parametrize("case", ["missing", "directory", "fifo", "deep_flow", "too_large", "unreadable"])
+def test_unusable_scene_files_are_refused(tmp_path, capsys, case):
+    path = tmp_path / "scene.yaml"
+    expect = {"missing": "no such file", "directory": "a directory", "fifo": "not a regular file",
+              "deep_flow": "nesting deeper than 32", "too_large": "larger than", "unreadable": "scene"}[case]
+    if case == "directory":
+        path.mkdir()
+    elif case == "fifo":
+        os.mkfifo(path)
+    elif case == "deep_flow":  # 50,000-deep nesting raised RecursionError before
+        path.write_text("name: " + "[" * 50_000 + "]" * 50_000 + "\n")
+    elif case == "too_large":
+        path.write_text("description: '" + "x" * 1_100_000 + "'\n")
+    elif case == "unreadable":
+        path = Path("/proc/self/mem")  # a "regular" file that cannot be read
+        expect = "cannot read scene"
+    line, elapsed = refused(tmp_path, capsys, path, field=expect)
+    assert str(path) in line and elapsed < 5.0
+
+
+# ---- fields: types, integers, non-finite and out-of-range numbers, names ----------------------
+NAN, INF = float("nan"), float("inf")
+FIELD_CASES = {
+    "name_trailing_newline": ([("name", "tiny\n")], "'name'"),
+    "name_uppercase": ([("name", "Tiny")], "'name'"),
+    "unknown_top_key": ([("extra", 1)], "'(top level)'"),
+    "unknown_solver_key": ([("solver.stepsize", 1)], "'solver'"),
+    "missing_solver": ([("solver", DELETE)], "'(top level)'"),
+    "rows_integral_float": ([("particles.lattice.rows", 3.0)], "'particles.lattice.rows'"),
+    "every_integral_float": ([("solver.history", {"every": 5.0})], "'solver.history.every'"),
+    "max_steps_float": ([("solver.max_steps", 1e20)], "'solver.max_steps'"),
+    "max_steps_beyond_int64": ([("solver.max_steps", 10**20)], "'solver.max_steps'"),
+    "max_steps_beyond_limit": ([("solver.max_steps", 10**16)], "'solver.max_steps'"),
+    "weight_nan": ([("particles.weight", NAN)], "'particles.weight'"),
+    "weight_inf": ([("particles.weight", INF)], "'particles.weight'"),
+    "weight_minus_inf": ([("particles.weight", -INF)], "'particles.weight'"),
+    "weight_zero": ([("particles.weight", 0.0)], "'particles.weight'"),
+    "weight_huge_int": ([("particles.weight", 10**400)], "'particles.weight'"),
+    "weight_bool": ([("particles.weight", True)], "'particles.weight'"),
+    "weight_string": ([("particles.weight", "50")], "'particles.weight'"),
+    "wall_l_u_nan": ([("forces.wall.l_u", NAN)], "'forces.wall.l_u'"),
+    "wall_r_u_inf": ([("forces.wall.r_u", INF)], "'forces.wall.r_u'"),
+    "pair_l_u_nan": ([("forces.pair.l_u", NAN)], "'forces.pair.l_u'"),
+    "pair_r_u_negative": ([("forces.pair.r_u", -1.0)], "'forces.pair.r_u'"),
+    "law_not_linear": ([("forces.pair.law", "cubic")], "'forces.pair.law'"),
+    "du_nan": ([("solver.du", NAN)], "'solver.du'"),
+    "du_inf": ([("solver.du", INF)], "'solver.du'"),
+    "f_tol_nan": ([("solver.f_tol", NAN)], "'solver.f_tol'"),
+    "f_tol_inf": ([("solver.f_tol", INF)], "'solver.f_tol'"),
+    "dt_max_nan": ([("solver.dt_max", NAN)], "'solver.dt_max'"),
+    "f_ref_inf": ([("solver.f_ref", INF)], "'solver.f_ref'"),
+    "skin_nan": ([("solver.skin", NAN)], "'solver.skin'"),
+    "chunk_too_small": ([("solver.chunk", 50)], "'solver.chunk'"),
+    "accept_unknown": ([("solver.accept", ["converged", "done"])], "'solver.accept.1'"),
+    "variant_unknown": ([("solver.variant", "newton")], "'solver.variant'"),
+    "lattice_a_nan": ([("particles.lattice.a", NAN)], "'particles.lattice.a'"),
+    "center_x_inf": ([("particles.lattice.center_x", INF)], "'particles.lattice.center_x'"),
+    "row_lengths_zero": ([("particles.lattice.row_lengths", [0, 2])], "'particles.lattice.row_lengths.0'"),
+    "points_nan": ([("particles", {"weight": 50.0, "points": [[1.0, NAN]]})], "'particles.points.0.1'"),
+    "lattice_and_points": ([("particles.points", [[5.0, 5.0]])], "'particles'"),
+    "wall_coordinate_nan": ([("walls.0.from", [0.0, NAN])], "'walls.0.from.1'"),
+    "wall_coordinate_huge": ([("walls.0.from", [0.0, 1e300])], "'walls'"),
+    "wall_zero_length": ([("walls.1.to", [0, 0])], "'walls' (floor)"),
+    "wall_names_duplicate": ([("walls.1.name", "left")], "'walls'"),
+    "wall_name_control_char": ([("walls.1.name", "flo\x00or")], "'walls.1.name'"),
+    "description_lone_surrogate": ([("description", "a\ud800b")], "'description'"),
+    "vessel_x_nan": ([("vessels", [{"name": "v", "x": [0.0, NAN]}])], "'vessels.0.x.1'"),
+    "vessel_x_reversed": ([("vessels", [{"name": "v", "x": [20.0, 0.0]}])], "'vessels' (v)"),
+    "outside_the_walls": ([("particles.lattice.center_x", 50.0)], "outside the walls' bounding box"),
+    "stiffness_overflows": ([("forces.wall.l_u", 1e-300), ("forces.wall.r_u", 1e300)], "'forces.wall'"),
+    "stiffness_underflows": ([("forces.pair.l_u", 1e300), ("forces.pair.r_u", 1e-300)], "'forces.pair'"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(FIELD_CASES))
+def test_bad_fields_are_refused_naming_the_field(tmp_path, capsys, case):
+    changes, field = FIELD_CASES[case]
+    spec = mutate(changes)
+    path = tmp_path / "scene.yaml"
+    # PyYAML writes NaN/inf as .nan/.inf and huge ints as digits, as a user would type them
+    path.write_text(yaml.dump(spec, allow_unicode=False))
+    line, _ = refused(tmp_path, capsys, path, field=field)
+    assert "scene.yaml" in line
+
+
+# ---- resources: refused with the estimate, before anything is allocated ------------------------
+RESOURCE_CASES = {
+    "1e10_particles": ([("particles.lattice.rows", 100_000), ("particles.lattice.row_lengths", [100_000])],
+                       "'particles'"),
+    "chunk_1e12": ([("solver.chunk", 10**12), ("solver.max_steps", 10**12)], "'solver.chunk'"),
+    "records_every_step": ([("solver.max_steps", 10**15), ("solver.history", {"every": 1})],
+                           "'solver.history.every'"),
+    "snapshots_of_1e6_particles": ([("particles.lattice.rows", 1000), ("particles.lattice.row_lengths", [1000]),
+                                    ("walls", [{"name": "left", "from": [0, 6000], "to": [0, 0]},
+                                               {"name": "floor", "from": [0, 0], "to": [11000, 0]},
+                                               {"name": "right", "from": [11000, 0], "to": [11000, 6000]}]),
+                                    ("particles.lattice.center_x", 5500.0), ("solver.max_steps", 10**15),
+                                    ("solver.history", {"snapshots": 10**6})], "'solver.history.snapshots'"),
+    "grid_of_1e15_cells": ([("forces.pair.l_u", 1e-6), ("forces.pair.r_u", 1e-3)], "'forces.pair.l_u'"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(RESOURCE_CASES))
+def test_runs_that_cannot_fit_in_memory_are_refused_with_the_estimate(tmp_path, capsys, case, monkeypatch):
+    monkeypatch.setenv("ISAFLOW_MEMORY_LIMIT_MB", "4096")  # a 4 GB machine: the refusals hold anywhere
+    changes, field = RESOURCE_CASES[case]
+    path = write_scene(tmp_path, mutate(changes))
+    line, elapsed = refused(tmp_path, capsys, path, field=field)
+    assert ("the run needs about" in line and "GB available" in line) or "cells" in line
+    assert elapsed < 5.0  # nothing was allocated (a 10^10-particle lattice would take minutes and 160 GB)
+
+
+# ---- --set overrides ---------------------------------------------------------------------------
+SET_CASES = {
+    "no_equals": ("solver.du", "key=value"),
+    "malformed_yaml": ("solver.du=[1,", "not valid YAML"),
+    "python_tag": ("name=!!python/object/apply:os.system [ls]", "explicit YAML tags"),
+    "alias": ("solver.accept=&a [*a]", "anchors and aliases"),
+    "into_a_scalar": ("solver.du.x=1", "'solver.du' is not a mapping"),
+    "into_a_list": ("walls.0.from=[1, 2]", "'walls' is not a mapping"),
+    "missing_field": ("solver.bogus.x=1", "no field 'bogus'"),
+    "empty_key": ("=1", "empty field name"),
+    "empty_segment": ("solver..du=1", "empty field name"),
+    "deep_value": ("solver.du=" + "[" * 100 + "]" * 100, "nesting deeper than 32"),
+    "control_char": ("solver.du=0.\x0701", "control characters"),
+    "nan_value": ("solver.du=.nan", "'solver.du'"),
+    "inf_value": ("solver.f_tol=.inf", "'solver.f_tol'"),
+    "replace_a_block_with_a_scalar": ("solver=5", "'solver'"),
+    "two_documents": ("solver.du=1\n---\n2", "more than one YAML document"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(SET_CASES))
+def test_bad_overrides_are_refused(tmp_path, capsys, case):
+    item, expect = SET_CASES[case]
+    path = write_scene(tmp_path, TINY)
+    line, _ = refused(tmp_path, capsys, path, "--set", item, field=expect)
+    assert "scene.yaml" in line
+
+
+# ---- start files (particles.from_run) ---------------------------------------------------------
+@pytest.fixture(scope="module")
+def tiny_run(tmp_path_factory):
+    """A valid run file of TINY stopped at step 300 (so a continuation has steps left)."""
+    tmp = tmp_path_factory.mktemp("start")
+    path = write_scene(tmp, TINY)
+    out = tmp / "tiny.nc"
+    spec = {**TINY["solver"], "max_steps": 300, "accept": ["converged", "step_limit"]}
+    assert cli.run(str(path), str(out), [f"solver={yaml.safe_dump(spec, default_flow_style=True).strip()}"],
+                   quiet=True) == 0
+    return out
+
+
+def start_case(tmp_path, tiny_run, case):
+    """(path of the start file, extra overrides, expected text) of one bad start file."""
+    p = tmp_path / "start.nc"
+    extra = []
+    ds = runfile.read(tiny_run)
+    if case == "missing":
+        return tmp_path / "nope.nc", extra, "no such file"
+    if case == "directory":
+        p.mkdir()
+        return p, extra, "a directory"
+    if case == "fifo":
+        os.mkfifo(p)
+        return p, extra, "not a regular file"
+    if case == "text_file":
+        p.write_text("pos: [1, 2]\n")
+        return p, extra, "not a netCDF file"
+    if case == "truncated":
+        p.write_bytes(Path(tiny_run).read_bytes()[:600])
+        return p, extra, "cannot be opened as netCDF"
+    if case == "partial_name":
+        p = tmp_path / f".tiny.nc{runfile.PARTIAL}12345"
+        p.write_bytes(Path(tiny_run).read_bytes())
+        return p, extra, "temporary file of an unfinished write"
+    if case == "incomplete":
+        ds.attrs["isaflow_complete"] = "no"
+    elif case == "no_pos":
+        ds = ds.drop_vars("pos")
+    elif case == "pos_1d":
+        ds["pos"] = ("particle", ds["pos"].values[:, 0])
+    elif case == "other_method":
+        ds.attrs["method"] = "sph"
+    elif case == "nan_pos":
+        ds["pos"].values[1, 0] = np.nan
+    elif case == "escaped":
+        ds.attrs["status"] = "escaped"
+    elif case == "outside_walls":
+        ds["pos"].values[0] = [30.0, 5.0]
+    elif case == "other_weight":
+        ds["weight"].values[:] = 10.0
+    elif case == "past_max_steps":
+        extra = ["solver.max_steps=300"]
+    elif case == "nan_state":
+        ds["state_vel"].values[0, 0] = np.nan
+    elif case == "steps_float":
+        ds["steps"] = ((), 300.5)
+    ds.to_netcdf(p)
+    expect = {"incomplete": "incomplete write", "no_pos": "no variable 'pos'", "pos_1d": "no variable 'pos'",
+              "other_method": "method 'sph'", "nan_pos": "must be finite", "escaped": "no valid state",
+              "outside_walls": "outside the walls", "other_weight": "'particles.weight'",
+              "past_max_steps": "'solver.max_steps'", "nan_state": "state_vel",
+              "steps_float": "no valid step count"}[case]
+    return p, extra, expect
+
+
+START_CASES = ["missing", "directory", "fifo", "text_file", "truncated", "partial_name", "incomplete", "no_pos",
+               "pos_1d", "other_method", "nan_pos", "escaped", "outside_walls", "other_weight", "past_max_steps",
+               "nan_state", "steps_float"]
+
+
+@pytest.mark.parametrize("case", START_CASES)
+def test_bad_start_files_are_refused(tmp_path, capsys, tiny_run, case):
+    start, extra, expect = start_case(tmp_path, tiny_run, case)
+    path = write_scene(tmp_path, {**TINY, "particles": {"weight": 50.0, "from_run": str(start)}})
+    sets = [a for e in extra for a in ("--set", e)]
+    line, _ = refused(tmp_path, capsys, path, *sets, field=expect)
+    assert "scene.yaml" in line and ("particles" in line or "solver" in line)
+
+
+def test_a_good_start_file_continues(tmp_path, capsys, tiny_run):
+    path = write_scene(tmp_path, {**TINY, "particles": {"weight": 50.0, "from_run": str(tiny_run)}})
+    out = tmp_path / "cont.nc"
+    assert cli.main(["run", str(path), "-o", str(out), "-q"]) == 0
+    ds = runfile.read(out)
+    assert int(ds["start_step"]) == 300 and ds.attrs["start_sha256"] == runfile.sha256(tiny_run)
+
+
+# ---- output paths: checked before the solve ---------------------------------------------------
+def out_case(tmp_path, case):
+    if case == "directory":
+        (tmp_path / "o").mkdir()
+        return tmp_path / "o", "a directory"
+    if case == "device":
+        return Path("/dev/null"), "a device"
+    if case == "full_device":
+        return Path("/dev/full"), "a device"
+    if case == "fifo":
+        os.mkfifo(tmp_path / "f.nc")
+        return tmp_path / "f.nc", "a device, FIFO or socket"
+    if case == "symlink":
+        (tmp_path / "real.nc").write_text("x")
+        (tmp_path / "link.nc").symlink_to(tmp_path / "real.nc")
+        return tmp_path / "link.nc", "a symbolic link"
+    if case == "parent_is_a_file":
+        (tmp_path / "file").write_text("x")
+        return tmp_path / "file" / "sub" / "run.nc", "is not a directory"
+    if case == "unwritable_directory":
+        if os.geteuid() == 0:  # root writes anywhere permissions allow nothing; /proc refuses new files
+            return Path("/proc/isaflow_test_run.nc"), "cannot write the output"
+        d = tmp_path / "ro"
+        d.mkdir()
+        d.chmod(stat.S_IRUSR | stat.S_IXUSR)
+        return d / "run.nc", "cannot write the output"
+    if case == "empty_name":
+        return Path("."), "names no file"
+
+
+OUT_CASES = ["directory", "device", "full_device", "fifo", "symlink", "parent_is_a_file", "unwritable_directory",
+             "empty_name"]
+
+
+@pytest.mark.parametrize("case", OUT_CASES)
+def test_unusable_output_paths_are_refused_before_the_solve(tmp_path, capsys, case, monkeypatch):
+    out, expect = out_case(tmp_path, case)
+    before = os.lstat(out) if os.path.lexists(out) else None
+    solved = []
+    monkeypatch.setattr("isaflow.methods.isa.solver.solve", lambda *a, **k: solved.append(1))
+    line, _ = refused(tmp_path, capsys, write_scene(tmp_path, TINY), out=out, field=expect)
+    assert not solved and str(out) in line
+    if before is not None:  # the device, FIFO, link or directory is untouched
+        after = os.lstat(out)
+        assert (after.st_mode, after.st_ino, after.st_rdev) == (before.st_mode, before.st_ino, before.st_rdev)
+
+
+def test_config_file_must_exist(tmp_path, capsys):
+    refused(tmp_path, capsys, write_scene(tmp_path, TINY), "--config", str(tmp_path / "none.yaml"), field="--config")
+
+
+# ---- the real command line: no traceback, exit 2 ---------------------------------------------
+@pytest.mark.parametrize("args", [["run", str(CORPUS / "binary.yaml"), "-o", "X"],
+                                  ["run", str(CORPUS / "alias_bomb.yaml"), "-o", "X", "--set", "solver.du=.nan"]])
+def test_command_line_refuses_without_a_traceback(tmp_path, args):
+    args = [a.replace("X", str(tmp_path / "run.nc")) for a in args]
+    proc = subprocess.run([sys.executable, "-m", "isaflow.cli", *args], capture_output=True, text=True, cwd=ROOT,
+                          timeout=120)
+    assert proc.returncode == 2 and "Traceback" not in proc.stderr
+    assert len(proc.stderr.strip().splitlines()) == 1 and not (tmp_path / "run.nc").exists()
+
+
+def test_argument_errors_exit_2(capsys):
+    for argv in ([], ["run"], ["run", "x.yaml"], ["bogus"]):
+        with pytest.raises(SystemExit) as exc:
+            cli.main(argv)
+        assert exc.value.code == 2
+    assert "Traceback" not in capsys.readouterr().err
+
+
+def test_undecodable_command_line_arguments_are_refused(tmp_path, capsys):
+    bad = os.fsdecode(b"scene\xff.yaml")  # how Python hands over non-UTF-8 argv bytes
+    assert cli.main(["run", bad, "-o", str(tmp_path / "r.nc")]) == 2
+    assert "not valid Unicode" in capsys.readouterr().err
+
+
+def test_accepted_hostile_physics_is_an_outcome_not_an_input_error(tmp_path, capsys):
+    """R_u = 1e308 N overflows the force (the study's float_limit case): a valid input whose run ends as
+    'nonfinite' - reported against solver.accept (exit 1), never written as a NaN file."""
+    spec = mutate([("forces.wall.r_u", 1e308), ("particles", {"weight": 50.0, "points": [[10.0, 0.1]]})])
+    out = tmp_path / "run.nc"
+    assert cli.main(["run", str(write_scene(tmp_path, spec)), "-o", str(out), "-q"]) == 1
+    assert "outcome 'nonfinite' is not accepted" in capsys.readouterr().err and not out.exists()

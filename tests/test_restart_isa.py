@@ -1,0 +1,118 @@
+"""Restarts (issue 9, item 4): a run split at any step and continued from its run file
+repeats the uninterrupted run bit for bit, for all three update rules.
+
+A column of 22 particles of the coarse lattice spreading over the floor of an
+80 cm vessel (particles cross cells, so a neighbour list built at the split
+step would sum forces in another order), with a skin of 4 cm (lists live
+long between builds), chunks of 1,000 steps, and a max|F| record stride of
+7 steps that does not divide the chunk.  Split steps are drawn at random (seeded) inside the run,
+plus a chunk multiple and the step after it; and, for the paper's rule in a
+settled vessel where it cycles, steps inside the window that detects the
+cycle.
+Compared exactly (np.array_equal): every data variable of the uninterrupted
+run, except pos0 / start_step / force_evals / wall_time (they describe the
+continued run itself) and snapshots (none here); records (hist_*) from the
+split step on, chunk-end samples after it.
+"""
+
+import numpy as np
+import pytest
+import yaml
+
+from isaflow import cli, runfile
+
+from conftest import L_B, L_P, R_B, R_P
+
+WALLS = [{"name": "left", "from": [0, 80], "to": [0, 0]}, {"name": "floor", "from": [0, 0], "to": [80, 0]},
+         {"name": "right", "from": [80, 0], "to": [80, 80]}]
+SCENE = {
+    "name": "restart",
+    "walls": WALLS,
+    "particles": {"weight": 50.0, "lattice": {"a": 10.0, "rows": 9, "row_lengths": [2, 3], "center_x": 15.0,
+                                              "bottom_y": 5.0}},
+    "forces": {"wall": {"law": "linear", "l_u": L_B, "r_u": R_B}, "pair": {"law": "linear", "l_u": L_P, "r_u": R_P}},
+    "solver": {"variant": "paper", "du": 0.01, "f_tol": 0.1, "max_steps": 8000, "chunk": 1000, "skin": 4.0,
+               "accept": ["converged", "cycle", "step_limit"], "history": {"every": 7, "walls": True}},
+}
+RULES = {  # rule: solver overrides (FIRE as in test_fire: du is only a move cap)
+    "paper": {},
+    "capped": {"variant": "capped", "f_ref": 5.0},
+    "fire": {"variant": "fire", "du": 1.0, "dt_max": 0.02},
+}
+OWN = {"pos0", "start_step", "force_evals", "wall_time"}  # properties of the continued run itself
+
+
+# the same lattice settled in a 40 cm vessel: the paper's rule ends in a limit cycle
+SETTLED = {**SCENE, "walls": [{"name": "left", "from": [0, 60], "to": [0, 0]},
+                              {"name": "floor", "from": [0, 0], "to": [40, 0]},
+                              {"name": "right", "from": [40, 0], "to": [40, 60]}],
+           "particles": {"weight": 50.0, "lattice": {"a": 10.0, "rows": 7, "row_lengths": [3, 4], "center_x": 20.0,
+                                                     "bottom_y": 5.0}}}
+
+
+def run(tmp_path, name, rule, *sets, base=SCENE):
+    spec = {**base, "solver": {**base["solver"], **RULES[rule]}}
+    path = tmp_path / "scene.yaml"
+    path.write_text(yaml.safe_dump(spec))
+    out = tmp_path / f"{name}.nc"
+    assert cli.run(str(path), str(out), list(sets), quiet=True) == 0
+    return out
+
+
+def from_run(path):
+    """Override replacing the lattice by a start file."""
+    return f"particles={{weight: 50.0, from_run: '{path}'}}"
+
+
+def assert_continues(whole, leg2, split):
+    assert leg2.attrs["restart"].startswith("solver state restored")
+    assert int(leg2["start_step"]) == split
+    for attr in ("status", "status_message", "cycle_period"):
+        assert str(whole.attrs[attr]) == str(leg2.attrs[attr]), attr
+    compared = 0
+    for name in whole.data_vars:
+        if name in OWN:
+            continue
+        a, b = whole[name], leg2[name]
+        if "record" in a.dims:
+            a = a.isel(record=whole["hist_step"].values >= split)
+        if "sample" in a.dims:
+            a = a.isel(sample=whole["sample_step"].values > split)
+        assert a.shape == b.shape, (name, a.shape, b.shape)
+        assert np.array_equal(a.values, b.values), f"{name} differs after a restart at step {split}"
+        compared += 1
+    assert compared >= 15
+
+
+def split_and_compare(tmp_path, rule, splits, base=SCENE):
+    whole = runfile.read(run(tmp_path, "whole", rule, base=base))
+    total = int(whole["steps"])
+    for split in sorted(s for s in splits(total) if 0 < s < total):
+        leg1 = run(tmp_path, f"leg1_{split}", rule, f"solver.max_steps={split}", base=base)
+        assert int(runfile.read(leg1)["steps"]) == split
+        leg2 = run(tmp_path, f"leg2_{split}", rule, from_run(leg1), base=base)
+        assert_continues(whole, runfile.read(leg2), split)
+    return whole
+
+
+@pytest.mark.parametrize("rule", list(RULES))
+def test_split_runs_repeat_the_uninterrupted_run_bit_for_bit(tmp_path, rule):
+    rng = np.random.default_rng(1)  # the same steps for every rule: paper and capped coincide while max|F| > f_ref
+    whole = split_and_compare(tmp_path, rule, lambda total: {int(s) for s in rng.integers(1, total, 6)} | {1000, 1001})
+    assert int(whole["steps"]) > 800, "the run must be long enough to split"
+
+
+def test_a_split_inside_the_cycle_window_repeats_the_uninterrupted_run(tmp_path):
+    """The 450 max|F| values that detect the paper rule's cycle straddle the restart (137 and 37 steps
+    before the chunk end that detects it): the window is restored from the run file."""
+    whole = split_and_compare(tmp_path, "paper", lambda total: {total - 137, total - 37}, base=SETTLED)
+    assert whole.attrs["status"] == "cycle" and int(whole["steps"]) % 1000 == 0
+
+
+def test_a_changed_scene_continues_from_positions_only(tmp_path):
+    """Another update rule (or walls, laws, du, ...) is a new problem from a previous state, as in the
+    paper's applications 3-4: the run file says so, and the continued run starts FIRE and the list afresh."""
+    leg1 = run(tmp_path, "leg1", "paper", "solver.max_steps=150")
+    leg2 = runfile.read(run(tmp_path, "leg2", "capped", from_run(leg1), "solver.max_steps=300"))
+    assert leg2.attrs["restart"].startswith("positions only") and "variant" in leg2.attrs["restart"]
+    assert leg2.attrs["start_sha256"] == runfile.sha256(leg1) and leg2.attrs["start_file"] == str(leg1)
