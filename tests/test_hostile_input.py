@@ -20,10 +20,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
+from conftest import ROOT, TINY
 
 from isaflow import cli, runfile
-
-from conftest import ROOT, TINY
 
 CORPUS = Path(__file__).parent / "data" / "hostile"
 

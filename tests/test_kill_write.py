@@ -16,10 +16,9 @@ import threading
 
 import pytest
 import yaml
+from conftest import ROOT, TINY
 
 from isaflow import runfile
-
-from conftest import ROOT, TINY
 
 TIMEOUT = 120  # s for any one wait (numba loads its cache in a few seconds)
 

@@ -18,10 +18,9 @@ split step on, chunk-end samples after it.
 import numpy as np
 import pytest
 import yaml
+from conftest import L_B, L_P, R_B, R_P
 
 from isaflow import cli, runfile
-
-from conftest import L_B, L_P, R_B, R_P
 
 WALLS = [{"name": "left", "from": [0, 80], "to": [0, 0]}, {"name": "floor", "from": [0, 0], "to": [80, 0]},
          {"name": "right", "from": [80, 0], "to": [80, 80]}]

@@ -15,7 +15,8 @@ import signal
 import sys
 from pathlib import Path
 
-from . import inputs, runfile, scene as scenes
+from . import inputs, runfile
+from . import scene as scenes
 
 
 def _interrupted(signum, frame):
@@ -118,7 +119,7 @@ def main(argv=None):
     except MemoryError:
         _error("out of memory (the estimate in methods.isa.budget was too low: please report); no output written")
         return 2
-    except Exception as err:  # noqa: BLE001 - one line, never a traceback, unless debugging
+    except Exception as err:
         if os.environ.get("ISAFLOW_DEBUG") == "1":
             raise
         _error(f"internal error {type(err).__name__}: {inputs.printable(str(err), 300)} (ISAFLOW_DEBUG=1 shows the "

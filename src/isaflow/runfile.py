@@ -12,8 +12,8 @@ import datetime as dt
 import glob
 import hashlib
 import os
-import stat
 import platform
+import stat
 import subprocess
 import sys
 import time
@@ -140,7 +140,7 @@ def to_dataset(result, tank, prov, started, finished, spacing, references=""):
 
 def now():
     """Current UTC time, ISO 8601 to the second."""
-    return dt.datetime.now(dt.timezone.utc).isoformat(timespec="seconds")
+    return dt.datetime.now(dt.UTC).isoformat(timespec="seconds")
 
 
 class RunFileError(ValueError):

@@ -7,7 +7,6 @@ import hashlib
 import json
 from dataclasses import dataclass, field
 from importlib import resources
-from pathlib import Path
 
 import numpy as np
 
@@ -195,105 +194,10 @@ def initial_state(scene):
 
 
 def start_file(scene):
-    """The state a ``from_run`` scene continues, checked before any work.
+    """The checked state a ``from_run`` scene continues (methods.isa.restart.start_file)."""
+    from .methods.isa.restart import start_file as _start_file
 
-    Returns {pos, weight, steps, spacing, path, sha256, state, restart}:
-    state is the solver's restart state (solver.STATE_VARS) when the run file
-    was made under the same dynamics (walls, force laws, update rule and its
-    numbers, chunk), so the continued run repeats the uninterrupted one bit
-    for bit; otherwise None (positions only: a new problem started from a
-    previous state, e.g. application 3 from application 1), and restart
-    says why.  Refused (SceneError naming 'particles.from_run' or the
-    conflicting field): missing, a directory or other non-regular file, not
-    netCDF, an incomplete write, not an ISA run, missing or malformed
-    variables, non-finite or escaped states, particles outside this scene's
-    walls, another particle weight, or a step at or past solver.max_steps.
-    """
-    from . import runfile
-    from .methods.isa import budget, solver
-
-    field = "particles.from_run"
-    src = scene.spec["particles"]["from_run"]
-    where = f"{scene.path}: field '{field}'"
-    try:
-        ds = runfile.open_run(src)
-    except runfile.RunFileError as err:
-        raise SceneError(f"{where}: {err}") from None
-    with ds:
-        if ds.attrs.get("method", "isa") != "isa":
-            raise SceneError(f"{where}: '{src}' is a run of method '{ds.attrs['method']}', not an ISA run")
-        shapes = {"pos": ("particle", "xy"), "weight": ("particle",), "steps": ()}
-        for name, dims in shapes.items():
-            if name not in ds.variables or ds[name].dims != dims:
-                raise SceneError(f"{where}: '{src}' has no variable '{name}' with dimensions {dims}")
-        n = ds.sizes["particle"]
-        if ds.sizes["xy"] != 2 or n == 0:
-            raise SceneError(f"{where}: '{src}' holds no particles in 2D")
-        budget.check_count(scene, n, field)
-        if ds.attrs.get("status") in ("escaped", "nonfinite"):
-            raise SceneError(f"{where}: '{src}' holds no valid state (status {ds.attrs['status']})")
-        pos = np.asarray(ds["pos"].values, float)
-        weight = np.asarray(ds["weight"].values, float)
-        steps = ds["steps"].values
-        try:
-            spacing = float(ds.attrs.get("spacing", np.nan))
-        except (TypeError, ValueError):
-            spacing = np.nan
-        state = _restart_state(scene, ds, n, where)
-    if not np.issubdtype(steps.dtype, np.integer) or not 0 <= int(steps) < 2**62:
-        raise SceneError(f"{where}: '{src}' has no valid step count")
-    steps = int(steps)
-    check_positions(scene.path, field, pos, scene.walls)
-    if not (np.isfinite(weight).all() and (weight > 0).all()):
-        raise SceneError(f"{where}: '{src}' has non-finite or non-positive particle weights")
-    w = float(scene.spec["particles"]["weight"])
-    if not np.all(weight == w):
-        raise SceneError(f"{scene.path}: field 'particles.weight': {w:g} N, but the particles of '{src}' weigh "
-                         f"{weight.min():g}-{weight.max():g} N (a run of another scene)")
-    max_steps = scene.spec["solver"]["max_steps"]
-    if steps >= max_steps:
-        raise SceneError(f"{scene.path}: field 'solver.max_steps': {max_steps} steps, but '{src}' is already at "
-                         f"step {steps} (counted from the chain's start): nothing to do")
-    budget.check_memory(scene, pos)
-    state, restart = state
-    return dict(pos=pos, weight=weight, steps=steps, spacing=spacing, path=src, sha256=runfile.sha256(src),
-                state=state, restart=restart)
-
-
-DYNAMICS = ("du", "f_tol", "f_ref", "dt_max", "skin", "chunk", "wall_l_u", "wall_r_u", "pair_l_u", "pair_r_u")
-
-
-def _restart_state(scene, ds, n, where):
-    """(state or None, why) of an open run file: its solver state if its dynamics equal this scene's."""
-    from .methods.isa import solver
-    from .methods.isa.settings import settings
-
-    s = settings(scene)
-    differ = ["variant"] if ds.attrs.get("variant") != s["variant"] else []
-    for k in DYNAMICS + ("stop_on_cycle",):
-        try:
-            if float(ds.attrs[k]) != float(s[k]):
-                differ.append(k)
-        except (KeyError, TypeError, ValueError):
-            differ.append(k)
-    if "wall_segment" not in ds or ds["wall_segment"].shape != scene.walls.shape or \
-            not np.array_equal(ds["wall_segment"].values, scene.walls):
-        differ.append("walls")
-    if differ:
-        return None, f"positions only (the run differs from this scene in {', '.join(differ)})"
-    present = [k for k in solver.STATE_VARS if k in ds.variables]
-    if not present:
-        return None, "positions only (the run file holds no solver state)"
-    state = {}
-    for name, (dims, _, _) in solver.STATE_VARS.items():
-        ok = name in ds.variables and ds[name].dims == dims
-        ok = ok and (dims[:1] != ("particle",) or ds[name].shape == (n, 2))
-        ok = ok and (dims != ("cycle_window",) or ds[name].size <= 10**6)
-        v = np.asarray(ds[name].values, float) if ok else None
-        if not ok or not np.isfinite(v).all():
-            raise SceneError(f"{where}: the run file's solver state '{name}' is missing, malformed or not finite")
-        state[name] = v
-    return state, "solver state restored (bit-identical continuation)"
+    return _start_file(scene)
 
 
 def initial_positions(scene):
