@@ -372,6 +372,16 @@ def test_unusable_output_paths_are_refused_before_the_solve(tmp_path, capsys, ca
         assert (after.st_mode, after.st_ino, after.st_rdev) == (before.st_mode, before.st_ino, before.st_rdev)
 
 
+def test_output_onto_an_input_is_refused(tmp_path, capsys, tiny_run):
+    scene_path = write_scene(tmp_path, TINY)
+    refused(tmp_path, capsys, scene_path, out=scene_path, field="would overwrite the scene")
+    start = tmp_path / "start.nc"
+    start.write_bytes(Path(tiny_run).read_bytes())
+    path = write_scene(tmp_path, {**TINY, "particles": {"weight": 50.0, "from_run": str(start)}}, "cont.yaml")
+    refused(tmp_path, capsys, path, out=start, field="would overwrite particles.from_run")
+    assert runfile.read(start)["steps"] == 300  # untouched
+
+
 def test_config_file_must_exist(tmp_path, capsys):
     refused(tmp_path, capsys, write_scene(tmp_path, TINY), "--config", str(tmp_path / "none.yaml"), field="--config")
 
@@ -408,3 +418,33 @@ def test_accepted_hostile_physics_is_an_outcome_not_an_input_error(tmp_path, cap
     out = tmp_path / "run.nc"
     assert cli.main(["run", str(write_scene(tmp_path, spec)), "-o", str(out), "-q"]) == 1
     assert "outcome 'nonfinite' is not accepted" in capsys.readouterr().err and not out.exists()
+
+
+# ---- the solver never returns a non-finite state silently (issue 9, item 2) ------------------
+def test_a_nan_position_ends_the_compiled_loop_as_nonfinite_naming_the_particle():
+    """With a NaN position every distance test is false, so the force laws take their 'coincident' /
+    'on the wall' branches and return finite forces: the loop must check positions, not only forces."""
+    from isaflow.methods.isa import relax as R
+    from conftest import box_walls
+
+    pos = np.array([[30.0, 5.0], [40.0, 5.0], [np.nan, 5.0], [50.0, 5.0]])
+    walls = box_walls()
+    force, hist = np.zeros_like(pos), np.zeros(10)
+    done, status, which = R.relax(pos, np.zeros_like(pos), np.full(4, 50.0), walls, np.array([0, 0, 100, 100.0]),
+                                  5.0, 1e4, 7.07, 3535.5, R.PAPER, 0.01, 50.0, 0.1, 0.1, 10, 2.0, force, hist)
+    assert (done, status, which) == (0, R.NONFINITE, 2)
+
+
+def test_a_run_started_at_its_step_limit_computes_its_forces_once(tmp_path):
+    """Called directly (the command line refuses such a start file), the solver evaluates the forces
+    of the start state instead of returning zeros, and takes no step."""
+    from isaflow import scene as scenes
+    from isaflow.methods.isa import solver
+
+    sc = scenes.load(write_scene(tmp_path, TINY))
+    pos0, weight, _, _ = scenes.initial_state(sc)
+    res = solver.solve(sc, pos0, weight, start_step=TINY["solver"]["max_steps"])
+    assert res.steps == TINY["solver"]["max_steps"] and res.force_evals == 1
+    np.testing.assert_array_equal(res.pos, pos0)
+    # the lattice start is out of balance: max|F| is the weight-scale residual, not 0
+    assert res.status == "step_limit" and res.residual == np.abs(res.fields["force"][1]).max() > 1.0

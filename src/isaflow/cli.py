@@ -43,7 +43,18 @@ def prepare(scene_path, out, overrides=(), config=None):
         except OSError as err:
             raise scenes.SceneError(f"{config}: --config: {err.strerror or err}") from None
     runfile.check_output(out)
+    inputs_read = {"the scene": scene_path, "--config": config, "particles.from_run": start and start["path"]}
+    for what, src in inputs_read.items():
+        if src and _same_file(src, out):
+            raise runfile.RunFileError(f"{out}: the output would overwrite {what} ('{src}'); choose another path")
     return scene, start, settings(scene)
+
+
+def _same_file(a, b):
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return False
 
 
 def run(scene_path, out, overrides=(), config=None, quiet=False):

@@ -252,11 +252,14 @@ def open_run(path):
     p = Path(path)
     if PARTIAL in p.name:
         raise RunFileError(f"'{path}' is the temporary file of an unfinished write, not a run file")
-    if not p.is_file():
-        kind = "a directory" if p.is_dir() else "not a regular file" if p.exists() else "no such file"
-        raise RunFileError(f"'{path}': {kind}")
-    with open(p, "rb") as f:
-        magic = f.read(8)
+    try:
+        if not p.is_file():
+            kind = "a directory" if p.is_dir() else "not a regular file" if p.exists() else "no such file"
+            raise RunFileError(f"'{path}': {kind}")
+        with open(p, "rb") as f:
+            magic = f.read(8)
+    except OSError as err:
+        raise RunFileError(f"'{path}': cannot read: {err.strerror or err}") from None
     if not (magic.startswith(b"CDF") or magic.startswith(b"\x89HDF")):
         raise RunFileError(f"'{path}' is not a netCDF file")
     try:

@@ -37,27 +37,13 @@ def start_file(scene):
         ds = runfile.open_run(src)
     except runfile.RunFileError as err:
         raise SceneError(f"{where}: {err}") from None
-    with ds:
-        if ds.attrs.get("method", "isa") != "isa":
-            raise SceneError(f"{where}: '{src}' is a run of method '{ds.attrs['method']}', not an ISA run")
-        shapes = {"pos": ("particle", "xy"), "weight": ("particle",), "steps": ()}
-        for name, dims in shapes.items():
-            if name not in ds.variables or ds[name].dims != dims:
-                raise SceneError(f"{where}: '{src}' has no variable '{name}' with dimensions {dims}")
-        n = ds.sizes["particle"]
-        if ds.sizes["xy"] != 2 or n == 0:
-            raise SceneError(f"{where}: '{src}' holds no particles in 2D")
-        budget.check_count(scene, n, field)
-        if ds.attrs.get("status") in ("escaped", "nonfinite"):
-            raise SceneError(f"{where}: '{src}' holds no valid state (status {ds.attrs['status']})")
-        pos = np.asarray(ds["pos"].values, float)
-        weight = np.asarray(ds["weight"].values, float)
-        steps = ds["steps"].values
-        try:
-            spacing = float(ds.attrs.get("spacing", np.nan))
-        except (TypeError, ValueError):
-            spacing = np.nan
-        state = _restart_state(scene, ds, n, where)
+    try:
+        with ds:
+            pos, weight, steps, spacing, state = _read_start(scene, ds, src, where, field)
+    except SceneError:
+        raise
+    except (OSError, RuntimeError, ValueError, TypeError, KeyError, IndexError) as err:
+        raise SceneError(f"{where}: '{src}' cannot be read as a run file ({type(err).__name__})") from None
     if not np.issubdtype(steps.dtype, np.integer) or not 0 <= int(steps) < 2**62:
         raise SceneError(f"{where}: '{src}' has no valid step count")
     steps = int(steps)
@@ -76,6 +62,30 @@ def start_file(scene):
     state, restart = state
     return dict(pos=pos, weight=weight, steps=steps, spacing=spacing, path=src, sha256=runfile.sha256(src),
                 state=state, restart=restart)
+
+
+def _read_start(scene, ds, src, where, field):
+    """(pos, weight, steps, spacing, (state, why)) of an open start file, shapes checked before loading."""
+    if ds.attrs.get("method", "isa") != "isa":
+        raise SceneError(f"{where}: '{src}' is a run of method '{ds.attrs['method']}', not an ISA run")
+    shapes = {"pos": ("particle", "xy"), "weight": ("particle",), "steps": ()}
+    for name, dims in shapes.items():
+        if name not in ds.variables or ds[name].dims != dims:
+            raise SceneError(f"{where}: '{src}' has no variable '{name}' with dimensions {dims}")
+    n = ds.sizes["particle"]
+    if ds.sizes["xy"] != 2 or n == 0:
+        raise SceneError(f"{where}: '{src}' holds no particles in 2D")
+    budget.check_count(scene, n, field)
+    if ds.attrs.get("status") in ("escaped", "nonfinite"):
+        raise SceneError(f"{where}: '{src}' holds no valid state (status {ds.attrs['status']})")
+    pos = np.asarray(ds["pos"].values, float)
+    weight = np.asarray(ds["weight"].values, float)
+    steps = ds["steps"].values
+    try:
+        spacing = float(ds.attrs.get("spacing", np.nan))
+    except (TypeError, ValueError):
+        spacing = np.nan
+    return pos, weight, steps, spacing, _restart_state(scene, ds, n, where)
 
 
 DYNAMICS = ("du", "f_tol", "f_ref", "dt_max", "skin", "chunk", "wall_l_u", "wall_r_u", "pair_l_u", "pair_r_u")
