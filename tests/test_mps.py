@@ -248,3 +248,19 @@ def test_bad_settings_name_file_and_field(tmp_path):
         settings.load(CFG, ["model.beta=1.5"])
     with pytest.raises(SceneError, match="no field"):
         settings.load(CFG, ["model.nope=1"])
+
+
+def test_stiff_cases_change_only_their_setting():
+    """Each stiff case overrides exactly the settings it names (large time step, small radii, no relaxation);
+    on_wall keeps the settings and asks for a particle on the floor line."""
+    from isaflow.methods.mps import outputs
+
+    cfg = settings.load(CFG)
+    changed = {}
+    for case in outputs.STIFF_CASES:
+        new, start = outputs.stiff_settings(cfg, case)
+        changed[case] = sorted(k for k in cfg if new[k] != cfg[k])
+        assert (start == "on_wall") == (case == "on_wall")
+    assert changed == {"large_dt": ["time.courant"], "small_re": ["model.re_density", "model.re_gradient", "model.re_laplacian"],
+                       "no_relaxation": ["model.relaxation"], "on_wall": []}
+    assert outputs.stiff_settings(cfg, "large_dt")[0]["time.courant"] == cfg["stiff.courant_large"] > cfg["time.courant"]

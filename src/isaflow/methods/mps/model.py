@@ -63,6 +63,22 @@ def number_density(pos, pi, pj, m, re):
 
 
 @njit(**JIT)
+def neighbour_offset_sum(pos, pi, pj, m, rc):
+    """(N, 2) sum_j (r_j - r_i) [cm] over all neighbours closer than rc (MPS-Basic's particle-distribution test)."""
+    out = np.zeros((pos.shape[0], 2))
+    for k in range(m):
+        i, j = pi[k], pj[k]
+        dx = pos[j, 0] - pos[i, 0]
+        dy = pos[j, 1] - pos[i, 1]
+        if dx * dx + dy * dy < rc * rc:
+            out[i, 0] += dx
+            out[i, 1] += dy
+            out[j, 0] -= dx
+            out[j, 1] -= dy
+    return out
+
+
+@njit(**JIT)
 def divergence(pos, vel, pi, pj, m, re, n0):
     """(N,) MPS divergence of vel [1/s] (all neighbours, wall velocity 0)."""
     div = np.zeros(pos.shape[0])
@@ -244,13 +260,14 @@ def collide(ps, vs, kind, pi, pj, m, dist, restitution):
 
 @njit(**JIT)
 def predict(pos, vel, kind, box, dt, gx, gy, nu, re_n, re_g, re_l, n0_n, n0_g, n0_l, lam, beta, rho0, source, gamma,
-            relax, sound, coll_dist, restitution):
+            relax, sound, coll_dist, restitution, dist_thr=0.0):
     """Explicit half of a step (eq. 3) and the pressure equation at the moved positions.
 
     Fluid: V* = V + dt (nu lap V + g), U* = U + dt V* (walls fixed), then the
     collision model if coll_dist > 0 (cm; see collide).  Then at U*: n* (radius
-    re_n), div V* (re_g), free surface (n* < beta n0: fluid and wall particles
-    get Dirichlet P = 0), source term (relax: relaxation of the standard
+    re_n), div V* (re_g), free surface (n* < beta n0 and, if dist_thr > 0 [cm], a
+    component of sum_j r_ij over the neighbours beyond dist_thr: MPS-Basic's
+    particle-distribution test; fluid and wall particles get Dirichlet P = 0), source term (relax: relaxation of the standard
     source) and the CSR system (see assemble) with the compressibility term
     1 / (rho0 c^2 dt^2) of sound speed ``sound`` [cm/s] (0: none).
     Returns (pos*, vel*, n*, div*, dirichlet, (pi, pj, m) at U*, (row, indptr, indices, data, rhs)).
@@ -267,16 +284,19 @@ def predict(pos, vel, kind, box, dt, gx, gy, nu, re_n, re_g, re_l, n0_n, n0_g, n
             ps[i, 0] = pos[i, 0] + dt * vs[i, 0]
             ps[i, 1] = pos[i, 1] + dt * vs[i, 1]
     if coll_dist > 0.0:
-        pi, pj, m = build_pairs(ps, box, rmax)
+        pi, pj, m = build_pairs(ps, box, coll_dist)
         collide(ps, vs, kind, pi, pj, m, coll_dist, restitution)
     pi, pj, m = build_pairs(ps, box, rmax)
     n_star = number_density(ps, pi, pj, m, re_n)
     div = divergence(ps, vs, pi, pj, m, re_g, n0_g)
     dirichlet = np.zeros(pos.shape[0], np.bool_)
     b = np.zeros(pos.shape[0])
+    offsets = neighbour_offset_sum(ps, pi, pj, m, rmax)
     for i in range(pos.shape[0]):
         if kind[i] != DUMMY:
             dirichlet[i] = n_star[i] < beta * n0_n
+            if dirichlet[i] and dist_thr > 0.0:
+                dirichlet[i] = abs(offsets[i, 0]) > dist_thr or abs(offsets[i, 1]) > dist_thr
             b[i] = source_term(n_star[i], div[i], n0_n, rho0, dt, source, gamma, relax)
     extra = 0.0
     if sound > 0.0:  # alpha / dt^2 with alpha = 1 / (rho0 c^2), times the row scale lambda n0 rho0 / (2 d)

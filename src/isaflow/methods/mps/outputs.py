@@ -15,7 +15,6 @@ import numpy as np
 import pandas as pd
 
 from isaflow import metrics, runfile
-from isaflow.core import units
 from isaflow.scene import load_tank
 
 from . import boundary, settings, solver
@@ -126,21 +125,6 @@ def time_to_rest(ds):
     return float(t[last[-1] + 1]) if len(last) else float(t[0])
 
 
-def growth_rate(ds):
-    """(rate [1/s], rate x sqrt(l0 / g) [1]) of the exponential growth of the rms speed from its minimum to the
-    first sample 10 times larger (least squares on log rms); NaN if it never grows tenfold.  A lattice
-    instability driven by the neighbourhood-minimum term of the gradient (p_i - p^_i ~ 2 l0 rho g) grows at a
-    rate ~ sqrt(g / l0), so the second number is about constant over spacings."""
-    t, u = ds["hist_time"].values, ds["hist_rms_speed"].values
-    k0 = int(np.argmin(u[: max(1, len(u) // 2)]))
-    up = np.flatnonzero(u[k0:] > 10 * u[k0])
-    if not len(up) or up[0] < 3 or u[k0] <= 0:
-        return np.nan, np.nan
-    sl = slice(k0, k0 + up[0] + 1)
-    rate = float(np.polyfit(t[sl], np.log(u[sl]), 1)[0])
-    return rate, rate * float(np.sqrt(float(ds.attrs["spacing"]) / units.G))
-
-
 def summary_row(path):
     """One summary row of a run file: metrics.run_row plus MPS noise, cost and rest measures."""
     ds = runfile.read(path)
@@ -150,12 +134,12 @@ def summary_row(path):
     row = dict(run=stem, case=case, source_term=a["variant"], dt_s=float(a["dt_s"]), sim_time_s=float(ds["sim_time"]),
                max_solve_residual=float(a["max_solve_residual"]), rms_speed_cm_s=float(ds["residual"]),
                rest_speed_cm_s=float(a["rest_speed_cm_s"]), time_to_rest_s=time_to_rest(ds),
-               max_speed_cm_s=float(ds["hist_max_speed"].values[-1]), message=a.get("message", ""),
+               max_speed_cm_s=float(ds["hist_max_speed"].values[-1]), message=a.get("status_message", ""),
                ms_per_step=1e3 * float(ds["wall_time"]) / max(1, int(ds["force_evals"])))
     rel, absn, probe = noise(ds)
-    rate, rate_scaled = growth_rate(ds)
-    row.update(panel_noise_rel=rel, panel_noise_N=absn, rms_growth_per_s=rate, rms_growth_x_sqrt_l0_g=rate_scaled,
-               min_rms_speed_cm_s=float(ds["hist_rms_speed"].values.min()))
+    u = ds["hist_rms_speed"].values
+    row.update(panel_noise_rel=rel, panel_noise_N=absn, min_rms_speed_cm_s=float(u.min()),
+               min_rms_time_s=float(ds["hist_time"].values[int(np.argmin(u))]))
     for k, p in enumerate(probe):
         row[f"probe{k}_std_N_cm2"] = float(p)
     m = metrics.run_row(ds)

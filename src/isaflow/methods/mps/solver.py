@@ -81,7 +81,8 @@ def step(s, dt, source, cfg, timers=None):
     ps, vs, n_star, div, dirichlet, pi, pj, m, system = model.predict(
         s.pos, s.vel, s.kind, s.grid_box, dt, 0.0, -units.G, cfg["model.kinematic_viscosity"], s.re_n, s.re_g, s.re_l,
         s.n0_n, s.n0_g, s.n0_l, s.lam, cfg["model.beta"], s.rho0, model.SOURCES[source], cfg["model.gamma_mixed"],
-        cfg["model.relaxation"], cfg["model.sound_speed"], cfg["model.collision_distance"] * s.l0, cfg["model.restitution"])
+        cfg["model.relaxation"], cfg["model.sound_speed"], cfg["model.collision_distance"] * s.l0, cfg["model.restitution"],
+        cfg["model.surface_distribution"] * s.l0)
     row, indptr, indices, data, rhs = system
     t1 = time.perf_counter()
     A = pressure.csr(indptr, indices, data)
@@ -217,7 +218,8 @@ def solve(tank, cfg, variant, spacing, t_end, probes, start=None, snapshots=0, l
         "source_term": variant, "spacing_cm": l0, "dt_s": dt, "rho0_N_s2_cm4": s.rho0, "particle_weight_N": s.weight,
         "re_density_cm": s.re_n, "re_gradient_cm": s.re_g, "re_laplacian_cm": s.re_l, "n0_density": s.n0_n, "n0_laplacian": s.n0_l,
         "lambda_cm2": s.lam, "beta": cfg["model.beta"], "relaxation": cfg["model.relaxation"],
-        "sound_speed_cm_s": cfg["model.sound_speed"], "n0_gradient": s.n0_g, "kinematic_viscosity_cm2_s": cfg["model.kinematic_viscosity"],
+        "sound_speed_cm_s": cfg["model.sound_speed"], "n0_gradient": s.n0_g,
+        "surface_distribution": cfg["model.surface_distribution"], "kinematic_viscosity_cm2_s": cfg["model.kinematic_viscosity"],
         "gamma_mixed": cfg["model.gamma_mixed"], "courant": cfg["time.courant"], "pressure_solver": cfg["pressure.solver"],
         "pressure_rtol": cfg["pressure.rtol"], "max_solve_residual": max_resid, "mean_solve_iterations": float(np.mean(iters)),
         "rest_speed_cm_s": u_rest, "average_window_s": cfg["time.average_window"], "wall_particles": int(nb[model.WALL]),
