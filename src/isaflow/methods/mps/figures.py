@@ -57,6 +57,8 @@ def wall_loads(runs, outputs):
             if len(on):
                 ax.text(on.mean(), 0.97, names[w], transform=ax.get_xaxis_transform(), ha="center", va="top", fontsize=8)
         ax.set_xticks([])
+        top = max(np.nanmax(mag + hist.std(0)), np.nanmax(th))
+        ax.set_ylim(-0.05 * top, 1.15 * top)  # headroom for the wall names
         ax.set_title(f"{ds.attrs['variant']}, l0 = {float(ds.attrs['spacing']):.3g} cm\n{ds.attrs['status']}", fontsize=9)
         ax.set_xlabel("10 cm panels along the walls (left, floor, right)")
     axes[0, 0].set_ylabel("wall force per panel |F| [N]")

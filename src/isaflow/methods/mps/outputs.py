@@ -8,6 +8,7 @@ Every function logs to stderr (call.py sends it to the rule's log).
 """
 
 import logging
+import re
 import sys
 from pathlib import Path
 
@@ -125,6 +126,20 @@ def time_to_rest(ds):
     return float(t[last[-1] + 1]) if len(last) else float(t[0])
 
 
+def escape_depth(ds):
+    """Distance [cm] behind the wall of the particle an 'escaped' message names ('particle K crossed wall NAME');
+    NaN for other runs.  Shows whether an escape is a graze of the wall line or a particle through the wall rows."""
+    m = re.search(r"particle (\d+) crossed wall '([^']+)'", ds.attrs.get("status_message", ""))
+    if not m:
+        return np.nan
+    walls = ds["wall_segment"].values
+    w = [str(n) for n in ds["wall"].values].index(m.group(2))
+    a, b = walls[w, :2], walls[w, 2:]
+    t = (b - a) / np.hypot(*(b - a))
+    normal = np.array([-t[1], t[0]])  # liquid on the wall's left
+    return float(-(ds["pos"].values[int(m.group(1))] - a) @ normal)
+
+
 def summary_row(path):
     """One summary row of a run file: metrics.run_row plus MPS noise, cost and rest measures."""
     ds = runfile.read(path)
@@ -135,6 +150,7 @@ def summary_row(path):
                max_solve_residual=float(a["max_solve_residual"]), rms_speed_cm_s=float(ds["residual"]),
                rest_speed_cm_s=float(a["rest_speed_cm_s"]), time_to_rest_s=time_to_rest(ds),
                max_speed_cm_s=float(ds["hist_max_speed"].values[-1]), message=a.get("status_message", ""),
+               escape_depth_cm=escape_depth(ds),
                ms_per_step=1e3 * float(ds["wall_time"]) / max(1, int(ds["force_evals"])))
     rel, absn, probe = noise(ds)
     u = ds["hist_rms_speed"].values

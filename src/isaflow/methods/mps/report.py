@@ -134,17 +134,19 @@ def fragment(df, cfg):
                              ("rest_speed_cm_s", g)],
                     ["single run", "status", "particles", "ms/step", "side err", "floor err", "panel rms err",
                      "panel noise std/mean", "rms speed cm/s", "rest limit cm/s"])
-    lines += [""] + _table(flow, [("run", None), ("status", None), ("mass_left_frac", g), ("level", g), ("slope_deg", g),
-                                  ("panel_noise_rel", g), ("time_to_rest_s", g), ("message", None)],
-                           ["flow run", "status", "mass left (fraction)", "second-vessel level cm", "slope deg",
-                            "panel noise", "time to rest s", "why it stopped"])
+    lines += [""] + _table(flow, [("run", None), ("status", None), ("sim_time_s", g), ("mass_left_frac", g), ("level", g),
+                                  ("slope_deg", g), ("panel_noise_rel", g), ("time_to_rest_s", g), ("message", None),
+                                  ("escape_depth_cm", g)],
+                           ["flow run", "status", "t end s", "mass left (fraction)", "second-vessel level cm", "slope deg",
+                            "panel noise", "time to rest s", "why it stopped", "depth behind the wall cm"])
     lines += ["", "Stiff and extreme cases (standard source, single vessel, "
               f"l0 = {cfg['stiff.spacing']:g} cm, {cfg['stiff.duration']:g} s): large_dt Courant "
               f"{cfg['stiff.courant_large']:g}; small_re all radii {cfg['stiff.re_small']:g} l0; no_relaxation gamma = "
               f"{cfg['stiff.relaxation_none']:g} (K&O 1996 literally); on_wall one particle started at "
               f"{tuple(cfg['stiff.on_wall_point'])} cm on the floor.", ""]
-    lines += _table(stiff, [("run", None), ("status", None), ("rms_speed_cm_s", g), ("floor_err", g), ("message", None)],
-                    ["case", "status", "rms speed cm/s", "floor err", "why it stopped"])
+    lines += _table(stiff, [("run", None), ("status", None), ("rms_speed_cm_s", g), ("floor_err", g), ("message", None),
+                            ("escape_depth_cm", g)],
+                    ["case", "status", "rms speed cm/s", "floor err", "why it stopped", "depth behind the wall cm"])
     lines += ["", ranking(df), "", findings(df)]
     counts = df.groupby(["case", "status"]).size()
     lines += ["", "Outcomes: " + "; ".join(f"{c} {s}: {n}" for (c, s), n in counts.items()) + "."]
