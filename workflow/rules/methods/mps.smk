@@ -134,6 +134,7 @@ rule mps_report:
     input:
         summary="results/mps/summary.csv",
         cfg=MPS_CFG,
+        bench="benchmarks/results/mps_step_cost.csv",
         code=code("methods/mps/report"),
     output:
         claims="results/claims/mps.csv",
