@@ -14,7 +14,9 @@ MPS_CODE = code("methods/mps/model", "methods/mps/boundary", "methods/mps/pressu
 MPS_SINGLE = [f"results/mps/single_{v}_dx{dx}.nc" for v in MPS_VARIANTS for dx in MPS_DX["single"]]
 MPS_FLOW = [f"results/mps/flow_{v}_dx{dx}.nc" for v in MPS_VARIANTS for dx in MPS_DX["flow"]]
 MPS_STIFF_RUNS = [f"results/mps/stiff_{c}.nc" for c in MPS_STIFF]
-MPS_RUNS = MPS_SINGLE + MPS_FLOW + MPS_STIFF_RUNS
+MPS_COURANTS = [f"{c:g}" for c in _MPS["dt_study"]["courants"]["value"]]
+MPS_DT_RUNS = [f"results/mps/dt_standard_c{c}.nc" for c in MPS_COURANTS]
+MPS_RUNS = MPS_SINGLE + MPS_FLOW + MPS_STIFF_RUNS + MPS_DT_RUNS
 
 register(MPS_RUNS + ["results/mps/summary.csv"] + figure("mps_wall_loads") + figure("mps_flow") + figure("mps_rest"),
          ["results/report/55_mps.md"], ["results/claims/mps.csv"])
@@ -70,6 +72,24 @@ rule mps_stiff:
         kw=lambda wc: dict(case=wc.case),
     log:
         "logs/mps/stiff_{case}.log",
+    script:
+        "../../scripts/call.py"
+
+
+rule mps_dt:
+    input:
+        cfg=MPS_CFG,
+        tank="config/tanks/single.yaml",
+        code=MPS_CODE,
+    output:
+        "results/mps/dt_standard_c{courant}.nc",
+    wildcard_constraints:
+        courant="|".join(MPS_COURANTS),
+    params:
+        func="methods.mps.outputs.run_dt",
+        kw=lambda wc: dict(courant=wc.courant),
+    log:
+        "logs/mps/dt_standard_c{courant}.log",
     script:
         "../../scripts/call.py"
 

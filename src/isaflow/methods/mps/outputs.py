@@ -3,7 +3,8 @@ per run, the stiff and extreme cases, and the summary table.
 
 Run ids: ``single_<variant>_dx<l0>`` (liquid block at rest in the single tank),
 ``flow_<variant>_dx<l0>`` (the same block at rest in flow_step50's first
-vessel: the opening appears at t = 0) and ``stiff_<case>`` (settings 'stiff').
+vessel: the opening appears at t = 0), ``stiff_<case>`` (settings 'stiff') and
+``dt_standard_c<courant>`` (settings 'dt_study').
 Every function logs to stderr (call.py sends it to the rule's log).
 """
 
@@ -71,6 +72,16 @@ def run_case(cfg, tank, outputs, case, variant, label):
         t_end, probes, snaps = settings_["time.single_time"], settings_["runs.probes_single"], 0
     _run_and_write(load_tank(tank), tank, settings_, variant, l0, t_end, probes, outputs[0], run_id(case, variant, l0),
                    snaps=snaps)
+
+
+def run_dt(cfg, tank, outputs, courant):
+    """Time-step study: the single vessel with the standard source at settings dt_study.spacing and Courant
+    number ``courant`` (a label, f'{c:g}' of one of dt_study.courants); write outputs[0]."""
+    base = settings.load(cfg)
+    c = next(float(x) for x in base["dt_study.courants"] if f"{x:g}" == courant)
+    settings_ = base.with_overrides(**{"time.courant": c})
+    _run_and_write(load_tank(tank), tank, settings_, "standard", base["dt_study.spacing"], base["time.single_time"],
+                   base["runs.probes_single"], outputs[0], f"dt_standard_c{courant}")
 
 
 def stiff_settings(cfg, case):
@@ -146,7 +157,7 @@ def summary_row(path):
     a = ds.attrs
     stem = Path(path).stem
     case = stem.split("_")[0]
-    row = dict(run=stem, case=case, source_term=a["variant"], dt_s=float(a["dt_s"]), sim_time_s=float(ds["sim_time"]),
+    row = dict(run=stem, case=case, source_term=a["variant"], courant=float(a["courant"]), dt_s=float(a["dt_s"]), sim_time_s=float(ds["sim_time"]),
                max_solve_residual=float(a["max_solve_residual"]), rms_speed_cm_s=float(ds["residual"]),
                rest_speed_cm_s=float(a["rest_speed_cm_s"]), time_to_rest_s=time_to_rest(ds),
                max_speed_cm_s=float(ds["hist_max_speed"].values[-1]), message=a.get("status_message", ""),

@@ -22,6 +22,15 @@ def noise_bound(row):
     return row.spacing_cm / row.depth if row.depth > 0 else np.nan
 
 
+def dt_rows(df):
+    """The time-step study's runs plus the single standard run at the same spacing (settings' Courant), by Courant."""
+    dt = df[df.case == "dt"]
+    if not len(dt):
+        return dt
+    same = df[(df.case == "single") & (df.source_term == "standard") & np.isclose(df.spacing_cm, dt.spacing_cm.iloc[0])]
+    return pd.concat([dt, same]).sort_values("courant")
+
+
 def claims(df):
     """Claims rows: Hattori's checkable statement and the Papadopoulos introduction's claim on MPS oscillations."""
     single = df[df.case == "single"].copy()
@@ -42,10 +51,12 @@ def claims(df):
         claim="in the MPS method (Moving Particles Semi-Implicit) ... some high frequency oscillations are suppressed, "
               "depending on time step-length, because of the implicit nature of the method, with no additional technique for suppression",
         measured="single vessel, standard source: panel-load noise std/mean "
+                 + "by Courant number (time step) " + ", ".join(f"{r.courant:g}: {r.panel_noise_rel:.3f}" for r in dt_rows(df).itertuples())
+                 + "; by spacing "
                  + ", ".join(f"{r.panel_noise_rel:.3f} (bound l0/h {r.bound:.3f}, l0 {r.spacing_cm:.3g} cm)" for r in std.itertuples())
                  + f"; runs at rest (any source term): {len(rest)} of {len(single)}",
         verdict="reproduced" if len(std) and len(quiet) == len(std) and len(rest) == len(single) else "not reproduced",
-        evidence="results/mps/summary.csv (panel_noise_rel, status), figures/mps_wall_loads.png, figures/mps_rest.png",
+        evidence="results/mps/summary.csv (panel_noise_rel, status; runs dt_standard_c*), figures/mps_wall_loads.png, figures/mps_rest.png",
         why="suppressed = wall-load noise below the resolution error l0/h of a panel load and the liquid coming to rest")]
     hat = single[single.source_term == "hattori"]
     rows.append(dict(
@@ -148,6 +159,14 @@ def fragment(df, cfg):
                             ("escape_depth_cm", g)],
                     ["case", "status", "rms speed cm/s", "floor err", "why it stopped", "depth behind the wall cm"])
     lines += ["", ranking(df), "", findings(df)]
+    dts = dt_rows(df)
+    if len(dts):
+        lines += ["", f"Time-step study (standard source, single vessel, l0 = {dts.spacing_cm.iloc[0]:.3g} cm, "
+                  f"{dts.sim_time_s.max():.2g} s):", ""]
+        lines += _table(dts, [("run", None), ("courant", g), ("dt_s", g), ("status", None), ("panel_noise_rel", g),
+                              ("probe1_std_N_cm2", g), ("contact_rms", g), ("rms_speed_cm_s", g)],
+                        ["run", "Courant", "dt s", "status", "panel noise std/mean", "probe (50, 35) std N/cm2",
+                         "panel rms err", "rms speed cm/s"])
     counts = df.groupby(["case", "status"]).size()
     lines += ["", "Outcomes: " + "; ".join(f"{c} {s}: {n}" for (c, s), n in counts.items()) + "."]
     if len(single):
