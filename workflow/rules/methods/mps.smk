@@ -9,7 +9,7 @@ with open(MPS_CFG) as _fh:
 MPS_VARIANTS = ["standard", "hattori", "mixed"]
 MPS_STIFF = ["large_dt", "small_re", "no_relaxation", "on_wall"]
 MPS_DX = {case: [f"{l0:.3g}" for l0 in _MPS["runs"][f"{case}_spacings"]["value"]] for case in ("single", "flow")}
-MPS_CODE = code("methods/mps/model", "methods/mps/boundary", "methods/mps/pressure", "methods/mps/solver",
+MPS_CODE = code("methods/mps/model", "methods/mps/operators", "methods/mps/boundary", "methods/mps/pressure", "methods/mps/solver",
                 "methods/mps/settings", "methods/mps/outputs")
 MPS_SINGLE = [f"results/mps/single_{v}_dx{dx}.nc" for v in MPS_VARIANTS for dx in MPS_DX["single"]]
 MPS_FLOW = [f"results/mps/flow_{v}_dx{dx}.nc" for v in MPS_VARIANTS for dx in MPS_DX["flow"]]
