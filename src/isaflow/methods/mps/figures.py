@@ -110,7 +110,8 @@ def rest(runs, outputs):
             ax.axhline(float(ds.attrs["rest_speed_cm_s"]), color=c, ls="--", lw=0.8)
         ax.set_title(f"source term: {name}", fontsize=9)
         ax.set_xlabel("time t [s]")
-        ax.legend(fontsize=7, loc="lower right")
+        ax.set_ylim(0.1, 30)  # room below the rest limits for the legend
+        ax.legend(fontsize=7, loc="lower right", ncol=2)
     axes[0, 0].set_ylabel("rms speed of the liquid [cm/s]\n(dashed: rest limit)")
     fig.tight_layout()
     _save(fig, outputs)

@@ -107,13 +107,16 @@ def ranking(df):
     """Sentence: per source term the median over single-vessel runs of the panel-load noise (std/mean) and of the
     per-panel rms error, and which is quieter / more accurate (from the table, no numbers typed)."""
     single = df[df.case == "single"]
-    med = single.groupby("source_term")[["panel_noise_rel", "contact_rms"]].median()
+    full = single[single.status != "escaped"]
+    med = full.groupby("source_term")[["panel_noise_rel", "contact_rms"]].median()
     if med.empty:
         return ""
     parts = [f"{k}: noise {r.panel_noise_rel:.3f}, panel rms error {r.contact_rms:.4f}" for k, r in med.iterrows()]
-    return ("Medians over the single-vessel spacings (" + "; ".join(parts) + "): quietest wall loads `"
-            + med.panel_noise_rel.idxmin() + "`, most accurate `" + med.contact_rms.idxmin() + "`.  Runs that escaped "
-            "are averaged over the last window before the escape.")
+    left_out = sorted(set(single.source_term) - set(med.index))
+    return ("Medians over the single-vessel spacings of the runs that lasted the full time (" + "; ".join(parts)
+            + "): quieter wall loads `" + med.panel_noise_rel.idxmin() + "`, more accurate `" + med.contact_rms.idxmin()
+            + "`" + (f"; no {', '.join(left_out)} run lasted (their columns above are averaged over the last window "
+                     "before the escape)" if left_out else "") + ".")
 
 
 def _table(df, cols, heads):
