@@ -12,7 +12,8 @@ from .style import LATTICE_MARKER, OUTCOME_STYLE, plt, save, variant_style
 FLOOR = 1e-4  # smallest |error| drawn on the log axes (exact zeros sit on it)
 
 PANELS = [
-    ("level_err_paper_cm", "|level - paper's level| (cm)", "(a) free-surface level against the paper"),
+    ("level_err_paper_cm", "|level - paper's level| (cm)",
+     "(a) free-surface level against the paper\n(k_p calibrated to match this level: config/inferred.yaml)"),
     ("level_err_hydro_cm", "|level - level implied by side loads| (cm)",
      "(b) level against hydrostatic consistency (2 B F_side / W)"),
     ("side_err", "|side-wall total / hydrostatic - 1| (-)", "(c) side-wall loads against hydrostatics"),
