@@ -110,6 +110,7 @@ def test_outputs_that_differ_are_caught(tmp_path, change):
 def test_paper_target_through_local_slurm_equals_local_run():
     proc = subprocess.run(["bash", str(ROOT / "tests" / "cluster" / "slurm_local.sh")], cwd=ROOT,
                           capture_output=True, text=True, timeout=3600)
+    print(proc.stdout)  # sacct lines, timing and the comparison: shown with pytest -rP
     if proc.returncode == 77:
         pytest.skip(proc.stderr.strip().splitlines()[-1])
     assert proc.returncode == 0, proc.stdout[-4000:] + proc.stderr[-4000:]

@@ -53,6 +53,10 @@ STATUS=1
 
 stop_all() {
     local entry
+    if [ -n "${SNAKEMAKE_PID:-}" ]; then kill "$SNAKEMAKE_PID" 2>/dev/null || true; wait "$SNAKEMAKE_PID" 2>/dev/null || true; fi
+    # jobs of this private cluster only (its own slurmctld): cancel before the daemons stop
+    timeout 10 scancel --full --quiet $(timeout 5 squeue -h -o %i 2>/dev/null) 2>/dev/null || true
+    sleep 1
     for ((i = ${#PIDS[@]} - 1; i >= 0; i--)); do
         entry=${PIDS[i]}
         kill "${entry#*:}" 2>/dev/null || true
@@ -68,6 +72,7 @@ stop_all() {
     fi
 }
 trap stop_all EXIT
+trap 'exit 143' TERM INT HUP
 
 started() { PIDS+=("$1:$2"); echo "$2" >"$WORK/$1.pid"; }
 
@@ -179,14 +184,18 @@ fi
 touch "$WORK/stamp"
 sleep 1
 log "local run of ${TARGETS[*]}"
-(cd "$WORK/local" && PYTHONPATH=$WORK/local/src "$PY" -m snakemake -c2 \
-    --workflow-profile workflow/profiles/default "${TARGETS[@]}") >"$WORK/log/local.log" 2>&1 ||
-    { tail -n 30 "$WORK/log/local.log"; exit 1; }
+(cd "$WORK/local" && PYTHONPATH=$WORK/local/src exec "$PY" -m snakemake -c2 \
+    --workflow-profile workflow/profiles/default "${TARGETS[@]}") >"$WORK/log/local.log" 2>&1 &
+SNAKEMAKE_PID=$!
+wait "$SNAKEMAKE_PID" || { tail -n 30 "$WORK/log/local.log"; exit 1; }
 log "SLURM run of ${TARGETS[*]}"
 T0=$(date +%s)
-(cd "$WORK/slurm" && PYTHONPATH=$WORK/slurm/src "$PY" -m snakemake --profile "$ROOT/tests/cluster/profile" \
-    --workflow-profile workflow/profiles/slurm "${TARGETS[@]}") >"$WORK/log/slurm.log" 2>&1 ||
+(cd "$WORK/slurm" && PYTHONPATH=$WORK/slurm/src exec "$PY" -m snakemake --profile "$ROOT/tests/cluster/profile" \
+    --workflow-profile workflow/profiles/slurm "${TARGETS[@]}") >"$WORK/log/slurm.log" 2>&1 &
+SNAKEMAKE_PID=$!
+wait "$SNAKEMAKE_PID" ||
     { tail -n 40 "$WORK/log/slurm.log"; cat "$WORK"/slurm/.snakemake/slurm_logs/*/*/*.log 2>/dev/null | tail -n 40; exit 1; }
+SNAKEMAKE_PID=
 T1=$(date +%s)
 log "SLURM run took $((T1 - T0)) s"
 
