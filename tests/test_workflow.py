@@ -10,8 +10,9 @@ SNAKEMAKE = [sys.executable, "-m", "snakemake"]
 
 
 def dry_run(*targets):
-    proc = subprocess.run([*SNAKEMAKE, "-n", "-c1", "--forceall", *targets], cwd=ROOT, capture_output=True,
-                          text=True, timeout=300)
+    """Dry run listing every job; without the default profile, whose `quiet: [rules, host]` hides job blocks."""
+    proc = subprocess.run([*SNAKEMAKE, "-n", "-c1", "--forceall", "--workflow-profile", "none", *targets], cwd=ROOT,
+                          capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stdout + proc.stderr
     return proc.stdout
 

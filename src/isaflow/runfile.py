@@ -29,7 +29,9 @@ from .methods import label
 PACKAGES = ("isaflow", "numpy", "numba", "scipy", "pyamg", "xarray", "netCDF4", "pandas", "matplotlib",
             "snakemake", "pyyaml", "jsonschema")
 # what can change a result: a run is "dirty" when any of these differs from the commit
-RESULT_INPUTS = ("src", "config", "workflow", "Snakefile", "pyproject.toml", "benchmarks/*.py")
+RESULT_INPUTS = ("src", "config", "workflow", "Snakefile", "pyproject.toml", "requirements", "benchmarks/*.py")
+# the pinned environment (requirements/compile.sh); its hash is recorded with every run
+LOCK_FILE = Path(__file__).resolve().parents[2] / "requirements" / "lock-py311.txt"
 
 
 def _git(*args):
@@ -44,7 +46,7 @@ def provenance(inputs, argv=None):
 
     inputs: {name: path} of the files the run reads (scene, tank, method
     settings, workflow config, start file); each gets ``<name>_file`` and
-    ``<name>_sha256``.  ``git_dirty`` is computed over the sources and
+    ``<name>_sha256``; so does the lock file of the pinned environment (``lock``).  ``git_dirty`` is computed over the sources and
     configuration that can change a result (RESULT_INPUTS), not over outputs.
     """
     commit = _git("rev-parse", "HEAD") or "unknown"
@@ -63,7 +65,8 @@ def provenance(inputs, argv=None):
         "machine": f"{platform.machine()} {platform.processor() or ''} {os.cpu_count()} cpus".strip(),
         "command": " ".join(argv if argv is not None else sys.argv),
     }
-    for name, path in inputs.items():
+    lock = {"lock": LOCK_FILE} if LOCK_FILE.is_file() else {}
+    for name, path in {**lock, **inputs}.items():
         out[f"{name}_file"] = str(path) if path else "none"
         out[f"{name}_sha256"] = sha256(path) if path else "none"
     return out

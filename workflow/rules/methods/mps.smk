@@ -113,7 +113,7 @@ rule mps_figure_loads:
         runs=MPS_SINGLE,
         code=code("methods/mps/figures"),
     output:
-        figure("mps_wall_loads"),
+        report_figure("mps_wall_loads", "mps_figure", "Methods compared"),
     params:
         func="methods.mps.figures.wall_loads",
     log:
@@ -127,7 +127,7 @@ rule mps_figure_rest:
         runs=MPS_SINGLE,
         code=code("methods/mps/figures"),
     output:
-        figure("mps_rest"),
+        report_figure("mps_rest", "mps_figure", "Methods compared"),
     params:
         func="methods.mps.figures.rest",
     log:
@@ -141,7 +141,7 @@ rule mps_figure_flow:
         runs=[f"results/mps/flow_{v}_dx{MPS_DX['flow'][-1]}.nc" for v in MPS_VARIANTS],
         code=code("methods/mps/figures"),
     output:
-        figure("mps_flow"),
+        report_figure("mps_flow", "mps_figure", "Methods compared"),
     params:
         func="methods.mps.figures.flow",
     log:

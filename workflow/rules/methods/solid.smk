@@ -1,11 +1,15 @@
-# Hooke's-law solid particles (marko2017 section 4): bar, shear, Hertz runs, figures, claims, report.
+# Hooke's-law solid particles (marko2017 section 4): bar, shear, Hertz runs, figures, claims, report
+# fragment 65.  Package: src/isaflow/methods/solid/.  Every rule calls one package function through
+# scripts/call.py.
 SOLID_CFG = "config/methods/solid.yaml"
 SOLID_CASES = ["bar_tension", "bar_compression", "shear", "hertz", "hertz_dt15ns", "hertz_dt56ns"]
 SOLID_RUNS = expand("results/solid/{case}_{variant}.nc", case=SOLID_CASES, variant=["paper", "hooke"])
-SOLID_CODE = [f"src/isaflow/methods/solid/{m}.py" for m in ("kernels", "lattice", "solve", "cases", "settings", "outputs")]
+SOLID_CODE = code("methods/solid/kernels", "methods/solid/lattice", "methods/solid/solve", "methods/solid/cases",
+                  "methods/solid/settings", "methods/solid/outputs")
+SOLID_FIGURES = figure("solid_bar") + figure("solid_hertz")
+SOLID_REPORT_FIGURES = [f for name in ("solid_bar", "solid_hertz") for f in report_figure(name, "solid_figure", "Methods compared")]
 
-SOLID_TARGETS = SOLID_RUNS + figure("solid_bar") + figure("solid_hertz")
-register(SOLID_TARGETS, ["results/report/65_solid.md"], ["results/claims/solid.csv"])
+register(SOLID_RUNS + SOLID_FIGURES, ["results/report/65_solid.md"], ["results/claims/solid.csv"])
 
 
 rule solid_run:
@@ -17,41 +21,41 @@ rule solid_run:
     wildcard_constraints:
         case="|".join(SOLID_CASES),
         variant="paper|hooke",
+    params:
+        func="methods.solid.outputs.run_case",
+        kw=lambda wc: dict(case=wc.case, variant=wc.variant),
     log:
         "logs/solid/{case}_{variant}.log",
-    run:
-        from isaflow.methods.solid.outputs import write_run
-
-        write_run(input.cfg, wildcards.case, wildcards.variant, output[0], log[0])
+    script:
+        "../../scripts/call.py"
 
 
 rule solid_figures:
     input:
         cfg=SOLID_CFG,
         runs=SOLID_RUNS,
-        code="src/isaflow/methods/solid/figures.py",
+        code=code("methods/solid/figures", "methods/solid/theory", "figures/style"),
     output:
-        bar=figure("solid_bar"),
-        hertz=figure("solid_hertz"),
+        SOLID_REPORT_FIGURES,
+    params:
+        func="methods.solid.figures.bar_and_hertz",
     log:
         "logs/solid/figures.log",
-    run:
-        from isaflow.methods.solid.figures import bar_and_hertz
-
-        bar_and_hertz(input.cfg, "results/solid", output.bar, output.hertz, log[0])
+    script:
+        "../../scripts/call.py"
 
 
 rule solid_claims:
     input:
         cfg=SOLID_CFG,
         runs=SOLID_RUNS,
-        code="src/isaflow/methods/solid/claims.py",
+        code=code("methods/solid/claims", "methods/solid/theory", "methods/solid/figures"),
     output:
-        claims="results/claims/solid.csv",
-        report="results/report/65_solid.md",
+        "results/claims/solid.csv",
+        "results/report/65_solid.md",
+    params:
+        func="methods.solid.claims.claims_and_report",
     log:
         "logs/solid/claims.log",
-    run:
-        from isaflow.methods.solid.claims import claims_and_report
-
-        claims_and_report(input.cfg, "results/solid", output.claims, output.report, log[0])
+    script:
+        "../../scripts/call.py"

@@ -1,5 +1,6 @@
-# Issue 10: weakly compressible SPH on the shared tank (single vessel, then the flow), figures,
-# summary, claims, report fragment 50.  Package: src/isaflow/methods/sph/.
+# Weakly compressible SPH on the shared tank (single vessel, then the flow), figures, summary, claims,
+# report fragment 50.  Package: src/isaflow/methods/sph/.  Every rule calls one package function
+# through scripts/call.py.
 import yaml as _sph_yaml
 
 SPH_CFG = "config/methods/sph.yaml"
@@ -15,21 +16,22 @@ SPH_VARIANTS = list(_SPH["variants"])
 SPH_SINGLE = [_sph_res(r) for r in _SPH["runs"]["single"]]
 SPH_FLOW = [_sph_res(r) for r in _SPH["runs"]["flow"]]
 SPH_STAB = list(_SPH["runs"]["stability"])
-SPH_CODE = [f"src/isaflow/methods/sph/{m}.py" for m in ("__init__", "kernels", "particles", "settings", "solver", "outputs")]
+SPH_CODE = code("methods/sph/__init__", "methods/sph/kernels", "methods/sph/particles", "methods/sph/settings",
+                "methods/sph/solver", "methods/sph/outputs")
+SPH_SINGLE_RUNS = [f"results/sph/single_wcsph_{r}.nc" for r in SPH_SINGLE]
+SPH_FLOW_RUNS = [f"results/sph/flow_wcsph_{r}.nc" for r in SPH_FLOW]
 SPH_RUNS = (
-    [f"results/sph/single_wcsph_{r}.nc" for r in SPH_SINGLE]
+    SPH_SINGLE_RUNS
     # the delta-SPH variant costs about twice as much per step: all but the finest resolution
     + [f"results/sph/single_{v}_{r}.nc" for v in SPH_VARIANTS if v != "wcsph" for r in SPH_SINGLE[:-1]]
-    + [f"results/sph/flow_wcsph_{r}.nc" for r in SPH_FLOW]
+    + SPH_FLOW_RUNS
     + [f"results/sph/stab_{c}.nc" for c in SPH_STAB]
 )
-SPH_FLOW_RUNS = [f"results/sph/flow_wcsph_{r}.nc" for r in SPH_FLOW]
+SPH_FIGURES = [f for name in ("sph_single", "sph_flow", "sph_flow_snapshots") for f in figure(name)]
+SPH_REPORT_FIGURES = [f for name in ("sph_single", "sph_flow", "sph_flow_snapshots")
+                      for f in report_figure(name, "sph_figure", "Methods compared")]
 
-register(
-    SPH_RUNS + ["results/sph/summary.csv"] + figure("sph_single") + figure("sph_flow") + figure("sph_flow_snapshots"),
-    ["results/report/50_sph.md"],
-    ["results/claims/sph.csv"],
-)
+register(SPH_RUNS + ["results/sph/summary.csv"] + SPH_FIGURES, ["results/report/50_sph.md"], ["results/claims/sph.csv"])
 
 
 rule sph_single:
@@ -41,12 +43,15 @@ rule sph_single:
         "results/sph/single_{variant}_{res}.nc",
     wildcard_constraints:
         variant="|".join(SPH_VARIANTS),
+    params:
+        func="methods.sph.outputs.run_case",
+        kw=lambda wc: dict(case="single", variant=wc.variant, rid=wc.res),
+    resources:
+        runtime=30,
     log:
         "logs/sph/single_{variant}_{res}.log",
-    run:
-        from isaflow.methods.sph.outputs import write_run
-
-        write_run(input.cfg, "single", wildcards.variant, wildcards.res, output[0], log[0])
+    script:
+        "../../scripts/call.py"
 
 
 rule sph_flow:
@@ -59,12 +64,15 @@ rule sph_flow:
         "results/sph/flow_{variant}_{res}.nc",
     wildcard_constraints:
         variant="|".join(SPH_VARIANTS),
+    params:
+        func="methods.sph.outputs.run_case",
+        kw=lambda wc: dict(case="flow", variant=wc.variant, rid=wc.res),
+    resources:
+        runtime=30,
     log:
         "logs/sph/flow_{variant}_{res}.log",
-    run:
-        from isaflow.methods.sph.outputs import write_run
-
-        write_run(input.cfg, "flow", wildcards.variant, wildcards.res, output[0], log[0], start=input.start)
+    script:
+        "../../scripts/call.py"
 
 
 rule sph_stability:
@@ -76,12 +84,13 @@ rule sph_stability:
         "results/sph/stab_{case}.nc",
     wildcard_constraints:
         case="|".join(SPH_STAB),
+    params:
+        func="methods.sph.outputs.run_case",
+        kw=lambda wc: dict(case="stab", variant="wcsph", rid=wc.case),
     log:
         "logs/sph/stab_{case}.log",
-    run:
-        from isaflow.methods.sph.outputs import write_run
-
-        write_run(input.cfg, "stab", "wcsph", wildcards.case, output[0], log[0])
+    script:
+        "../../scripts/call.py"
 
 
 rule sph_summary:
@@ -90,42 +99,39 @@ rule sph_summary:
         code=SPH_CODE + code("metrics", "theory"),
     output:
         "results/sph/summary.csv",
+    params:
+        func="methods.sph.outputs.summary",
     log:
         "logs/sph/summary.log",
-    run:
-        from isaflow.methods.sph.outputs import summary
-
-        summary(input.runs, output[0])
+    script:
+        "../../scripts/call.py"
 
 
 rule sph_figures:
     input:
-        runs=SPH_RUNS,
-        code="src/isaflow/methods/sph/figures.py",
+        single_runs=SPH_SINGLE_RUNS,
+        flow_runs=SPH_FLOW_RUNS,
+        code=code("methods/sph/figures"),
     output:
-        single=figure("sph_single"),
-        flow=figure("sph_flow"),
-        snaps=figure("sph_flow_snapshots"),
+        SPH_REPORT_FIGURES,
+    params:
+        func="methods.sph.figures.all_figures",
     log:
         "logs/sph/figures.log",
-    run:
-        from isaflow.methods.sph import figures
-
-        figures.single([f"results/sph/single_wcsph_{r}.nc" for r in SPH_SINGLE], output.single)
-        figures.flow(SPH_FLOW_RUNS, output.flow)
-        figures.snapshots(SPH_FLOW_RUNS[-1], output.snaps)
+    script:
+        "../../scripts/call.py"
 
 
 rule sph_report:
     input:
         summary="results/sph/summary.csv",
-        code="src/isaflow/methods/sph/report.py",
+        code=code("methods/sph/report"),
     output:
-        claims="results/claims/sph.csv",
-        report="results/report/50_sph.md",
+        "results/claims/sph.csv",
+        "results/report/50_sph.md",
+    params:
+        func="methods.sph.report.write",
     log:
         "logs/sph/report.log",
-    run:
-        from isaflow.methods.sph.report import write
-
-        write(input.summary, output.claims, output.report)
+    script:
+        "../../scripts/call.py"

@@ -1,65 +1,64 @@
-# Issue 12: the truncated SPH hydrostatic problem in 1D as a linear system
-# (Merino-Alonso et al. 2020, abstract only).  Sweep -> tables -> figures,
-# claims and report fragment 60.  Package: src/isaflow/methods/sph1d/.
+# The truncated SPH hydrostatic problem in 1D as a linear system (Merino-Alonso et al. 2020, abstract
+# only).  Sweep -> tables -> figures, claims and report fragment 60.  Package: src/isaflow/methods/sph1d/.
+# Every rule calls one package function through scripts/call.py.
 
 SPH1D_SETTINGS = "config/methods/sph1d.yaml"
-SPH1D_CODE = [f"src/isaflow/methods/sph1d/{m}.py" for m in
-              ("__init__", "system", "column", "closed_form", "sweep", "settings", "pipeline")]
-SPH1D_FIGURES = {name: figure(f"sph1d_{name}") for name in ("error_vs_n", "maps", "variants")}
+SPH1D_CODE = code("methods/sph1d/*", "core/smoothing", "runfile")
+SPH1D_FIGURES = [f for name in ("error_vs_n", "maps", "variants") for f in figure(f"sph1d_{name}")]
+SPH1D_REPORT_FIGURES = [f for name in ("error_vs_n", "maps", "variants")
+                        for f in report_figure(f"sph1d_{name}", "sph1d_figure", "Methods compared")]
+
+register(SPH1D_FIGURES + ["results/sph1d/summary.csv"], ["results/report/60_sph1d.md"], ["results/claims/sph1d.csv"])
 
 
 rule sph1d_sweep:
     input:
-        settings=SPH1D_SETTINGS,
-        code=SPH1D_CODE + code("core/smoothing", "runfile"),
+        settings_path=SPH1D_SETTINGS,
+        code=SPH1D_CODE,
     output:
-        sweep="results/sph1d/sweep.nc",
-        cases="results/sph1d/cases.csv",
-        summary="results/sph1d/summary.csv",
+        "results/sph1d/sweep.nc",
+        "results/sph1d/cases.csv",
+        "results/sph1d/summary.csv",
+    params:
+        func="methods.sph1d.pipeline.run_sweep",
+    resources:
+        runtime=10,
     log:
         "logs/sph1d/sweep.log",
-    run:
-        from isaflow.methods.sph1d import pipeline
-
-        pipeline.run_sweep(input.settings, output.sweep, output.cases, output.summary, log[0])
+    script:
+        "../../scripts/call.py"
 
 
 rule sph1d_figures:
     input:
-        settings=SPH1D_SETTINGS,
-        sweep="results/sph1d/sweep.nc",
-        cases="results/sph1d/cases.csv",
-        code=SPH1D_CODE + ["src/isaflow/methods/sph1d/figures.py", "src/isaflow/figures/style.py"],
+        settings_path=SPH1D_SETTINGS,
+        sweep_nc="results/sph1d/sweep.nc",
+        cases_csv="results/sph1d/cases.csv",
+        code=SPH1D_CODE + code("figures/style"),
     output:
-        [f for pair in SPH1D_FIGURES.values() for f in pair],
+        SPH1D_REPORT_FIGURES,
+    params:
+        func="methods.sph1d.pipeline.make_figures",
     log:
         "logs/sph1d/figures.log",
-    run:
-        from isaflow.methods.sph1d import pipeline
-
-        pipeline.make_figures(input.settings, input.sweep, input.cases, SPH1D_FIGURES, log[0])
+    script:
+        "../../scripts/call.py"
 
 
 rule sph1d_report:
     input:
-        settings=SPH1D_SETTINGS,
-        sweep="results/sph1d/sweep.nc",
-        cases="results/sph1d/cases.csv",
-        summary="results/sph1d/summary.csv",
-        figures=[f for pair in SPH1D_FIGURES.values() for f in pair],
-        code=SPH1D_CODE + ["src/isaflow/methods/sph1d/report.py"],
+        settings_path=SPH1D_SETTINGS,
+        sweep_nc="results/sph1d/sweep.nc",
+        cases_csv="results/sph1d/cases.csv",
+        summary_csv="results/sph1d/summary.csv",
+        figure_files=SPH1D_FIGURES,
+        code=SPH1D_CODE,
     output:
-        claims="results/claims/sph1d.csv",
-        fragment="results/report/60_sph1d.md",
+        "results/claims/sph1d.csv",
+        "results/report/60_sph1d.md",
+    params:
+        func="methods.sph1d.pipeline.make_report",
     log:
         "logs/sph1d/report.log",
-    run:
-        from isaflow.methods.sph1d import pipeline
-
-        pipeline.make_report(input.settings, input.sweep, input.cases, input.summary,
-                             output.claims, output.fragment, log[0])
-
-
-SPH1D_TARGETS = [f for pair in SPH1D_FIGURES.values() for f in pair] + ["results/sph1d/summary.csv"]
-register(targets=SPH1D_TARGETS + ["results/claims/sph1d.csv", "results/report/60_sph1d.md"])
-register(report=["results/report/60_sph1d.md"], claims=["results/claims/sph1d.csv"])
+    script:
+        "../../scripts/call.py"

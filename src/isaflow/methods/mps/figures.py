@@ -2,25 +2,13 @@
 the rms speed of the liquid at rest against time (every single-vessel run, with its rest limit), and the
 flow (Fig. 10-like snapshots and the final state)."""
 
-from pathlib import Path
+import numpy as np
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from isaflow import metrics, runfile  # noqa: E402
-from isaflow.methods import registry  # noqa: E402
+from isaflow import metrics, runfile
+from isaflow.figures.style import plt, save
+from isaflow.methods import registry
 
 VARIANTS = registry()["mps"].variants
-
-
-def _save(fig, paths):
-    for p in paths:
-        Path(p).parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(p, dpi=110, metadata={"CreationDate": None} if str(p).endswith(".pdf") else None)
-    plt.close(fig)
 
 
 def pick_runs(paths):
@@ -64,7 +52,7 @@ def wall_loads(runs, outputs):
     axes[0, 0].set_ylabel("wall force per panel |F| [N]")
     axes[0, 0].legend(fontsize=7, loc="lower center")
     fig.tight_layout()
-    _save(fig, out)
+    save(fig, out)
 
 
 def flow(runs, outputs):
@@ -93,7 +81,7 @@ def flow(runs, outputs):
     for ax in axes[:, 0]:
         ax.set_ylabel("y [cm]", fontsize=7)
     fig.tight_layout()
-    _save(fig, out)
+    save(fig, out)
 
 
 def rest(runs, outputs):
@@ -114,4 +102,4 @@ def rest(runs, outputs):
         ax.legend(fontsize=7, loc="lower right", ncol=2)
     axes[0, 0].set_ylabel("rms speed of the liquid [cm/s]\n(dashed: rest limit)")
     fig.tight_layout()
-    _save(fig, outputs)
+    save(fig, outputs)

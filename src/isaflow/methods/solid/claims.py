@@ -9,11 +9,11 @@ from pathlib import Path
 
 import numpy as np
 
-from isaflow import runfile
 
 from . import settings
 from . import theory as T
 from .cases import to_pa
+from .figures import read_runs
 
 PAPER = "marko2017_lagrangian_solid_sph.txt"
 # the paper's stated numbers, as printed (SI)
@@ -147,13 +147,10 @@ def _rows(cfg, runs):
     return out
 
 
-def write_claims(config_path, run_dir, out):
-    """results/claims/solid.csv from the settings and the run files in run_dir."""
+def write_claims(config_path, run_paths, out):
+    """results/claims/solid.csv from the settings and the run files."""
     cfg = settings.load(config_path)
-    runs = {}
-    for f in sorted(Path(run_dir).glob("*.nc")):
-        ds = runfile.read(f)
-        runs[(ds.attrs["case"], ds.attrs["variant"])] = ds
+    runs = read_runs(run_paths)
     Path(out).parent.mkdir(parents=True, exist_ok=True)
     with open(out, "w", newline="") as fh:
         w = csv.writer(fh)
@@ -163,7 +160,7 @@ def write_claims(config_path, run_dir, out):
     return out
 
 
-def write_report(claims_csv, run_dir, out):
+def write_report(claims_csv, run_paths, out):
     """results/report/65_solid.md: the claims table and the runs' outcomes and costs."""
     with open(claims_csv) as fh:
         rows = list(csv.DictReader(fh))
@@ -177,8 +174,7 @@ def write_report(claims_csv, run_dir, out):
         cells = [r[k].replace("|", "\\|") for k in ("section", "claim", "measured", "verdict")]
         lines.append("| " + " | ".join(cells) + " |")
     lines += ["", "| run | variant | status | steps | simulated time [s] | solver time [s] |", "|---|---|---|---|---|---|"]
-    for f in sorted(Path(run_dir).glob("*.nc")):
-        ds = runfile.read(f)
+    for ds in read_runs(run_paths).values():
         lines.append(f"| {ds.attrs['case']} | {ds.attrs['variant']} | {ds.attrs['status']} | {int(ds['steps'])} | "
                      f"{float(ds['sim_time']):.3g} | {float(ds['wall_time']):.3g} |")
     lines += ["", "Figures: `figures/solid_bar.png` (deformed bars and shear block), `figures/solid_hertz.png` "
@@ -188,9 +184,7 @@ def write_report(claims_csv, run_dir, out):
     return out
 
 
-def claims_and_report(config_path, run_dir, claims_out, report_out, log_path):
-    """Claims CSV and report fragment (workflow entry point); logs what it wrote."""
-    write_claims(config_path, run_dir, claims_out)
-    write_report(claims_out, run_dir, report_out)
-    Path(log_path).parent.mkdir(parents=True, exist_ok=True)
-    Path(log_path).write_text(f"wrote {claims_out}\nwrote {report_out}\n")
+def claims_and_report(cfg, runs, outputs):
+    """Claims CSV and report fragment, outputs[0] and outputs[1] (workflow entry point)."""
+    write_claims(cfg, runs, outputs[0])
+    write_report(outputs[0], runs, outputs[1])

@@ -1,11 +1,10 @@
 """Figures of the solid cases, from run files only: deformed bars (Fig. 1), Hertz load and pressure (Fig. 3)."""
 
-from pathlib import Path
 
 import numpy as np
 
 from isaflow import runfile
-from isaflow.figures.style import PAPER, THEORY, plt
+from isaflow.figures.style import PAPER, THEORY, plt, save
 from isaflow.methods import variant as variant_of
 
 from . import settings
@@ -13,19 +12,10 @@ from . import theory as T
 from .cases import to_pa
 
 
-def save(fig, outputs):
-    """Write fig to every path; PDFs without a creation date (reproducible bytes).
-    (isaflow.figures.style.save lacks the metadata argument: candidate to move there.)"""
-    for out in outputs:
-        Path(out).parent.mkdir(parents=True, exist_ok=True)
-        meta = {"CreationDate": None} if str(out).endswith(".pdf") else {}
-        fig.savefig(out, bbox_inches="tight", metadata=meta)
-    plt.close(fig)
-
-
-def _runs(run_dir):
+def read_runs(paths):
+    """{(case, variant): Dataset} of the solid run files."""
     out = {}
-    for f in sorted(Path(run_dir).glob("*.nc")):
+    for f in paths:
         ds = runfile.read(f)
         out[(ds.attrs["case"], ds.attrs["variant"])] = ds
     return out
@@ -39,11 +29,11 @@ def _slice(ds, scale):
     return p0, p0 + scale * (p - p0)
 
 
-def bar_figure(config_path, run_dir, outputs, variant="hooke"):
+def bar_figure(config_path, runs, outputs, variant="hooke"):
     """Fig. 1 analogue: bar unloaded, in tension, in compression, and the shear block; middle z layer."""
     cfg = settings.load(config_path)
     scale = cfg["bar"]["exaggeration"]
-    runs = _runs(run_dir)
+    runs = read_runs(runs)
     fig, axes = plt.subplots(1, 4, figsize=(10, 4.6), sharey=True, gridspec_kw={"width_ratios": [1, 1, 1, 2.2]})
     panels = [("bar_tension", "(a) no stress", 0.0), ("bar_tension", "(b) tension", scale),
               ("bar_compression", "(c) compression", scale), ("shear", "(d) shear", scale)]
@@ -70,14 +60,14 @@ def bar_figure(config_path, run_dir, outputs, variant="hooke"):
     save(fig, outputs)
 
 
-def hertz_figure(config_path, run_dir, outputs):
+def hertz_figure(config_path, runs, outputs):
     """Fig. 3 analogue: (a) load per unit thickness and (b) peak contact pressure against indentation."""
     cfg = settings.load(config_path)
     hz = cfg["hertz"]
     E, nu = cfg["material"]["E_GPa"] * 1e9, cfg["material"]["nu"]
     Er, R = T.reduced_modulus(E, nu), hz["radius_mm"] * 1e-3
     d = np.linspace(hz["depths_um"][0], hz["depths_um"][-1], 50) * 1e-6
-    runs = _runs(run_dir)
+    runs = read_runs(runs)
     fig, (a, b) = plt.subplots(1, 2, figsize=(9, 3.6))
     a.plot(d * 1e6, T.load_candidates(R, d, Er, 0)["line_per_m"] / 1e6, color=THEORY,
            label="Hertz line contact pi a p_max / 2 (chord a)")
@@ -99,9 +89,7 @@ def hertz_figure(config_path, run_dir, outputs):
     save(fig, outputs)
 
 
-def bar_and_hertz(config_path, run_dir, bar_outputs, hertz_outputs, log_path):
-    """Both figures (workflow entry point); writes one line per figure to log_path."""
-    bar_figure(config_path, run_dir, bar_outputs)
-    hertz_figure(config_path, run_dir, hertz_outputs)
-    Path(log_path).parent.mkdir(parents=True, exist_ok=True)
-    Path(log_path).write_text("".join(f"wrote {o}\n" for o in [*bar_outputs, *hertz_outputs]))
+def bar_and_hertz(cfg, runs, outputs):
+    """Both figures (workflow entry point): outputs are the bar's [png, pdf], then Hertz's."""
+    bar_figure(cfg, runs, outputs[:2])
+    hertz_figure(cfg, runs, outputs[2:])

@@ -1,16 +1,12 @@
 """Run files of the solid cases (netCDF, units on every variable, provenance, atomic write).
 
-Written here, not by isaflow.runfile.to_dataset, because that one needs a tank
-and the solid cases have none (no walls, no liquid): candidate to merge into
-runfile once it accepts tank-less runs.
+The variables are built here, not by isaflow.runfile.to_dataset, because that one needs a tank
+and the solid cases have none (no walls, no liquid); provenance and the atomic write are runfile's.
 """
 
-import hashlib
 import logging
-import subprocess
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
 import xarray as xr
@@ -19,13 +15,6 @@ from isaflow import runfile
 from isaflow.methods import label
 
 from . import cases, settings, solve
-
-
-def _git_commit():
-    try:
-        return subprocess.run(["git", "rev-parse", "HEAD"], capture_output=True, text=True, timeout=20).stdout.strip()
-    except (OSError, subprocess.SubprocessError):
-        return "unknown"
 
 
 def to_dataset(r, config_path, started, finished):
@@ -60,18 +49,21 @@ def to_dataset(r, config_path, started, finished):
         "method": r.method, "variant": r.variant, "variant_label": label(r.method, r.variant),
         "status": r.status, "status_message": r.message, "residual_name": r.residual_name,
         "time_coverage_start": started, "time_coverage_end": finished,
-        "config_file": str(config_path),
-        "config_sha256": hashlib.sha256(Path(config_path).read_bytes()).hexdigest(),
-        "git_commit": _git_commit(), "command": " ".join(sys.argv),
+        "Conventions": "CF-1.10, ACDD-1.3", "creator_name": "isaflow replication workflow", "date_created": finished,
+        **runfile.provenance({"settings": config_path}),
         **{k: (v if isinstance(v, (int, float, str)) else str(v)) for k, v in r.params.items()},
     }
     return ds
 
 
-def write_run(config_path, case, variant, out, log_path=None):
+def run_case(cfg, outputs, case, variant):
+    """Workflow entry point (stderr is the rule's log): write_run to outputs[0]."""
+    logging.basicConfig(stream=sys.stderr, level=logging.INFO, format="%(asctime)s %(message)s")
+    return write_run(cfg, case, variant, outputs[0])
+
+
+def write_run(config_path, case, variant, out):
     """Run one case/variant from the settings file and write its run file to out."""
-    if log_path:
-        logging.basicConfig(filename=log_path, level=logging.INFO, format="%(asctime)s %(message)s", force=True)
     log = logging.getLogger("isaflow.solid")
     cfg = settings.load(config_path)
     solve.warmup()

@@ -1,27 +1,11 @@
 """SPH figures from run files only: Fig. 6-like single vessel, Fig. 10-like flow, flow snapshots."""
 
-from pathlib import Path
+import numpy as np
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-
-from isaflow import metrics, runfile  # noqa: E402
-from isaflow.methods.sph.outputs import level as _level  # noqa: E402
-
-
-def _walls(ax, ds):
-    for x0, y0, x1, y1 in ds["wall_segment"].values:
-        ax.plot([x0, x1], [y0, y1], color="k", lw=2)
-
-
-def _save(fig, out):
-    Path(out[0]).parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out[0], dpi=150)
-    fig.savefig(out[1], metadata={"CreationDate": None})
-    plt.close(fig)
+from isaflow import metrics, runfile
+from isaflow.figures.style import draw_walls as _walls
+from isaflow.figures.style import plt, save
+from isaflow.methods.sph.outputs import level as _level
 
 
 def single(paths, out):
@@ -51,7 +35,7 @@ def single(paths, out):
     b.title.set_fontsize(9)
     b.legend(fontsize=7)
     fig.tight_layout()
-    _save(fig, out)
+    save(fig, out)
 
 
 def flow(paths, out):
@@ -76,7 +60,7 @@ def flow(paths, out):
         ax.title.set_fontsize(9)
         ax.legend(fontsize=7, loc="upper right")
     fig.tight_layout()
-    _save(fig, out)
+    save(fig, out)
 
 
 def snapshots(path, out):
@@ -94,4 +78,11 @@ def snapshots(path, out):
         ax.set(aspect="equal", ylim=(-55, 105), xlabel="x (cm)", ylabel="y (cm)", title=f"t = {t[k]:.2f} s")
         ax.title.set_fontsize(9)
     fig.tight_layout()
-    _save(fig, out)
+    save(fig, out)
+
+
+def all_figures(single_runs, flow_runs, outputs):
+    """outputs: [png, pdf] of single(single_runs), flow(flow_runs), snapshots(finest flow run), in that order."""
+    single(single_runs, outputs[0:2])
+    flow(flow_runs, outputs[2:4])
+    snapshots(flow_runs[-1], outputs[4:6])

@@ -1,4 +1,5 @@
-"""Workflow entry points of the SPH runs: run files, the summary table, claims and report fragment.
+"""Workflow entry points of the SPH runs (called through workflow/scripts/call.py, stderr is the
+rule's log): run files and the summary table.
 
 Run ids: ``single_<variant>_<res>`` (single vessel from hydrostatic density at
 rest), ``flow_<variant>_<res>`` (continues the single run's final state with
@@ -7,6 +8,7 @@ the walls switched to flow_step50's) and ``stab_<case>`` (stability cases);
 """
 
 import logging
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -20,7 +22,6 @@ from . import settings, solver
 REFERENCES = ("Marko (2017), Computation 5, 33 (section 2); Monaghan (1992), Annu. Rev. Astron. Astrophys. 30, 543; "
               "Monaghan (1994), J. Comput. Phys. 110, 399; Adami, Hu & Adams (2012), J. Comput. Phys. 231, 7057; "
               "Molteni & Colagrossi (2009), Comput. Phys. Commun. 180, 861")
-TANKS = {"single": "config/tanks/single.yaml", "flow": "config/tanks/flow_step50.yaml"}
 
 
 def res_id(resolution):
@@ -35,22 +36,22 @@ def resolution_of(spec, case, rid):
     raise KeyError(f"no {case} resolution '{rid}' in the SPH settings")
 
 
-def _logger(log_path):
-    log = logging.getLogger(f"sph.{log_path}")
+def _logger():
+    log = logging.getLogger("isaflow.sph")
     log.setLevel(logging.INFO)
-    if log_path:
-        Path(log_path).parent.mkdir(parents=True, exist_ok=True)
-        log.addHandler(logging.FileHandler(log_path, mode="w"))
+    if not log.handlers:
+        log.addHandler(logging.StreamHandler(sys.stderr))
     return log
 
 
-def write_run(cfg_path, case, variant, rid, out, log_path=None, start=None):
-    """Run one case ('single', 'flow' from run file ``start``, or 'stab' with rid the case name); write its run file."""
-    log = _logger(log_path)
+def run_case(cfg, tank, outputs, case, variant, rid, start=None):
+    """Run one case ('single', 'flow' from run file ``start``, or 'stab' with rid the case name) with the
+    settings file ``cfg`` in the tank file ``tank``; write its run file outputs[0]."""
+    log, cfg_path, out = _logger(), cfg, outputs[0]
     spec = settings.load(cfg_path)
     solver.warm_up()  # compile outside the timing
-    inputs = {"tank": TANKS["flow" if case == "flow" else "single"], "settings": cfg_path}
-    tank = load_tank(inputs["tank"])
+    inputs = {"tank": tank, "settings": cfg_path}
+    tank = load_tank(tank)
     kw = {}
     if case == "flow":
         kw["start"] = runfile.read(start)
@@ -128,9 +129,9 @@ def row(path):
     return out
 
 
-def summary(paths, out):
-    """results/sph/summary.csv: one row per run file."""
-    df = pd.DataFrame([row(p) for p in paths])
-    Path(out).parent.mkdir(parents=True, exist_ok=True)
-    df.to_csv(out, index=False)
+def summary(runs, outputs):
+    """outputs[0] (results/sph/summary.csv): one row per run file."""
+    df = pd.DataFrame([row(p) for p in runs])
+    Path(outputs[0]).parent.mkdir(parents=True, exist_ok=True)
+    df.to_csv(outputs[0], index=False)
     return df

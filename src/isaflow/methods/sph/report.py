@@ -92,9 +92,11 @@ def fragment(df):
     return "\n".join(out)
 
 
-def write(summary_csv, claims_out, report_out):
-    df = pd.read_csv(summary_csv)
-    for path, text in ((claims_out, None), (report_out, fragment(df))):
+def write(summary, outputs):
+    """outputs: the claims CSV and the report fragment, from the summary table."""
+    df = pd.read_csv(summary)
+    claims_out, report_out = outputs
+    for path in outputs:
         Path(path).parent.mkdir(parents=True, exist_ok=True)
     claims(df).to_csv(claims_out, index=False)
     Path(report_out).write_text(fragment(df))

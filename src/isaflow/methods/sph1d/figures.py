@@ -4,23 +4,13 @@ import numpy as np
 import pandas as pd
 import xarray as xr
 
-from pathlib import Path
 
-from isaflow.figures.style import plt
+from isaflow.figures.style import plt, save
 
 KERNEL_COLOURS = {"cubic_spline": "tab:gray", "wendland_c2": "tab:red", "wendland_c4": "tab:blue",
                   "wendland_c6": "tab:green"}
 KERNEL_LABELS = {"cubic_spline": "cubic spline", "wendland_c2": "Wendland C2", "wendland_c4": "Wendland C4",
                  "wendland_c6": "Wendland C6"}
-def save(fig, outputs):
-    """Write fig to every output (PNG, PDF without creation date, so reruns are byte-stable)."""
-    for out in outputs:
-        Path(out).parent.mkdir(parents=True, exist_ok=True)
-        meta = {"CreationDate": None} if str(out).endswith(".pdf") else {}
-        fig.savefig(out, bbox_inches="tight", metadata=meta)
-    plt.close(fig)
-
-
 SHOWN_RATIOS = (0.75, 1.25, 1.45, 1.75, 2.0, 2.5)  # one to four neighbours per side
 
 

@@ -1,6 +1,8 @@
-"""Workflow entry points of the 1D study: one call per Snakemake rule, each logging to a file."""
+"""Workflow entry points of the 1D study: one call per Snakemake rule through workflow/scripts/call.py
+(``func(**inputs, outputs=[...])``; stderr is the rule's log)."""
 
 import logging
+import sys
 from pathlib import Path
 
 import pandas as pd
@@ -14,18 +16,18 @@ from . import figures, report, settings, sweep
 log = logging.getLogger("isaflow.methods.sph1d")
 
 
-def _logging(path):
-    Path(path).parent.mkdir(parents=True, exist_ok=True)
-    handler = logging.FileHandler(path, mode="w")
+def _logging():
+    handler = logging.StreamHandler(sys.stderr)
     handler.setFormatter(logging.Formatter("%(asctime)s %(message)s"))
     log.addHandler(handler)
     log.setLevel(logging.INFO)
     return handler
 
 
-def run_sweep(settings_path, sweep_nc, cases_csv, summary_csv, log_path):
-    """Solve the sweep; write the netCDF (with provenance), the case table and the summary table."""
-    handler = _logging(log_path)
+def run_sweep(settings_path, outputs):
+    """Solve the sweep; outputs: the netCDF (with provenance), the case table and the summary table."""
+    sweep_nc, cases_csv, summary_csv = outputs
+    handler = _logging()
     try:
         s = settings.load(settings_path)
         started = runfile.now()
@@ -46,9 +48,13 @@ def _labels():
     return {v.name: (v.label, v.colour) for v in m.variants.values()}
 
 
-def make_figures(settings_path, sweep_nc, cases_csv, out, log_path):
-    """out: {'error_vs_n': [png, pdf], 'maps': [...], 'variants': [...]}."""
-    handler = _logging(log_path)
+FIGURES = ("error_vs_n", "maps", "variants")
+
+
+def make_figures(settings_path, sweep_nc, cases_csv, outputs):
+    """outputs: [png, pdf] of each of FIGURES, in that order."""
+    out = {name: outputs[2 * k:2 * k + 2] for k, name in enumerate(FIGURES)}
+    handler = _logging()
     try:
         s = settings.load(settings_path)
         default = list(s["variants"])[0]
@@ -61,9 +67,10 @@ def make_figures(settings_path, sweep_nc, cases_csv, out, log_path):
         log.removeHandler(handler)
 
 
-def make_report(settings_path, sweep_nc, cases_csv, summary_csv, claims_csv, fragment_md, log_path):
-    """Claims CSV and report fragment from the tables."""
-    handler = _logging(log_path)
+def make_report(settings_path, sweep_nc, cases_csv, summary_csv, outputs, figure_files=()):
+    """outputs: the claims CSV and the report fragment, from the tables (figure_files: inputs for ordering only)."""
+    claims_csv, fragment_md = outputs
+    handler = _logging()
     try:
         s = settings.load(settings_path)
         cases, summary = pd.read_csv(cases_csv), pd.read_csv(summary_csv)
