@@ -11,6 +11,7 @@ bad input.
 
 import copy
 import os
+import re
 import stat
 import subprocess
 import sys
@@ -448,3 +449,33 @@ def test_a_run_started_at_its_step_limit_computes_its_forces_once(tmp_path):
     np.testing.assert_array_equal(res.pos, pos0)
     # the lattice start is out of balance: max|F| is the weight-scale residual, not 0
     assert res.status == "step_limit" and res.residual == np.abs(res.fields["force"][1]).max() > 1.0
+
+
+# Method settings files (config/methods/*.yaml) go through the same reader and checks as scenes.
+METHOD_SETTINGS = {
+    "sph": ("config/methods/sph.yaml", "isaflow.methods.sph.settings"),
+    "mps": ("config/methods/mps.yaml", "isaflow.methods.mps.settings"),
+    "sph1d": ("config/methods/sph1d.yaml", "isaflow.methods.sph1d.settings"),
+    "solid": ("config/methods/solid.yaml", "isaflow.methods.solid.settings"),
+}
+SETTINGS_MUTATIONS = {
+    "alias": lambda t: "base: &a {value: 1}\n" + t,
+    # the first top-level key again at the end
+    "duplicate_key": lambda t: t + "\n" + re.search(r"^([a-z_0-9]+):", t, re.M).group(1) + ": {}\n",
+    # the first numeric value becomes NaN
+    "nan_value": lambda t: re.sub(r"value: -?[0-9][0-9.eE+-]*", "value: .nan", t, count=1),
+    "python_tag": lambda t: "x: !!python/object/apply:os.system ['true']\n" + t,
+}
+
+
+@pytest.mark.parametrize("mutation", sorted(SETTINGS_MUTATIONS))
+@pytest.mark.parametrize("method", sorted(METHOD_SETTINGS))
+def test_bad_method_settings_are_refused_naming_the_file(tmp_path, method, mutation):
+    import importlib
+
+    src, module = METHOD_SETTINGS[method]
+    bad = tmp_path / f"{method}_{mutation}.yaml"
+    bad.write_text(SETTINGS_MUTATIONS[mutation]((ROOT / src).read_text()))
+    with pytest.raises(ValueError, match=f"^{bad}: ") as err:
+        importlib.import_module(module).load(bad)
+    assert "\n" not in str(err.value)

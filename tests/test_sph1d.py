@@ -120,7 +120,7 @@ def test_settings_reject_unknown_keys(tmp_path):
     text = open("config/methods/sph1d.yaml").read().replace("classify:", "classify:\n  bogus: {value: 1, source: 'x'}")
     bad = tmp_path / "bad.yaml"
     bad.write_text(text)
-    with pytest.raises(SceneError, match=r"bad.yaml: classify"):
+    with pytest.raises(SceneError, match=r"bad.yaml: field 'classify'"):
         settings.load(bad)
 
 

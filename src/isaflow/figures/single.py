@@ -4,7 +4,7 @@ import numpy as np
 
 from .. import metrics, theory
 from ..runfile import read
-from .style import (CALIBRATED, COMPUTED, LABEL_BOX, OURS_LEVEL, PAPER, PAPER_LEVEL, THEORY, draw_walls,
+from .style import (CALIBRATED, COMPUTED, LABEL_BOX, OURS_LEVEL, PAPER_LEVEL, THEORY, draw_walls,
                     legend_below, literal_levels, nice_value, plt, run_caption, save, scale_bar, state_phrase)
 
 

@@ -7,11 +7,10 @@ flattened to ``group.key`` -> value and keeps the sources for the report.
 import copy
 import json
 from importlib import resources
-from pathlib import Path
 
-import jsonschema
-import yaml
 
+from isaflow import inputs
+from isaflow.inputs import InputError
 from isaflow.scene import SceneError
 
 SCHEMA = json.loads(resources.files("isaflow.methods.mps").joinpath("settings.schema.json").read_text())
@@ -42,21 +41,17 @@ def load(path=DEFAULT_PATH, overrides=()):
     Raises SceneError with one line naming the file and the field.
     """
     path = str(path)
-    try:
-        spec = yaml.safe_load(Path(path).read_text())
-    except (OSError, UnicodeDecodeError, yaml.YAMLError) as err:
-        raise SceneError(f"{path}: cannot read MPS settings: {err}") from None
+    _, spec = inputs.read_yaml(path, "MPS settings")
     for item in overrides:
         key, sep, value = item.partition("=")
         group, _, name = key.strip().partition(".")
-        if not sep or not isinstance(spec, dict) or name not in spec.get(group, {}):
-            raise SceneError(f"{path}: override '{item}': no field '{key.strip()}'")
-        spec[group][name]["value"] = yaml.safe_load(value)
-    errors = sorted(jsonschema.Draft202012Validator(SCHEMA).iter_errors(spec), key=lambda e: list(e.absolute_path))
-    if errors:
-        e = errors[0]
-        where = ".".join(str(p) for p in e.absolute_path) or "(top level)"
-        raise SceneError(f"{path}: field '{where}': {e.message}")
+        if not sep or name not in spec.get(group, {}):
+            raise SceneError(f"{path}: override '{inputs.printable(item)}': no field '{inputs.printable(key.strip())}'")
+        try:
+            spec[group][name]["value"] = inputs.parse_yaml(value)
+        except InputError as err:
+            raise SceneError(f"{path}: override '{inputs.printable(item)}': {err}") from None
+    inputs.validate(spec, SCHEMA, path)
     values = {f"{g}.{k}": v["value"] for g, grp in spec.items() for k, v in grp.items()}
     sources = {f"{g}.{k}": v["source"] for g, grp in spec.items() for k, v in grp.items()}
     return Settings(values, sources, path)

@@ -4,13 +4,10 @@ Every value is ``{value: ..., source: "..."}``; unknown keys are rejected and
 a bad file raises isaflow.scene.SceneError naming the file and field.
 """
 
-from pathlib import Path
 
-import jsonschema
-import yaml
 
 from isaflow.core.units import KG, PA
-from isaflow.scene import SceneError
+from isaflow import inputs
 
 
 def _item(value_schema):
@@ -56,17 +53,7 @@ def load(path):
 
 def load_with_sources(path):
     """The validated file as written: {section: {key: {value, source}}}."""
-    path = str(path)
-    try:
-        spec = yaml.safe_load(Path(path).read_text())
-    except (OSError, yaml.YAMLError) as err:
-        raise SceneError(f"{path}: cannot read settings: {err}") from None
-    errors = sorted(jsonschema.Draft202012Validator(SCHEMA).iter_errors(spec), key=lambda e: list(e.path))
-    if errors:
-        e = errors[0]
-        where = ".".join(str(p) for p in e.absolute_path) or "(top level)"
-        raise SceneError(f"{path}: field '{where}': {e.message}")
-    return spec
+    return inputs.load(path, SCHEMA, "solid settings")[1]
 
 
 def material_units(mat):

@@ -8,9 +8,8 @@ scene.SceneError naming the file and the field.
 
 from pathlib import Path
 
-import jsonschema
-import yaml
 
+from ... import inputs
 from ...scene import SceneError
 
 DEFAULT_PATH = Path(__file__).resolve().parents[4] / "config" / "methods" / "sph.yaml"
@@ -75,17 +74,7 @@ SCHEMA = {
 
 def load(path=DEFAULT_PATH):
     """The validated settings file as a dict (SceneError naming file and field)."""
-    path = str(path)
-    try:
-        spec = yaml.safe_load(Path(path).read_text())
-    except (OSError, yaml.YAMLError) as err:
-        raise SceneError(f"{path}: cannot read SPH settings: {err}") from None
-    errors = sorted(jsonschema.Draft202012Validator(SCHEMA).iter_errors(spec), key=lambda e: list(e.path))
-    if errors:
-        e = errors[0]
-        where = ".".join(str(p) for p in e.absolute_path) or "(top level)"
-        raise SceneError(f"{path}: field '{where}': {e.message}")
-    return spec
+    return inputs.load(path, SCHEMA, "SPH settings")[1]
 
 
 def resolve(spec, variant, overrides=None):

@@ -6,11 +6,10 @@ isaflow.scene.SceneError with one line naming the file and the field.
 
 from pathlib import Path
 
-import jsonschema
 import numpy as np
-import yaml
 
 from isaflow.core.smoothing import NAMES
+from isaflow import inputs
 from isaflow.scene import SceneError
 
 from .system import FLOORS, GRADIENT_FORMS
@@ -56,14 +55,7 @@ def _values(node):
 def load(path):
     """{name: value} of a settings file; adds 'ratios' (array of h/dx) and 'path'."""
     path = Path(path)
-    try:
-        spec = yaml.safe_load(path.read_text())
-    except (OSError, yaml.YAMLError) as err:
-        raise SceneError(f"{path}: cannot read: {err}") from None
-    errors = sorted(jsonschema.Draft202012Validator(SCHEMA).iter_errors(spec), key=lambda e: list(e.path))
-    if errors:
-        e = errors[0]
-        raise SceneError(f"{path}: {'.'.join(map(str, e.path)) or '(top)'}: {e.message}")
+    spec = inputs.load(path, SCHEMA, "1D SPH settings")[1]
     s = _values(spec)
     r = s["ratio"]
     if r["stop"] < r["start"]:
