@@ -49,3 +49,9 @@ def test_every_rule_has_a_log_and_solver_rules_a_benchmark():
         if "isaflow run" in block:
             assert "benchmark:" in block, name
     assert Path(ROOT / "Snakefile").exists()
+
+
+def test_lint_passes():
+    """snakemake --lint: every rule has a log, a conda environment, no mixed functions in rule files."""
+    proc = subprocess.run([*SNAKEMAKE, "--lint"], cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]

@@ -34,6 +34,8 @@ rule mps_single:
     params:
         func="methods.mps.outputs.run_case",
         kw=lambda wc: dict(case="single", variant=wc.variant, label=wc.dx),
+    conda:
+        "../../envs/isaflow.yaml"
     log:
         "logs/mps/single_{variant}_dx{dx}.log",
     script:
@@ -52,6 +54,8 @@ rule mps_flow:
     params:
         func="methods.mps.outputs.run_case",
         kw=lambda wc: dict(case="flow", variant=wc.variant, label=wc.dx),
+    conda:
+        "../../envs/isaflow.yaml"
     log:
         "logs/mps/flow_{variant}_dx{dx}.log",
     script:
@@ -70,6 +74,8 @@ rule mps_stiff:
     params:
         func="methods.mps.outputs.run_stiff",
         kw=lambda wc: dict(case=wc.case),
+    conda:
+        "../../envs/isaflow.yaml"
     log:
         "logs/mps/stiff_{case}.log",
     script:
@@ -88,6 +94,8 @@ rule mps_dt:
     params:
         func="methods.mps.outputs.run_dt",
         kw=lambda wc: dict(courant=wc.courant),
+    conda:
+        "../../envs/isaflow.yaml"
     log:
         "logs/mps/dt_standard_c{courant}.log",
     script:
@@ -102,6 +110,8 @@ rule mps_summary:
         "results/mps/summary.csv",
     params:
         func="methods.mps.outputs.summary",
+    conda:
+        "../../envs/isaflow.yaml"
     log:
         "logs/mps/summary.log",
     script:
@@ -116,6 +126,8 @@ rule mps_figure_loads:
         report_figure("mps_wall_loads", "mps_figure", "Methods compared"),
     params:
         func="methods.mps.figures.wall_loads",
+    conda:
+        "../../envs/isaflow.yaml"
     log:
         "logs/mps/figure_loads.log",
     script:
@@ -130,6 +142,8 @@ rule mps_figure_rest:
         report_figure("mps_rest", "mps_figure", "Methods compared"),
     params:
         func="methods.mps.figures.rest",
+    conda:
+        "../../envs/isaflow.yaml"
     log:
         "logs/mps/figure_rest.log",
     script:
@@ -144,6 +158,8 @@ rule mps_figure_flow:
         report_figure("mps_flow", "mps_figure", "Methods compared"),
     params:
         func="methods.mps.figures.flow",
+    conda:
+        "../../envs/isaflow.yaml"
     log:
         "logs/mps/figure_flow.log",
     script:
@@ -161,6 +177,8 @@ rule mps_report:
         report="results/report/55_mps.md",
     params:
         func="methods.mps.report.write",
+    conda:
+        "../../envs/isaflow.yaml"
     log:
         "logs/mps/report.log",
     script:

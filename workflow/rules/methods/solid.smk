@@ -24,6 +24,8 @@ rule solid_run:
     params:
         func="methods.solid.outputs.run_case",
         kw=lambda wc: dict(case=wc.case, variant=wc.variant),
+    conda:
+        "../../envs/isaflow.yaml"
     log:
         "logs/solid/{case}_{variant}.log",
     script:
@@ -39,6 +41,8 @@ rule solid_figures:
         SOLID_REPORT_FIGURES,
     params:
         func="methods.solid.figures.bar_and_hertz",
+    conda:
+        "../../envs/isaflow.yaml"
     log:
         "logs/solid/figures.log",
     script:
@@ -55,6 +59,8 @@ rule solid_claims:
         "results/report/65_solid.md",
     params:
         func="methods.solid.claims.claims_and_report",
+    conda:
+        "../../envs/isaflow.yaml"
     log:
         "logs/solid/claims.log",
     script:

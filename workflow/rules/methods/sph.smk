@@ -7,14 +7,12 @@ SPH_CFG = "config/methods/sph.yaml"
 with open(SPH_CFG) as _fh:
     _SPH = _sph_yaml.safe_load(_fh)
 
-
-def _sph_res(r):
-    return f"n{r['particles']}" if "particles" in r else f"dx{r['spacing']:g}"
-
-
 SPH_VARIANTS = list(_SPH["variants"])
-SPH_SINGLE = [_sph_res(r) for r in _SPH["runs"]["single"]]
-SPH_FLOW = [_sph_res(r) for r in _SPH["runs"]["flow"]]
+# resolution ids as isaflow.methods.sph.outputs.res_id names them: n<particles> or dx<spacing>
+SPH_SINGLE, SPH_FLOW = (
+    [f"n{r['particles']}" if "particles" in r else f"dx{r['spacing']:g}" for r in _SPH["runs"][case]]
+    for case in ("single", "flow")
+)
 SPH_STAB = list(_SPH["runs"]["stability"])
 SPH_CODE = code("methods/sph/__init__", "methods/sph/kernels", "methods/sph/particles", "methods/sph/settings",
                 "methods/sph/solver", "methods/sph/outputs")
@@ -48,6 +46,8 @@ rule sph_single:
         kw=lambda wc: dict(case="single", variant=wc.variant, rid=wc.res),
     resources:
         runtime=30,
+    conda:
+        "../../envs/isaflow.yaml"
     log:
         "logs/sph/single_{variant}_{res}.log",
     script:
@@ -69,6 +69,8 @@ rule sph_flow:
         kw=lambda wc: dict(case="flow", variant=wc.variant, rid=wc.res),
     resources:
         runtime=30,
+    conda:
+        "../../envs/isaflow.yaml"
     log:
         "logs/sph/flow_{variant}_{res}.log",
     script:
@@ -87,6 +89,8 @@ rule sph_stability:
     params:
         func="methods.sph.outputs.run_case",
         kw=lambda wc: dict(case="stab", variant="wcsph", rid=wc.case),
+    conda:
+        "../../envs/isaflow.yaml"
     log:
         "logs/sph/stab_{case}.log",
     script:
@@ -101,6 +105,8 @@ rule sph_summary:
         "results/sph/summary.csv",
     params:
         func="methods.sph.outputs.summary",
+    conda:
+        "../../envs/isaflow.yaml"
     log:
         "logs/sph/summary.log",
     script:
@@ -116,6 +122,8 @@ rule sph_figures:
         SPH_REPORT_FIGURES,
     params:
         func="methods.sph.figures.all_figures",
+    conda:
+        "../../envs/isaflow.yaml"
     log:
         "logs/sph/figures.log",
     script:
@@ -131,6 +139,8 @@ rule sph_report:
         "results/report/50_sph.md",
     params:
         func="methods.sph.report.write",
+    conda:
+        "../../envs/isaflow.yaml"
     log:
         "logs/sph/report.log",
     script:

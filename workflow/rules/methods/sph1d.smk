@@ -23,6 +23,8 @@ rule sph1d_sweep:
         func="methods.sph1d.pipeline.run_sweep",
     resources:
         runtime=10,
+    conda:
+        "../../envs/isaflow.yaml"
     log:
         "logs/sph1d/sweep.log",
     script:
@@ -39,6 +41,8 @@ rule sph1d_figures:
         SPH1D_REPORT_FIGURES,
     params:
         func="methods.sph1d.pipeline.make_figures",
+    conda:
+        "../../envs/isaflow.yaml"
     log:
         "logs/sph1d/figures.log",
     script:
@@ -58,6 +62,8 @@ rule sph1d_report:
         "results/report/60_sph1d.md",
     params:
         func="methods.sph1d.pipeline.make_report",
+    conda:
+        "../../envs/isaflow.yaml"
     log:
         "logs/sph1d/report.log",
     script:
