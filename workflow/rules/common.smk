@@ -15,14 +15,17 @@ RUNS = config["runs"]
 # not matter).  register(targets=[...]) adds files to the full target;
 # register(report=[...]) adds report fragments results/report/NN_name.md
 # (assembled in NN order); register(claims=[...]) adds claims-table CSVs
-# (columns: paper, section, claim, measured, verdict, evidence).
-TARGETS = {"targets": [], "report": [], "claims": []}
+# (columns: paper, section, claim, measured, verdict, evidence); register(timing=[...])
+# adds timing fragments results/timing/<part>.md, appended to docs/timing.md (everything
+# that changes from run to run goes there, never into docs/replication.md).
+TARGETS = {"targets": [], "report": [], "claims": [], "timing": []}
 
 
-def register(targets=(), report=(), claims=()):
+def register(targets=(), report=(), claims=(), timing=()):
     TARGETS["targets"].extend(targets)
     TARGETS["report"].extend(report)
     TARGETS["claims"].extend(claims)
+    TARGETS["timing"].extend(timing)
 
 
 def code(*patterns):

@@ -187,7 +187,10 @@ def paper_claims(metrics, calibration, config, outputs):
     flat = fc["surface_range_cm"] <= tol
     rows.append(_row("6.4", '"y_eq ~ 32.0 cm ~ 33.4 cm, which confirms that a satisfactory in-compressibility of the '
                      'liquid is assured"',
-                     f"mean level {fc['depth']:.1f} cm above the second floor, but the surface is a heap: slope "
+                     f"mean level {fc['depth']:.1f} cm above the second floor ({fc['depth'] - flow['level_second']:+.2f} cm "
+                     f"from the paper's measured {flow['level_second']:g}, {fc['depth'] - flow['level_expected']:+.2f} cm "
+                     f"from its expected {flow['level_expected']:g}; tolerance a/4 = {fc['spacing_cm'] / 4:g} cm), "
+                     f"but the surface is a heap: slope "
                      f"{fc['slope_deg']:+.1f} deg, range {fc['surface_range_cm']:.1f} cm (a liquid: within a/2 = "
                      f"{tol:g} cm); area per particle {fc['area_loss_global']:.0%} below the initial lattice's",
                      "reproduced" if flat and fc["area_loss_global"] <= RHOMB_BOUND else "not reproduced",

@@ -10,8 +10,9 @@ import pandas as pd
 from . import comparison, md_table, write
 
 
-def speed_section(step_cost, compile, memory, machine, output_cost, table1, table1_md, outputs):
-    """Fragment: cost per particle-step, NumPy ratio, memory, compile cache, Table 1 total, output cost."""
+def speed_section(step_cost, compile, memory, machine, output_cost, table1, table1_md, outputs, parts=()):
+    """docs/timing.md: cost per particle-step, NumPy ratio, memory, compile cache, Table 1 total, output cost,
+    then the other methods' timing fragments (parts: results/timing/*.md, in name order)."""
     sc = pd.read_csv(step_cost)
     nb = sc[sc["impl"] == "numba"].set_index("N")
     npy = sc[sc["impl"] == "numpy"].set_index("N")
@@ -64,6 +65,7 @@ def speed_section(step_cost, compile, memory, machine, output_cost, table1, tabl
             "division per pair) costs a few ns per particle even vectorised, so a 40x ratio would need the "
             "compiled step to run at about 1.5 ns per particle-step: not reachable with this algorithm. The ratio "
             "approaches 40x only at N = 180, where NumPy's per-call overhead dominates.", ""]
+    text += [Path(p).read_text() for p in sorted(parts)]
     write(text, outputs[0])
 
 

@@ -19,7 +19,7 @@ MPS_DT_RUNS = [f"results/mps/dt_standard_c{c}.nc" for c in MPS_COURANTS]
 MPS_RUNS = MPS_SINGLE + MPS_FLOW + MPS_STIFF_RUNS + MPS_DT_RUNS
 
 register(MPS_RUNS + ["results/mps/summary.csv"] + figure("mps_wall_loads") + figure("mps_flow") + figure("mps_rest"),
-         ["results/report/55_mps.md"], ["results/claims/mps.csv"])
+         ["results/report/55_mps.md"], ["results/claims/mps.csv"], ["results/timing/55_mps.md"])
 
 
 rule mps_single:
@@ -175,6 +175,7 @@ rule mps_report:
     output:
         claims="results/claims/mps.csv",
         report="results/report/55_mps.md",
+        timing="results/timing/55_mps.md",
     params:
         func="methods.mps.report.write",
     conda:

@@ -9,7 +9,8 @@ SOLID_CODE = code("methods/solid/kernels", "methods/solid/lattice", "methods/sol
 SOLID_FIGURES = figure("solid_bar") + figure("solid_hertz")
 SOLID_REPORT_FIGURES = [f for name in ("solid_bar", "solid_hertz") for f in report_figure(name, "solid_figure", "Methods compared")]
 
-register(SOLID_RUNS + SOLID_FIGURES, ["results/report/65_solid.md"], ["results/claims/solid.csv"])
+register(SOLID_RUNS + SOLID_FIGURES, ["results/report/65_solid.md"], ["results/claims/solid.csv"],
+         ["results/timing/65_solid.md"])
 
 
 rule solid_run:
@@ -57,6 +58,7 @@ rule solid_claims:
     output:
         "results/claims/solid.csv",
         "results/report/65_solid.md",
+        "results/timing/65_solid.md",
     params:
         func="methods.solid.claims.claims_and_report",
     conda:

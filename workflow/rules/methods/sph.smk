@@ -29,7 +29,8 @@ SPH_FIGURES = [f for name in ("sph_single", "sph_flow", "sph_flow_snapshots") fo
 SPH_REPORT_FIGURES = [f for name in ("sph_single", "sph_flow", "sph_flow_snapshots")
                       for f in report_figure(name, "sph_figure", "Methods compared")]
 
-register(SPH_RUNS + ["results/sph/summary.csv"] + SPH_FIGURES, ["results/report/50_sph.md"], ["results/claims/sph.csv"])
+register(SPH_RUNS + ["results/sph/summary.csv"] + SPH_FIGURES, ["results/report/50_sph.md"], ["results/claims/sph.csv"],
+         ["results/timing/50_sph.md"])
 
 
 rule sph_single:
@@ -137,6 +138,7 @@ rule sph_report:
     output:
         "results/claims/sph.csv",
         "results/report/50_sph.md",
+        "results/timing/50_sph.md",
     params:
         func="methods.sph.report.write",
     conda:

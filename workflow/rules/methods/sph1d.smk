@@ -8,7 +8,8 @@ SPH1D_FIGURES = [f for name in ("error_vs_n", "maps", "variants") for f in figur
 SPH1D_REPORT_FIGURES = [f for name in ("error_vs_n", "maps", "variants")
                         for f in report_figure(f"sph1d_{name}", "sph1d_figure", "Methods compared")]
 
-register(SPH1D_FIGURES + ["results/sph1d/summary.csv"], ["results/report/60_sph1d.md"], ["results/claims/sph1d.csv"])
+register(SPH1D_FIGURES + ["results/sph1d/summary.csv"], ["results/report/60_sph1d.md"], ["results/claims/sph1d.csv"],
+         ["results/timing/60_sph1d.md"])
 
 
 rule sph1d_sweep:
@@ -60,6 +61,7 @@ rule sph1d_report:
     output:
         "results/claims/sph1d.csv",
         "results/report/60_sph1d.md",
+        "results/timing/60_sph1d.md",
     params:
         func="methods.sph1d.pipeline.make_report",
     conda:

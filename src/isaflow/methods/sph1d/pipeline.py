@@ -68,8 +68,9 @@ def make_figures(settings_path, sweep_nc, cases_csv, outputs):
 
 
 def make_report(settings_path, sweep_nc, cases_csv, summary_csv, outputs, figure_files=()):
-    """outputs: the claims CSV and the report fragment, from the tables (figure_files: inputs for ordering only)."""
-    claims_csv, fragment_md = outputs
+    """outputs: the claims CSV, the report fragment and the timing fragment, from the tables (figure_files:
+    inputs for ordering only)."""
+    claims_csv, fragment_md, timing_md = outputs
     handler = _logging()
     try:
         s = settings.load(settings_path)
@@ -84,9 +85,10 @@ def make_report(settings_path, sweep_nc, cases_csv, summary_csv, outputs, figure
         with xr.open_dataset(sweep_nc) as ds:
             nmax, secs = int(ds.n[-1]), float(ds.attrs["solve_seconds"])
         labels = {v: lab for v, (lab, _) in _labels().items()}
-        text = report.fragment(cases, summary, claims, variants, labels, nmax, secs)
-        Path(fragment_md).parent.mkdir(parents=True, exist_ok=True)
-        Path(fragment_md).write_text(text)
+        text = report.fragment(cases, summary, claims, variants, labels, nmax)
+        for path, content in ((fragment_md, text), (timing_md, report.timing(cases, nmax, secs))):
+            Path(path).parent.mkdir(parents=True, exist_ok=True)
+            Path(path).write_text(content)
         log.info("sph1d claims: %s", ", ".join(claims.verdict))
     finally:
         log.removeHandler(handler)

@@ -96,7 +96,7 @@ def claims_table(cases, variants, small, figures):
     return pd.DataFrame(rows)
 
 
-def fragment(cases, summary, claims, variants, labels, nmax, solve_seconds):
+def fragment(cases, summary, claims, variants, labels, nmax):
     """Markdown of the report section (results/report/60_sph1d.md)."""
     d = variants[0]
     s = summary[summary.variant == d]
@@ -107,7 +107,7 @@ def fragment(cases, summary, claims, variants, labels, nmax, solve_seconds):
         "The abstract states neither the gradient form nor the floor; the discrete equations we chose are "
         "in `docs/sph1d.md`.  Variants: " + "; ".join(f"`{v}`: {labels[v]}" for v in variants) + ".", "",
         f"Sweep: h/dx {cases.ratio.min():.2f} to {cases.ratio.max():.2f}, N up to {nmax}, "
-        f"{len(cases)} (variant, kernel, h/dx) cases in {solve_seconds:.1f} s.  Error: relative quadratic "
+        f"{len(cases)} (variant, kernel, h/dx) cases (solve time in `docs/timing.md`).  Error: relative quadratic "
         "error at the largest N; behaviour over the last four N (settled, decreasing, divergent).", "",
         f"Per kernel and neighbours per side (`{d}`):", "",
         "| kernel | nb | median error | min | max | divergent ratios | max cond_1/N |",
@@ -124,3 +124,9 @@ def fragment(cases, summary, claims, variants, labels, nmax, solve_seconds):
               "![error and conditioning maps](../figures/sph1d_maps.png)",
               "![variants](../figures/sph1d_variants.png)", ""]
     return "\n".join(lines)
+
+
+def timing(cases, nmax, solve_seconds):
+    """Markdown for docs/timing.md: the sweep's solve time."""
+    return (f"## 1D truncated SPH sweep: solve time\n\n{len(cases)} (variant, kernel, h/dx) cases, N up to {nmax}, "
+            f"every N of each case: {solve_seconds:.1f} s of banded solves and condition estimates (one process).\n")
