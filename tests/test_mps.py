@@ -106,8 +106,8 @@ def manual_step(l0=5.0, seed=0, dt=1e-3, nu=7.0):
     p = np.zeros(len(s.pos))
     p[row >= 0] = x[row[row >= 0]]
     p = np.maximum(p, 0.0)
-    pos1, vel1, grad, bad = model.correct(pos_n, ps, vs, p, s.kind, qi, qj, qm, s.re_g, s.n0_g, s.rho0, dt,
-                                          s.walls, s.escape_box)
+    pos1, vel1, grad, bad, _ = model.correct(pos_n, ps, vs, p, s.kind, qi, qj, qm, s.re_g, s.n0_g, s.rho0, dt,
+                                             s.walls, s.escape_box, s.graze_depth)
     return dict(s=s, dt=dt, nu=nu, pos_n=pos_n, vel_n=vel_n, lap=lap, p=p, pos1=pos1, vel1=vel1, grad=grad,
                 bad=bad, resid=resid)
 
@@ -264,3 +264,25 @@ def test_stiff_cases_change_only_their_setting():
     assert changed == {"large_dt": ["time.courant"], "small_re": ["model.re_density", "model.re_gradient", "model.re_laplacian"],
                        "no_relaxation": ["model.relaxation"], "on_wall": []}
     assert outputs.stiff_settings(cfg, "large_dt")[0]["time.courant"] == cfg["stiff.courant_large"] > cfg["time.courant"]
+
+
+@pytest.mark.parametrize("begin, end, escaped", [
+    ((99.5, 0.3), (100.05, -0.05), False),  # cuts the opening's convex corner (crosses floor1 at x = 99.97), ends
+                                            # 0.07 cm from floor1's end, in front of left2
+    ((99.9, 0.3), (99.9, -0.05), False),    # 0.05 cm past floor1's line: the half cell before the first wall row
+    ((99.9, 0.3), (99.0, -2.0), True),      # 2 cm past floor1's line: through the first wall row (l0/2 = 1.67 cm)
+])
+def test_a_wall_crossing_is_an_escape_only_past_the_first_wall_particle_row(begin, end, escaped):
+    """model.correct: a move across a wall line ending within graze = l0/2 of the wall segment is a graze
+    (returned, the run goes on), farther is an escape (bad[0] == 2) naming the particle and the wall."""
+    walls = load_tank(ROOT / "config" / "tanks" / "flow_step50.yaml").walls
+    l0 = 10.0 / 3.0
+    start, stop = np.array([begin]), np.array([end])
+    no_pairs = np.zeros(0, np.int64)
+    _, _, _, bad, deepest = model.correct(start, stop, np.zeros((1, 2)), np.zeros(1), np.array([model.FLUID]),
+                                          no_pairs, no_pairs, 0, 1.0, 1.0, 1.0, 1e-3, walls,
+                                          np.array([-1e3, -1e3, 1e3, 1e3]), 0.5 * l0)
+    if escaped:
+        assert bad[0] == 2 and bad[1] == 0 and bad[2] == 1  # wall 1 is floor1
+    else:
+        assert bad[0] == 0 and 0.0 < deepest <= 0.5 * l0

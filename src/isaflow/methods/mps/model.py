@@ -9,7 +9,7 @@ Units: cm, s, density N s^2 / cm^4 (2D), pressure N / cm^2.
 import numpy as np
 from numba import njit
 
-from isaflow.core.geometry import crossed_wall
+from isaflow.core.geometry import crossed_wall, segment_closest
 from isaflow.core.neighbours import build_pairs  # noqa: F401  (re-exported for tests and benchmarks)
 
 from .operators import (DIM, DUMMY, FLUID, JIT, WALL, divergence, gradient, lattice_constants,  # noqa: F401
@@ -177,16 +177,21 @@ def predict(pos, vel, kind, box, dt, gx, gy, nu, re_n, re_g, re_l, n0_n, n0_g, n
 
 
 @njit(**JIT)
-def correct(pos_old, ps, vs, p, kind, pi, pj, m, re_g, n0_g, rho0, dt, walls, box):
+def correct(pos_old, ps, vs, p, kind, pi, pj, m, re_g, n0_g, rho0, dt, walls, box, graze):
     """Pressure half of a step (eqs. 4-5): V' = -dt / rho0 grad P, U' = dt V'.
 
-    Returns (pos, vel, grad P (N, 2), bad): bad = (kind of failure, particle,
-    wall): 0 fine, 1 non-finite, 2 crossed a wall (from pos_old), 3 left the box.
+    Returns (pos, vel, grad P (N, 2), bad, deepest graze [cm]): bad = (kind of
+    failure, particle, wall): 0 fine, 1 non-finite, 2 crossed a wall (from
+    pos_old) and ended more than ``graze`` [cm] from it, 3 more than ``graze``
+    outside the box.  A
+    crossing that ends within ``graze`` of the wall segment is a graze: its
+    distance is returned (0.0 when there is none), the step goes on.
     """
     g = gradient(ps, p, kind, pi, pj, m, re_g, n0_g)
     pos = ps.copy()
     vel = vs.copy()
     bad = (0, -1, -1)
+    deepest = 0.0
     for i in range(pos.shape[0]):
         if kind[i] != FLUID:
             continue
@@ -201,7 +206,13 @@ def correct(pos_old, ps, vs, p, kind, pi, pj, m, re_g, n0_g, rho0, dt, walls, bo
             continue
         w = crossed_wall(pos_old[i, 0], pos_old[i, 1], pos[i, 0], pos[i, 1], walls)
         if w >= 0:
-            bad = (2, i, w)
-        elif pos[i, 0] < box[0] or pos[i, 0] > box[2] or pos[i, 1] < box[1] or pos[i, 1] > box[3]:
+            cx, cy = segment_closest(pos[i, 0], pos[i, 1], walls[w, 0], walls[w, 1], walls[w, 2], walls[w, 3])
+            depth = np.hypot(pos[i, 0] - cx, pos[i, 1] - cy)
+            if depth > graze:
+                bad = (2, i, w)
+            else:
+                deepest = max(deepest, depth)
+        elif (pos[i, 0] < box[0] - graze or pos[i, 0] > box[2] + graze or pos[i, 1] < box[1] - graze
+              or pos[i, 1] > box[3] + graze):
             bad = (3, i, -1)
-    return pos, vel, g, bad
+    return pos, vel, g, bad, deepest

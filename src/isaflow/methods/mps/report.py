@@ -93,13 +93,19 @@ def findings(df):
                    "raises the wall particles' pressure builds up slowly: the wall particles by the bottom-left corner stay "
                    "below the pressure of the liquid particle in the corner, which creeps into the corner at a few cm/s "
                    "until it crosses the wall line.")
-    if len(flow):
-        out.append(f"Every flow run stops within {flow.sim_time_s.max():.2g} s of the opening ("
-                   + "; ".join(f"{r.run}: {r.status}, {r.message}" for r in flow.itertuples()) + "): the liquid leaving over "
-                   "the end of floor1 (a convex corner) crosses the floor line before the edge, because the corner's wall "
-                   "particles have n* < beta n0, are free-surface (P = 0) and push nothing back; only the collision model "
-                   "(at 0.5 l0 from the wall particles, i.e. at the wall line) acts there.  The flow measures are those of "
-                   "that moment, not of a drained state.")
+    esc_flow = flow[flow.status == "escaped"]
+    if len(esc_flow):
+        out.append("Escaped flow runs (their measures are those of that moment, not of a drained state): "
+                   + "; ".join(f"{r.run}: {r.message}, t = {r.sim_time_s:.3g} s" for r in esc_flow.itertuples()) + ".")
+    grazed = df[df.graze_steps > 0]
+    if len(grazed):
+        deep = grazed.loc[grazed.deepest_graze_cm.idxmax()]
+        out.append(f"Wall-line grazes (a move across a wall line ending within l0/2 of the wall, i.e. short of the first "
+                   f"wall-particle row; counted, not escapes) occur in {len(grazed)} of {len(df)} runs, the deepest "
+                   f"{deep.deepest_graze_cm:.2g} cm ({deep.deepest_graze_cm / deep.spacing_cm:.0%} of l0, {deep.run}): "
+                   "the liquid leaving over the end of floor1 (a convex corner) cuts the corner, whose wall particles "
+                   "have n* < beta n0, are free-surface (P = 0) and push nothing back, and the falling jet overshoots "
+                   "the second floor's line before the wall particles stop it.")
     return "  ".join(out)
 
 

@@ -67,6 +67,8 @@ class State:
         pad = (layers + 1) * l0
         self.grid_box = box + np.array([-pad, -pad, pad, pad])
         self.escape_box = box
+        self.graze_depth = cfg["walls.graze_depth"] * l0  # cm: deeper crossings are escapes
+        self.grazes, self.deepest_graze = 0, 0.0  # steps with a graze, deepest graze [cm]
         self.panel_wall, self.panel_centre, self.load_matrix = boundary.load_map(self.walls, self.bnd, cfg["walls.panel_length"])
 
     def panel_forces(self):
@@ -105,8 +107,12 @@ def step(s, dt, source, cfg, timers=None):
     p[unk] = x[row[unk]]
     if cfg["model.clip_negative"]:
         p = np.maximum(p, 0.0)
-    pos, vel, _, bad = model.correct(s.pos, ps, vs, p, s.kind, pi, pj, m, s.re_g, s.n0_g, s.rho0, dt, s.walls, s.escape_box)
+    pos, vel, _, bad, graze = model.correct(s.pos, ps, vs, p, s.kind, pi, pj, m, s.re_g, s.n0_g, s.rho0, dt, s.walls,
+                                            s.escape_box, s.graze_depth)
     s.pos, s.vel, s.p = pos, vel, p
+    if graze > 0.0:
+        s.grazes += 1
+        s.deepest_graze = max(s.deepest_graze, graze)
     if timers is not None:
         timers += (t1 - t0, t2 - t1, time.perf_counter() - t2)
     return bad, resid, its
@@ -159,9 +165,10 @@ def solve(tank, cfg, variant, spacing, t_end, probes, start=None, snapshots=0, l
         if bad[0] == 1:
             status, message = "nonfinite", f"step {step0 + k}: particle {bad[1]} has a non-finite position or velocity"
         elif bad[0] == 2:
-            status, message = "escaped", f"step {step0 + k}: particle {bad[1]} crossed wall '{tank.wall_names[bad[2]]}'"
+            status, message = ("escaped", f"step {step0 + k}: particle {bad[1]} crossed wall '{tank.wall_names[bad[2]]}' "
+                                          f"(more than {s.graze_depth:.3g} cm past it)")
         elif bad[0] == 3:
-            status, message = "escaped", f"step {step0 + k}: particle {bad[1]} left the walls' bounding box"
+            status, message = "escaped", f"step {step0 + k}: particle {bad[1]} left the walls' bounding box by more than {s.graze_depth:.3g} cm"
         elif bad[0] == 4 or not resid <= fail_tol:
             status, message = "solver_failed", f"step {step0 + k}: pressure solve residual {resid:.3g} > {fail_tol:.3g} after {its} iterations"
         v = s.vel[: s.nf]
@@ -225,7 +232,8 @@ def solve(tank, cfg, variant, spacing, t_end, probes, start=None, snapshots=0, l
         "rest_speed_cm_s": u_rest, "average_window_s": cfg["time.average_window"], "wall_particles": int(nb[model.WALL]),
         "dummy_particles": int(nb[model.DUMMY]), "time_predict_s": timers[0], "time_solve_s": timers[1],
         "time_correct_s": timers[2], "collision_distance_cm": cfg["model.collision_distance"] * l0, "restitution": cfg["model.restitution"], "settings_file": cfg.path,
-        "panel_length": cfg["walls.panel_length"],
+        "panel_length": cfg["walls.panel_length"], "graze_depth_cm": s.graze_depth, "graze_steps": s.grazes,
+        "deepest_graze_cm": s.deepest_graze,
     }
     return Result(
         method="mps", variant=variant, pos0=pos0, pos=s.pos[: s.nf].copy(), weight=np.full(s.nf, s.weight),
