@@ -60,9 +60,14 @@ def flow(runs, outputs):
     out = outputs
     dss = [runfile.read(p) for p in runs]
     ncol = max(ds.sizes.get("snapshot", 1) for ds in dss)
-    fig, axes = plt.subplots(len(dss), ncol, figsize=(2.6 * ncol, 1.7 * len(dss) + 0.6), squeeze=False)
+    fig, axes = plt.subplots(len(dss), ncol, figsize=(3.0 * ncol, 1.9 * len(dss) + 1.0), squeeze=False)
     for row, ds in zip(axes, dss):
         v = VARIANTS[ds.attrs["variant"]]
+        m = metrics.run_row(ds)
+        row[0].annotate(f"{ds.attrs['variant']} ({ds.attrs['status']}): {m['particles_left']} of {m['particles']} left, "
+                        f"second vessel depth {m['depth']:.1f} cm, surface slope {m['slope_deg']:+.1f} deg, range "
+                        f"{m['surface_range_cm']:.1f} cm", (0, 1.32), xycoords="axes fraction", fontsize=8,
+                        color=v.colour, fontweight="bold")
         snaps = ds["snap_pos"].values if "snap_pos" in ds else ds["pos"].values[None]
         times = ds["snap_time"].values if "snap_time" in ds else [float(ds["sim_time"])]
         for ax, pos, t in zip(row, snaps, times):
@@ -72,7 +77,7 @@ def flow(runs, outputs):
             ax.set_xlim(-10, 310)
             ax.set_ylim(-60, 110)
             ax.set_aspect("equal")
-            ax.set_title(f"{ds.attrs['variant']} l0={float(ds.attrs['spacing']):.3g} cm, t={t:.2f} s", fontsize=7)
+            ax.set_title(f"l0 = {float(ds.attrs['spacing']):.3g} cm, t = {t:.2f} s", fontsize=7)
             ax.tick_params(labelsize=6)
         for ax in row[len(snaps):]:
             ax.axis("off")
@@ -80,6 +85,7 @@ def flow(runs, outputs):
         ax.set_xlabel("x [cm]", fontsize=7)
     for ax in axes[:, 0]:
         ax.set_ylabel("y [cm]", fontsize=7)
+    fig.suptitle("MPS flow into the second vessel: snapshots per pressure source term (last column: end state)", fontsize=9)
     fig.tight_layout()
     save(fig, out)
 

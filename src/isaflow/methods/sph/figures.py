@@ -1,11 +1,19 @@
 """SPH figures from run files only: Fig. 6-like single vessel, Fig. 10-like flow, flow snapshots."""
 
+import textwrap
+
 import numpy as np
 
 from isaflow import metrics, runfile
 from isaflow.figures.style import draw_walls as _walls
 from isaflow.figures.style import plt, save
-from isaflow.methods.sph.outputs import level as _level
+from isaflow.methods.sph.outputs import row
+
+
+def _method_title(fig, ds, what):
+    """Suptitle naming the method, the variant (its registry label, wrapped) and what the figure shows."""
+    label = textwrap.fill(f"variant {ds.attrs['variant']}: {ds.attrs['variant_label']}", 90)
+    fig.suptitle(f"Weakly compressible SPH, {what}\n{label}", fontsize=9)
 
 
 def single(paths, out):
@@ -34,31 +42,32 @@ def single(paths, out):
           title="(b) per-panel wall loads, mean over the final window")
     b.title.set_fontsize(9)
     b.legend(fontsize=7)
+    _method_title(fig, ds, "single vessel, W = 9 kN")
     fig.tight_layout()
     save(fig, out)
 
 
 def flow(paths, out):
     """Final state of each flow run with the measured second-vessel surface and the expected flat one."""
-    runs = sorted([runfile.read(p) for p in paths], key=lambda d: -float(d.attrs["spacing"]))
-    fig, axes = plt.subplots(len(runs), 1, figsize=(10, 3.3 * len(runs)), squeeze=False)
-    for ax, ds in zip(axes[:, 0], runs):
+    paths = sorted(paths, key=lambda p: -float(runfile.read(p).attrs["spacing"]))
+    fig, axes = plt.subplots(len(paths), 1, figsize=(10, 3.3 * len(paths)), squeeze=False)
+    for ax, path in zip(axes[:, 0], paths):
+        ds, r = runfile.read(path), row(path)
         pos = ds["pos"].values
         sc = ax.scatter(*pos.T, c=ds["pressure"].values, s=max(1.0, 2000 / ds.sizes["particle"]), cmap="viridis")
         fig.colorbar(sc, ax=ax, label="pressure (N/cm$^2$)")
         _walls(ax, ds)
-        lev = _level(ds, "second") + float(ds.attrs["cell_dy"]) / 2
-        w = ds["weight"].values
-        left = w[pos[:, 0] < 100].sum()
-        gamma = w.sum() / (float(ds.attrs["first_vessel_width"]) * float(ds.attrs["liquid_depth"]))
-        expect = -50 + (w.sum() - left) / (gamma * 200)
-        ax.axhline(lev, xmin=1 / 3, color="tab:red", lw=1, label=f"measured surface {lev:.1f} cm")
-        ax.axhline(expect, xmin=1 / 3, color="k", ls="--", lw=1, label=f"flat surface of the liquid held {expect:.1f} cm")
-        ax.set(aspect="equal", xlabel="x (cm)", ylabel="y (cm)", ylim=(-55, 105),
+        x0, x1 = ds["vessel_x"].values[-1]
+        for y, style, what in ((r["surface_cm"], dict(color="tab:red", lw=1), "measured surface"),
+                               (r["surface_expected_cm"], dict(color="k", ls="--", lw=1), "flat surface of the liquid held")):
+            ax.plot([x0, x1], [y, y], label=f"{what} {y:.1f} cm (slope {r['surface_slope_deg']:+.1f} deg)"
+                    if what == "measured surface" else f"{what} {y:.1f} cm", **style)
+        ax.set(aspect="equal", xlabel="x (cm)", ylabel="y (cm)",
                title=f"{ds.sizes['particle']} particles: t = {float(ds['sim_time']):.1f} s, {ds.attrs['status']}, "
-                     f"{left / w.sum():.1%} of the weight left in the first vessel")
+                     f"{r['mass_left_fraction']:.1%} of the weight left in the first vessel")
         ax.title.set_fontsize(9)
         ax.legend(fontsize=7, loc="upper right")
+    _method_title(fig, ds, "flow into the second vessel, final states")
     fig.tight_layout()
     save(fig, out)
 
@@ -68,15 +77,16 @@ def snapshots(path, out):
     ds = runfile.read(path)
     t = ds["snap_time"].values
     n = len(t)
-    fig, axes = plt.subplots((n + 1) // 2, 2, figsize=(12, 2.4 * ((n + 1) // 2)), squeeze=False)
+    fig, axes = plt.subplots((n + 1) // 2, 2, figsize=(12, 3.3 * ((n + 1) // 2) + 0.8), squeeze=False)
     for k, ax in enumerate(axes.ravel()):
         if k >= n:
             ax.axis("off")
             continue
         ax.scatter(*ds["snap_pos"].values[k].T, s=max(0.5, 1000 / ds.sizes["particle"]), color="tab:blue")
         _walls(ax, ds)
-        ax.set(aspect="equal", ylim=(-55, 105), xlabel="x (cm)", ylabel="y (cm)", title=f"t = {t[k]:.2f} s")
+        ax.set(aspect="equal", xlabel="x (cm)", ylabel="y (cm)", title=f"t = {t[k]:.2f} s")
         ax.title.set_fontsize(9)
+    _method_title(fig, ds, f"flow snapshots, {ds.sizes['particle']} particles")
     fig.tight_layout()
     save(fig, out)
 
