@@ -332,7 +332,7 @@ def methods_tables(isa_errors, isa_metrics, summaries, outputs, isa_flows=("flow
     isa = pd.read_csv(isa_errors)
     for _, r in isa.iterrows():
         single.append(dict(method="isa", variant=r["variant"], run=r["run"], spacing_cm=r["a_cm"],
-                           particles=int(r["particles"]), status=r["status"], steps=int(r["steps"]),
+                           particles=int(r["particles"]), status=r["status"], steps=int(r["steps"]), dynamic=False,
                            wall_time_s=r["wall_time_s"], **{k: r[k] for k in SINGLE_MEASURES}))
     m = pd.read_csv(isa_metrics).set_index("run")
     for run in isa_flows:
@@ -347,7 +347,8 @@ def methods_tables(isa_errors, isa_metrics, summaries, outputs, isa_flows=("flow
             ds = read(path)
             a = ds.attrs
             base = dict(method=method, variant=a["variant"], run=run, spacing_cm=float(a["spacing"]),
-                        particles=int(ds.sizes["particle"]), status=a["status"], steps=int(ds["steps"]))
+                        particles=int(ds.sizes["particle"]), status=a["status"], steps=int(ds["steps"]),
+                        dynamic=bool(np.isfinite(float(ds["sim_time"]))))  # contract: sim_time NaN when static
             if not np.isfinite(ds["pos"].values).all():
                 continue
             if case == "flow" and "vessel" in ds.coords:
