@@ -176,6 +176,7 @@ rule mps_report:
         claims="results/claims/mps.csv",
         report="results/report/55_mps.md",
         timing="results/timing/55_mps.md",
+        table="docs/tables/mps_single.csv",
     params:
         func="methods.mps.report.write",
     conda:

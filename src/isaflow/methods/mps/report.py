@@ -149,11 +149,18 @@ def fragment(df, cfg):
              f"{cfg['time.average_window']:g} s; noise is the std over that window.  At rest means rms speed below "
              f"sqrt(2 x {cfg['time.rest_fraction']:g} g l0) (kinetic pressure below {100 * cfg['time.rest_fraction']:g} % "
              "of the hydrostatic step between neighbours).", ""]
-    lines += _table(single, [("run", None), ("status", None), ("particles", g), ("side_err", g),
-                             ("floor_err", g), ("contact_rms", g), ("panel_noise_rel", g), ("rms_speed_cm_s", g),
-                             ("rest_speed_cm_s", g)],
-                    ["single run", "status", "particles", "side err", "floor err", "panel rms err",
-                     "panel noise std/mean", "rms speed cm/s", "rest limit cm/s"])
+    by_term = single.groupby("source_term", sort=False).agg(
+        runs=("run", "size"), at_rest=("status", lambda x: int((x == "converged").sum())),
+        escaped=("status", lambda x: int((x == "escaped").sum())), side_err_min=("side_err", "min"),
+        side_err_max=("side_err", "max"), panel_rms_median=("contact_rms", "median"),
+        noise_median=("panel_noise_rel", "median")).reset_index()
+    lines += ["Single vessel, per source term over the spacings "
+              f"{', '.join(f'{x:.3g}' for x in sorted(single.spacing_cm.unique(), reverse=True))} cm (every run: "
+              f"[`docs/tables/{SINGLE_TABLE}`](tables/{SINGLE_TABLE})):", ""]
+    lines += _table(by_term, [("source_term", None), ("runs", g), ("at_rest", g), ("escaped", g), ("side_err_min", g),
+                              ("side_err_max", g), ("panel_rms_median", g), ("noise_median", g)],
+                    ["source term", "runs", "at rest", "escaped", "side err min", "side err max",
+                     "panel rms err (median)", "panel noise std/mean (median)"])
     lines += [""] + _table(flow, [("run", None), ("status", None), ("sim_time_s", g), ("mass_left_frac", g), ("level", g),
                                   ("slope_deg", g), ("panel_noise_rel", g), ("time_to_rest_s", g), ("message", None),
                                   ("escape_depth_cm", g)],
@@ -207,9 +214,14 @@ def timing(df, cfg, bench):
     return "\n".join(lines + ["", cost(bench), ""])
 
 
+SINGLE_TABLE = "mps_single.csv"  # every single-vessel run, next to the report
+SINGLE_COLUMNS = ["run", "source_term", "spacing_cm", "particles", "status", "side_err", "floor_err", "contact_rms",
+                  "panel_noise_rel", "rms_speed_cm_s", "rest_speed_cm_s", "graze_steps", "deepest_graze_cm"]
+
+
 def write(summary, cfg, bench, outputs):
-    """outputs = [claims CSV, report fragment, timing fragment] from the summary table, the settings file and the
-    step-cost benchmark."""
+    """outputs = [claims CSV, report fragment, timing fragment, docs/tables/mps_single.csv] from the summary
+    table, the settings file and the step-cost benchmark."""
     df = pd.read_csv(summary, keep_default_na=True)
     cfg_ = settings.load(cfg)
     for p in outputs:
@@ -217,3 +229,4 @@ def write(summary, cfg, bench, outputs):
     claims(df).to_csv(outputs[0], index=False)
     Path(outputs[1]).write_text(fragment(df, cfg_) + "\n")
     Path(outputs[2]).write_text(timing(df, cfg_, bench))
+    df[df.case == "single"][SINGLE_COLUMNS].to_csv(outputs[3], index=False, float_format="%.6g")

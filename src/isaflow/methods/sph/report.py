@@ -13,40 +13,11 @@ def _fmt(x, f=".3g"):
 
 
 def claims(df):
-    """Rows (paper, section, claim, measured, verdict, evidence)."""
-    flow = df[(df.case == "flow") & (df.variant == "wcsph")].sort_values("spacing_cm")
+    """Rows (paper, section, claim, measured, verdict, evidence): the paper's claim about SPH itself.  Claims
+    about the paper's own method are judged on its own runs (report.claims) and, where a liquid is the
+    reference, once in the methods comparison (report.methods); SPH's flow numbers are in the fragment."""
     stab = df[df.case == "stab"].set_index("stability_case")
     rows = []
-    if len(flow):
-        f = flow.iloc[0]
-        few = 14 / 180
-        rows.append(dict(
-            section="6.4", claim="almost whole amount of liquid has been transferred to second vessel, except of few, "
-                                 "fourteen, drops-particles, which remain, in equilibrium, at the bottom of first vessel; "
-                                 "this is reasonable and was expected",
-            measured="; ".join(f"{r.particles} particles: {r.mass_left_fraction:.1%} of the weight left ({r.status})"
-                               for r in flow.itertuples()),
-            verdict="reproduced" if f.mass_left_fraction <= few else "not reproduced",
-            evidence=f"SPH liquid at the finest flow resolution leaves {f.mass_left_fraction:.1%} "
-                     f"(paper: 14 of 180 = {few:.1%}); results/sph/summary.csv, figures/sph_flow.png"))
-        tol = float(f.spacing_cm) / 2
-        ok = abs(f.surface_cm - f.surface_expected_cm) <= tol
-        rows.append(dict(
-            section="6.4", claim="y_eq = ((180 - 14)/180) x (72.5 cm/2) = 33.4 cm ... confirms that a satisfactory "
-                                 "in-compressibility of the liquid is assured",
-            measured=f"SPH surface {f.surface_cm:.2f} cm "
-                     f"(second-vessel floor at -50 cm) vs {f.surface_expected_cm:.2f} cm for a flat liquid of the "
-                     f"weight received; slope {f.surface_slope_deg:.2g} deg",
-            verdict="reproduced" if ok else "not reproduced",
-            evidence=f"a liquid settles flat at W_received / (rho g 200 cm) within half a cell ({tol:.2g} cm): "
-                     f"the paper's relation holds for SPH; results/sph/summary.csv"))
-        rows.append(dict(
-            section="abstract", claim="This incremental static analysis approximates dynamic behavior with strong damping",
-            measured="; ".join(f"{r.particles} particles: {r.status} at t = {r.sim_time_s:.1f} s, slope "
-                               f"{r.surface_slope_deg:.2g} deg" for r in flow.itertuples()),
-            verdict="not testable here (needs the paper's method's flow end state beside these SPH numbers: "
-                    "the cross-method comparison)",
-            evidence="results/sph/summary.csv (SPH dynamic behaviour: mass left, level, slope, time to rest)"))
     if "low_viscosity" in stab.index:
         s = stab.loc["low_viscosity"]
         rows.append(dict(

@@ -116,11 +116,8 @@ def fragment(cases, summary, claims, variants, labels, nmax):
     for _, r in s.iterrows():
         lines.append(f"| {r.kernel} | {r.neighbours} | {r.median_error:.3g} | {r.min_error:.3g} | "
                      f"{r.max_error:.3g} | {r.divergent_ratios if r.divergent else '-'} | {r.max_cond_over_n:.3g} |")
-    lines += ["", "| claim (abstract) | measured | verdict |", "|---|---|---|"]
-    for _, r in claims.iterrows():
-        cells = [str(x).replace("|", "/") for x in (r.claim, r.measured, r.verdict, r.evidence)]
-        lines.append(f"| {cells[0]} | {cells[1]} | **{cells[2]}** ({cells[3]}) |")
-    lines += ["", "![error against N](../figures/sph1d_error_vs_n.png)",
+    lines += ["", "Verdicts on the abstract's four claims: " + "; ".join(
+        f"({k}) **{v}**" for k, v in enumerate(claims.verdict, 1)) + " (measurements in the claims table above).", "", "![error against N](../figures/sph1d_error_vs_n.png)",
               "![error and conditioning maps](../figures/sph1d_maps.png)",
               "![variants](../figures/sph1d_variants.png)", ""]
     return "\n".join(lines)
