@@ -87,3 +87,12 @@ def test_installed_environment_is_the_lock():
         pytest.skip(f"installed environment is not the lock ({len(differ)}: {', '.join(differ[:5])}); "
                     "install with `pip install -r requirements/lock-py311.txt`")
     assert not differ
+
+
+def test_run_files_record_the_lock_file_and_its_hash():
+    """Provenance names the lock relative to the project (equal across clones) and its sha256."""
+    from isaflow import runfile
+
+    prov = runfile.provenance({})
+    assert prov["lock_file"] == "requirements/lock-py311.txt"
+    assert prov["lock_sha256"] == runfile.sha256(ROOT / "requirements" / "lock-py311.txt")

@@ -65,8 +65,10 @@ def provenance(inputs, argv=None):
         "machine": f"{platform.machine()} {platform.processor() or ''} {os.cpu_count()} cpus".strip(),
         "command": " ".join(argv if argv is not None else sys.argv),
     }
-    lock = {"lock": LOCK_FILE} if LOCK_FILE.is_file() else {}
-    for name, path in {**lock, **inputs}.items():
+    if LOCK_FILE.is_file():  # named relative to the project, so two clones record the same attribute
+        out["lock_file"] = str(LOCK_FILE.relative_to(LOCK_FILE.parents[1]))
+        out["lock_sha256"] = sha256(LOCK_FILE)
+    for name, path in inputs.items():
         out[f"{name}_file"] = str(path) if path else "none"
         out[f"{name}_sha256"] = sha256(path) if path else "none"
     return out
