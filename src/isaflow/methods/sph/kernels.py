@@ -5,8 +5,10 @@ Arrays (units cm, N, s; masses N s^2/cm, densities N s^2/cm^4, pressures N/cm^2)
   (boundary) particles, which never move;
 - v (nf, 2) velocities; rho (n,) densities; p (n,) pressures;
 - pairs (pi, pj, m): half list of core.neighbours.build_pairs over all
-  particles within rc = 2 h + skin, wall-wall pairs dropped, pi < pj (so pi
-  is always liquid and pj >= nf marks a wall particle);
+  particles within rc = 2 h + skin, wall-wall pairs dropped, pi always
+  liquid (pj >= nf marks a wall particle), in runs of equal pi: every pass
+  keeps pi's running sum in a register along a run (each particle's sum still
+  adds the pairs in list order, as pj of another run never equals pi);
 - par (NPAR,) float64 settings, indices below (see :func:`pack`).
 
 Equations: marko2017 eq. 6 (density summation) or the continuity equation,
@@ -61,19 +63,35 @@ def density_of(p, rho0, c0, gamma, tait):
 
 @njit(**JIT)
 def list_pairs(x, nf, box, rc):
-    """Pair list over all particles within rc, wall-wall pairs dropped, pi < pj."""
+    """Pair list over all particles within rc, wall-wall pairs dropped, pi liquid.
+
+    build_pairs' order and orientation (pi runs over its rows), swapped only where
+    pi would be a wall particle: the passes keep pi's sums in registers along a run.
+    """
     pi, pj, m = build_pairs(x, box, rc)
     k = 0
     for q in range(m):
         a = pi[q]
         b = pj[q]
-        if a > b:
+        if a >= nf:
             a, b = b, a
         if a < nf:
             pi[k] = a
             pj[k] = b
             k += 1
     return pi, pj, k
+
+
+@njit(inline="always", **JIT)
+def pair_kernel(x, a, b, h, kind, c):
+    """(W_ab [1/cm^2], (dW/dr)/r [1/cm^4]) of particles a, b (0 beyond 2h); c = norm / h^2."""
+    dx = x[a, 0] - x[b, 0]
+    dy = x[a, 1] - x[b, 1]
+    r = np.sqrt(dx * dx + dy * dy)
+    q = r / h
+    if q >= 2.0:
+        return 0.0, 0.0
+    return c * kernel_w(kind, q), (c * kernel_dw(kind, q) / (h * r) if r > 0.0 else 0.0)
 
 
 @njit(**JIT)
@@ -83,33 +101,37 @@ def kernel_pass(x, pi, pj, m, par, wk, fk):
     kind = int(par[KERNEL])
     c = par[NORM] / (h * h)
     for k in range(m):
-        a = pi[k]
-        b = pj[k]
-        dx = x[a, 0] - x[b, 0]
-        dy = x[a, 1] - x[b, 1]
-        r = np.sqrt(dx * dx + dy * dy)
-        q = r / h
-        if q >= 2.0:
-            wk[k] = 0.0
-            fk[k] = 0.0
-        else:
-            wk[k] = c * kernel_w(kind, q)
-            fk[k] = c * kernel_dw(kind, q) / (h * r) if r > 0.0 else 0.0
+        wk[k], fk[k] = pair_kernel(x, pi[k], pj[k], h, kind, c)
 
 
 @njit(**JIT)
-def sum_density(rho, nf, pi, pj, m, wk, par):
-    """rho[:nf] = sum_b m_b W_ab over liquid and wall particles, self included (marko2017 eq. 6)."""
+def kernel_density_pass(x, rho, nf, pi, pj, m, par, wk, fk):
+    """kernel_pass and, in the same sweep, rho[:nf] = sum_b m_b W_ab over liquid and wall particles,
+    self included (marko2017 eq. 6)."""
     mass, h = par[MASS], par[H]
-    w0 = mass * par[NORM] / (h * h) * kernel_w(int(par[KERNEL]), 0.0)
+    kind = int(par[KERNEL])
+    c = par[NORM] / (h * h)
+    w0 = mass * par[NORM] / (h * h) * kernel_w(kind, 0.0)
     for a in range(nf):
         rho[a] = w0
+    run = -1  # the run's particle pi; its density is summed in ra
+    ra = 0.0
     for k in range(m):
         a = pi[k]
         b = pj[k]
-        rho[a] += mass * wk[k]
+        if a != run:
+            if run >= 0:
+                rho[run] = ra
+            run = a
+            ra = rho[a]
+        w, f = pair_kernel(x, a, b, h, kind, c)
+        wk[k] = w
+        fk[k] = f
+        ra += mass * w
         if b < nf:
-            rho[b] += mass * wk[k]
+            rho[b] += mass * w
+    if run >= 0:
+        rho[run] = ra
 
 
 @njit(**JIT)
@@ -119,34 +141,43 @@ def density_rate(x, v, rho, nf, pi, pj, m, fk, par, drho):
     hydrostatic part rho0 g (y_a - y_b) / c0^2 removed.  Uses the cached fk of the pairs."""
     mass, h, c0, rho0, g, delta = par[MASS], par[H], par[C0], par[RHO0], par[GRAV], par[DELTA]
     drho[:nf] = 0.0
+    run = -1  # the run's particle pi; its rate is summed in da
+    da = 0.0
     for k in range(m):
         f = fk[k]
         if f == 0.0:
             continue
         a = pi[k]
         b = pj[k]
+        if a != run:
+            if run >= 0:
+                drho[run] = da
+            run = a
+            da = drho[a]
         dx = x[a, 0] - x[b, 0]
         dy = x[a, 1] - x[b, 1]
         if b >= nf:
-            drho[a] += mass * f * (v[a, 0] * dx + v[a, 1] * dy)
+            da += mass * f * (v[a, 0] * dx + v[a, 1] * dy)
             continue
         dd = mass * f * ((v[a, 0] - v[b, 0]) * dx + (v[a, 1] - v[b, 1]) * dy)
-        drho[a] += dd
+        da += dd
         drho[b] += dd
         if delta > 0.0:
             d = (rho[b] - rho[a]) - rho0 * g * dy / (c0 * c0)
             t = -2.0 * delta * h * c0 * mass * d * f
-            drho[a] += t / rho[b]
+            da += t / rho[b]
             drho[b] -= t / rho[a]
+    if run >= 0:
+        drho[run] = da
 
 
 @njit(**JIT)
-def forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum):
+def forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum, p_rho2):
     """Pressures (liquid: equation of state; walls: Adami et al. 2012 eq. 27) and accelerations.
 
     rho[:nf] is read; rho[nf:] and p are overwritten.  acc (nf, 2) cm/s^2
     includes gravity; wall_force (nw, 2) N: force of each wall particle on the
-    liquid; wsum (nw, 3) scratch.  Every pair force is applied with opposite
+    liquid; wsum (nw, 3) and p_rho2 (n,) (P / rho^2 per particle) scratch.  Every pair force is applied with opposite
     signs to both particles (eq. 9 in its symmetric form).
     """
     mass, rho0, c0, gamma = par[MASS], par[RHO0], par[C0], par[GAMMA]
@@ -172,6 +203,8 @@ def forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum):
             pw = 0.0
         p[nf + q] = pw
         rho[nf + q] = density_of(pw, rho0, c0, gamma, tait)
+    for a in range(p.shape[0]):
+        p_rho2[a] = p[a] / (rho[a] * rho[a])
     alpha = par[ALPHA]
     wall_visc = par[WALL_VISC] > 0
     eps2 = 0.01 * h * h
@@ -179,12 +212,21 @@ def forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum):
         acc[a, 0] = 0.0
         acc[a, 1] = -g
     wall_force[:] = 0.0
+    run = -1  # the run's particle pi; its acceleration is summed in (sx, sy)
+    sx = sy = 0.0
     for k in range(m):
         f = fk[k]
         if f == 0.0:
             continue
         a = pi[k]
         b = pj[k]
+        if a != run:
+            if run >= 0:
+                acc[run, 0] = sx
+                acc[run, 1] = sy
+            run = a
+            sx = acc[a, 0]
+            sy = acc[a, 1]
         dx = x[a, 0] - x[b, 0]
         dy = x[a, 1] - x[b, 1]
         wall = b >= nf
@@ -196,7 +238,7 @@ def forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum):
             dvy = v[a, 1] - v[b, 1]
         ra = rho[a]
         rb = rho[b]
-        s = p[a] / (ra * ra) + p[b] / (rb * rb)
+        s = p_rho2[a] + p_rho2[b]
         vr = dvx * dx + dvy * dy
         if vr < 0.0 and alpha > 0.0 and (wall_visc or not wall):
             mu = h * vr / (dx * dx + dy * dy + eps2)
@@ -204,23 +246,27 @@ def forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum):
         s *= mass * f
         ax = -s * dx
         ay = -s * dy
-        acc[a, 0] += ax
-        acc[a, 1] += ay
+        sx += ax
+        sy += ay
         if wall:
             wall_force[b - nf, 0] += mass * ax
             wall_force[b - nf, 1] += mass * ay
         else:
             acc[b, 0] -= ax
             acc[b, 1] -= ay
+    if run >= 0:
+        acc[run, 0] = sx
+        acc[run, 1] = sy
 
 
 @njit(**JIT)
 def evaluate(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum):
     """Kernels, densities (summed, eq. 6, or rho[:nf] as given) and forces of a state (see forces)."""
-    kernel_pass(x, pi, pj, m, par, wk, fk)
     if par[SUMMATION] > 0:
-        sum_density(rho, nf, pi, pj, m, wk, par)
-    forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum)
+        kernel_density_pass(x, rho, nf, pi, pj, m, par, wk, fk)
+    else:
+        kernel_pass(x, pi, pj, m, par, wk, fk)
+    forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum, np.empty(x.shape[0]))
 
 
 @njit(**JIT)
@@ -286,6 +332,7 @@ def advance(x, v, rho, p, nf, walls, box, grid_box, par, n_steps, xref, pi, pj, 
     rate0 = np.zeros(nf)
     rate1 = np.zeros(nf)
     rho_n = np.zeros(nf)
+    p_rho2 = np.empty(x.shape[0])
     diag[0] = 0.0
     diag[2] = 0.0
     diag[3] = -1.0
@@ -323,14 +370,14 @@ def advance(x, v, rho, p, nf, walls, box, grid_box, par, n_steps, xref, pi, pj, 
                 fk = np.empty(pi.shape[0])
             xref[:nf] = x[:nf]
             diag[2] += 1.0
-        kernel_pass(x, pi, pj, m, par, wk, fk)
         if summation:
-            sum_density(rho, nf, pi, pj, m, wk, par)
+            kernel_density_pass(x, rho, nf, pi, pj, m, par, wk, fk)
         else:
+            kernel_pass(x, pi, pj, m, par, wk, fk)
             density_rate(x, v, rho, nf, pi, pj, m, fk, par, rate1)
             for a in range(nf):
                 rho[a] = rho_n[a] + half * (rate0[a] + rate1[a])
-        forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum)
+        forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum, p_rho2)
         wall_repulsion(x, nf, walls, panel0, npanel, par, acc, panel_sum)
         v2 = 0.0
         for a in range(nf):
