@@ -43,15 +43,29 @@ def lattice_constants(re_over_l0, l0=1.0):
 
 
 @njit(**JIT)
-def number_density(pos, pi, pj, m, re):
-    """(N,) number density of every particle from the pair list (pairs beyond r_e ignored)."""
-    n = np.zeros(pos.shape[0])
+def pair_distances(pos, pi, pj, m):
+    """(m,) distance |r_j - r_i| [cm] of every pair (np.hypot), for operators sharing one pair list."""
+    dist = np.empty(m)
     for k in range(m):
         i, j = pi[k], pj[k]
-        r = np.hypot(pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1])
-        wt = weight(r, re)
-        n[i] += wt
-        n[j] += wt
+        dist[k] = np.hypot(pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1])
+    return dist
+
+
+@njit(**JIT)
+def number_density(pos, pi, pj, m, re):
+    """(N,) number density of every particle from the pair list (pairs beyond r_e ignored)."""
+    return number_density_of_pairs(pos.shape[0], pair_distances(pos, pi, pj, m), pi, pj, m, re)
+
+
+@njit(**JIT)
+def number_density_of_pairs(n_particles, dist, pi, pj, m, re):
+    """number_density from the pair distances dist (see pair_distances)."""
+    n = np.zeros(n_particles)
+    for k in range(m):
+        wt = weight(dist[k], re)
+        n[pi[k]] += wt
+        n[pj[k]] += wt
     return n
 
 
