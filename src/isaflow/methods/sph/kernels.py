@@ -290,6 +290,9 @@ def wall_repulsion(x, nf, walls, panel0, npanel, par, acc, panel_force):
             ex = walls[w, 2] - walls[w, 0]
             ey = walls[w, 3] - walls[w, 1]
             L2 = ex * ex + ey * ey
+            cross = ex * (py - walls[w, 1]) - ey * (px - walls[w, 0])
+            if cross * cross > (1.0 + 1e-6) * r0 * r0 * L2:
+                continue  # farther than r0 from the wall's line, so from the segment (d >= r0 below)
             t = ((px - walls[w, 0]) * ex + (py - walls[w, 1]) * ey) / L2
             t = min(1.0, max(0.0, t))
             dx = px - (walls[w, 0] + t * ex)
