@@ -62,7 +62,7 @@ def assemble_pairs(dist, kind, dirichlet, b, pi, pj, m, re, n0, lam, diag_extra)
             nu += 1
     count = np.ones(nu, np.int64)  # diagonal
     for k in range(m):
-        i, j = pi[k], pj[k]
+        i, j = np.uint32(pi[k]), np.uint32(pj[k])
         if row[i] >= 0 and row[j] >= 0:
             if dist[k] < re:
                 count[row[i]] += 1
@@ -77,7 +77,7 @@ def assemble_pairs(dist, kind, dirichlet, b, pi, pj, m, re, n0, lam, diag_extra)
         indices[indptr[r]] = r
         data[indptr[r]] = diag_extra
     for k in range(m):
-        i, j = pi[k], pj[k]
+        i, j = np.uint32(pi[k]), np.uint32(pj[k])
         if kind[i] == DUMMY or kind[j] == DUMMY or (row[i] < 0 and row[j] < 0):
             continue
         r = dist[k]
@@ -110,7 +110,7 @@ def collide(ps, vs, kind, pi, pj, m, dist, restitution):
     particle exchanges the normal relative velocity with restitution e if it approaches, and both are
     pushed apart to ``dist`` (equal masses; wall and dummy particles immovable).  In place."""
     for k in range(m):
-        i, j = pi[k], pj[k]
+        i, j = np.uint32(pi[k]), np.uint32(pj[k])
         if kind[i] != FLUID and kind[j] != FLUID:
             continue
         dx = ps[j, 0] - ps[i, 0]

@@ -9,6 +9,8 @@ Arrays (units cm, N, s; masses N s^2/cm, densities N s^2/cm^4, pressures N/cm^2)
   liquid (pj >= nf marks a wall particle), in runs of equal pi: every pass
   keeps pi's running sum in a register along a run (each particle's sum still
   adds the pairs in list order, as pj of another run never equals pi);
+  the passes read pi, pj as unsigned (np.uint32) so that numba indexes
+  without its negative-index wraparound;
 - par (NPAR,) float64 settings, indices below (see :func:`pack`).
 
 Equations: marko2017 eq. 6 (density summation) or the continuity equation,
@@ -101,7 +103,7 @@ def kernel_pass(x, pi, pj, m, par, wk, fk):
     kind = int(par[KERNEL])
     c = par[NORM] / (h * h)
     for k in range(m):
-        wk[k], fk[k] = pair_kernel(x, pi[k], pj[k], h, kind, c)
+        wk[k], fk[k] = pair_kernel(x, np.uint32(pi[k]), np.uint32(pj[k]), h, kind, c)
 
 
 @njit(**JIT)
@@ -117,8 +119,8 @@ def kernel_density_pass(x, rho, nf, pi, pj, m, par, wk, fk):
     run = -1  # the run's particle pi; its density is summed in ra
     ra = 0.0
     for k in range(m):
-        a = pi[k]
-        b = pj[k]
+        a = np.uint32(pi[k])
+        b = np.uint32(pj[k])
         if a != run:
             if run >= 0:
                 rho[run] = ra
@@ -147,8 +149,8 @@ def density_rate(x, v, rho, nf, pi, pj, m, fk, par, drho):
         f = fk[k]
         if f == 0.0:
             continue
-        a = pi[k]
-        b = pj[k]
+        a = np.uint32(pi[k])
+        b = np.uint32(pj[k])
         if a != run:
             if run >= 0:
                 drho[run] = da
@@ -188,9 +190,9 @@ def forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum, p_rh
     # walls at rest: p_w = (sum_f p_f W_wf + g . sum_f rho_f r_wf W_wf) / sum_f W_wf
     wsum[:] = 0.0
     for k in range(m):
-        b = pj[k]
+        b = np.uint32(pj[k])
         if b >= nf and wk[k] > 0.0:
-            a = pi[k]
+            a = np.uint32(pi[k])
             q = b - nf
             wsum[q, 0] += wk[k]
             wsum[q, 1] += p[a] * wk[k]
@@ -218,8 +220,8 @@ def forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum, p_rh
         f = fk[k]
         if f == 0.0:
             continue
-        a = pi[k]
-        b = pj[k]
+        a = np.uint32(pi[k])
+        b = np.uint32(pj[k])
         if a != run:
             if run >= 0:
                 acc[run, 0] = sx
