@@ -85,10 +85,10 @@ def list_pairs(x, nf, box, rc):
 
 
 @njit(inline="always", **JIT)
-def pair_kernel(x, a, b, h, kind, c):
-    """(W_ab [1/cm^2], (dW/dr)/r [1/cm^4]) of particles a, b (0 beyond 2h); c = norm / h^2."""
-    dx = x[a, 0] - x[b, 0]
-    dy = x[a, 1] - x[b, 1]
+def pair_kernel(xa, ya, x, b, h, kind, c):
+    """(W_ab [1/cm^2], (dW/dr)/r [1/cm^4]) of particle b and a particle at (xa, ya) (0 beyond 2h); c = norm / h^2."""
+    dx = xa - x[b, 0]
+    dy = ya - x[b, 1]
     r = np.sqrt(dx * dx + dy * dy)
     q = r / h
     if q >= 2.0:
@@ -103,7 +103,8 @@ def kernel_pass(x, pi, pj, m, par, wk, fk):
     kind = int(par[KERNEL])
     c = par[NORM] / (h * h)
     for k in range(m):
-        wk[k], fk[k] = pair_kernel(x, np.uint32(pi[k]), np.uint32(pj[k]), h, kind, c)
+        a = np.uint32(pi[k])
+        wk[k], fk[k] = pair_kernel(x[a, 0], x[a, 1], x, np.uint32(pj[k]), h, kind, c)
 
 
 @njit(**JIT)
@@ -116,8 +117,8 @@ def kernel_density_pass(x, rho, nf, pi, pj, m, par, wk, fk):
     w0 = mass * par[NORM] / (h * h) * kernel_w(kind, 0.0)
     for a in range(nf):
         rho[a] = w0
-    run = -1  # the run's particle pi; its density is summed in ra
-    ra = 0.0
+    run = -1  # the run's particle pi: its density is summed in ra, its position held in (xa, ya)
+    ra = xa = ya = 0.0
     for k in range(m):
         a = np.uint32(pi[k])
         b = np.uint32(pj[k])
@@ -125,8 +126,8 @@ def kernel_density_pass(x, rho, nf, pi, pj, m, par, wk, fk):
             if run >= 0:
                 rho[run] = ra
             run = a
-            ra = rho[a]
-        w, f = pair_kernel(x, a, b, h, kind, c)
+            ra, xa, ya = rho[a], x[a, 0], x[a, 1]
+        w, f = pair_kernel(xa, ya, x, b, h, kind, c)
         wk[k] = w
         fk[k] = f
         ra += mass * w
@@ -143,8 +144,8 @@ def density_rate(x, v, rho, nf, pi, pj, m, fk, par, drho):
     hydrostatic part rho0 g (y_a - y_b) / c0^2 removed.  Uses the cached fk of the pairs."""
     mass, h, c0, rho0, g, delta = par[MASS], par[H], par[C0], par[RHO0], par[GRAV], par[DELTA]
     drho[:nf] = 0.0
-    run = -1  # the run's particle pi; its rate is summed in da
-    da = 0.0
+    run = -1  # the run's particle pi: its rate is summed in da, its state held in registers
+    da = xa = ya = vxa = vya = ra = 0.0
     for k in range(m):
         f = fk[k]
         if f == 0.0:
@@ -156,19 +157,20 @@ def density_rate(x, v, rho, nf, pi, pj, m, fk, par, drho):
                 drho[run] = da
             run = a
             da = drho[a]
-        dx = x[a, 0] - x[b, 0]
-        dy = x[a, 1] - x[b, 1]
+            xa, ya, vxa, vya, ra = x[a, 0], x[a, 1], v[a, 0], v[a, 1], rho[a]
+        dx = xa - x[b, 0]
+        dy = ya - x[b, 1]
         if b >= nf:
-            da += mass * f * (v[a, 0] * dx + v[a, 1] * dy)
+            da += mass * f * (vxa * dx + vya * dy)
             continue
-        dd = mass * f * ((v[a, 0] - v[b, 0]) * dx + (v[a, 1] - v[b, 1]) * dy)
+        dd = mass * f * ((vxa - v[b, 0]) * dx + (vya - v[b, 1]) * dy)
         da += dd
         drho[b] += dd
         if delta > 0.0:
-            d = (rho[b] - rho[a]) - rho0 * g * dy / (c0 * c0)
+            d = (rho[b] - ra) - rho0 * g * dy / (c0 * c0)
             t = -2.0 * delta * h * c0 * mass * d * f
             da += t / rho[b]
-            drho[b] -= t / rho[a]
+            drho[b] -= t / ra
     if run >= 0:
         drho[run] = da
 
@@ -214,8 +216,8 @@ def forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum, p_rh
         acc[a, 0] = 0.0
         acc[a, 1] = -g
     wall_force[:] = 0.0
-    run = -1  # the run's particle pi; its acceleration is summed in (sx, sy)
-    sx = sy = 0.0
+    run = -1  # the run's particle pi: its acceleration is summed in (sx, sy), its state held in registers
+    sx = sy = xa = ya = vxa = vya = ra = pa = 0.0
     for k in range(m):
         f = fk[k]
         if f == 0.0:
@@ -227,20 +229,19 @@ def forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum, p_rh
                 acc[run, 0] = sx
                 acc[run, 1] = sy
             run = a
-            sx = acc[a, 0]
-            sy = acc[a, 1]
-        dx = x[a, 0] - x[b, 0]
-        dy = x[a, 1] - x[b, 1]
+            sx, sy = acc[a, 0], acc[a, 1]
+            xa, ya, vxa, vya, ra, pa = x[a, 0], x[a, 1], v[a, 0], v[a, 1], rho[a], p_rho2[a]
+        dx = xa - x[b, 0]
+        dy = ya - x[b, 1]
         wall = b >= nf
         if wall:
-            dvx = v[a, 0]
-            dvy = v[a, 1]
+            dvx = vxa
+            dvy = vya
         else:
-            dvx = v[a, 0] - v[b, 0]
-            dvy = v[a, 1] - v[b, 1]
-        ra = rho[a]
+            dvx = vxa - v[b, 0]
+            dvy = vya - v[b, 1]
         rb = rho[b]
-        s = p_rho2[a] + p_rho2[b]
+        s = pa + p_rho2[b]
         vr = dvx * dx + dvy * dy
         if vr < 0.0 and alpha > 0.0 and (wall_visc or not wall):
             mu = h * vr / (dx * dx + dy * dy + eps2)
