@@ -27,6 +27,8 @@ from ...core.geometry import crossed_wall
 from ...core.neighbours import build_pairs
 from ...core.smoothing import dw as kernel_dw
 from ...core.smoothing import w as kernel_w
+from .eos import density_of, pressure_of
+from .repulsion import wall_repulsion
 
 JIT = dict(cache=True, nogil=True)
 
@@ -35,32 +37,6 @@ JIT = dict(cache=True, nogil=True)
  WALL_VISC, LJ_D, LJ_R0, NPAR) = range(19)
 # return codes of advance()
 OK, CROSSED, LEFT_BOX, NONFINITE = range(4)
-
-
-@njit(inline="always", **JIT)
-def pressure_of(rho, rho0, c0, gamma, tait, clamp):
-    """Equation of state P(rho) [N/cm^2]: Tait B((rho/rho0)^gamma - 1), B = rho0 c0^2/gamma, or linear."""
-    if tait:
-        r = rho / rho0
-        if gamma == 7.0:  # the usual exponent, without a pow call
-            r2 = r * r
-            rg = r2 * r2 * r2 * r
-        else:
-            rg = r**gamma
-        p = rho0 * c0 * c0 / gamma * (rg - 1.0)
-    else:
-        p = c0 * c0 * (rho - rho0)
-    if clamp and p < 0.0:
-        p = 0.0
-    return p
-
-
-@njit(inline="always", **JIT)
-def density_of(p, rho0, c0, gamma, tait):
-    """Inverse equation of state rho(P) [N s^2/cm^4]."""
-    if tait:
-        return rho0 * max(1.0 + p * gamma / (rho0 * c0 * c0), 1e-6) ** (1.0 / gamma)
-    return rho0 + p / (c0 * c0)
 
 
 @njit(**JIT)
@@ -273,46 +249,6 @@ def evaluate(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum):
 
 
 @njit(**JIT)
-def wall_repulsion(x, nf, walls, panel0, npanel, par, acc, panel_force):
-    """Lennard-Jones wall repulsion (marko2017 eq. 7, Monaghan 1994: M = 12, N = 4) as a safety net.
-
-    A liquid particle closer than r0 = par[LJ_R0] to a wall segment gets
-    D ((r0/d)^12 - (r0/d)^4) / d [cm/s^2] along the wall's normal through it
-    (D = par[LJ_D], cm^2/s^2).  The force of the wall on the liquid is added to
-    panel_force[panel0[w] + k] (N) for the panel k of the wall's npanel[w] equal panels.
-    """
-    r0 = par[LJ_R0]
-    if r0 <= 0.0:
-        return
-    D = par[LJ_D]
-    mass = par[MASS]
-    for a in range(nf):
-        px = x[a, 0]
-        py = x[a, 1]
-        for w in range(walls.shape[0]):
-            ex = walls[w, 2] - walls[w, 0]
-            ey = walls[w, 3] - walls[w, 1]
-            L2 = ex * ex + ey * ey
-            cross = ex * (py - walls[w, 1]) - ey * (px - walls[w, 0])
-            if cross * cross > (1.0 + 1e-6) * r0 * r0 * L2:
-                continue  # farther than r0 from the wall's line, so from the segment (d >= r0 below)
-            t = ((px - walls[w, 0]) * ex + (py - walls[w, 1]) * ey) / L2
-            t = min(1.0, max(0.0, t))
-            dx = px - (walls[w, 0] + t * ex)
-            dy = py - (walls[w, 1] + t * ey)
-            d = np.sqrt(dx * dx + dy * dy)
-            if d >= r0 or d == 0.0:
-                continue
-            q4 = (r0 / d) ** 4
-            f = D * (q4 * q4 * q4 - q4) / (d * d)
-            acc[a, 0] += f * dx
-            acc[a, 1] += f * dy
-            k = panel0[w] + min(npanel[w] - 1, int(t * npanel[w]))
-            panel_force[k, 0] += mass * f * dx
-            panel_force[k, 1] += mass * f * dy
-
-
-@njit(**JIT)
 def advance(x, v, rho, p, nf, walls, box, grid_box, par, n_steps, xref, pi, pj, m, wk, fk, acc,
             wall_force, wsum, force_sum, panel0, npanel, panel_sum, diag):
     """Velocity Verlet (kick-drift-kick) for n_steps steps; acc must hold the current state's.
@@ -384,7 +320,7 @@ def advance(x, v, rho, p, nf, walls, box, grid_box, par, n_steps, xref, pi, pj, 
             for a in range(nf):
                 rho[a] = rho_n[a] + half * (rate0[a] + rate1[a])
         forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum, p_rho2)
-        wall_repulsion(x, nf, walls, panel0, npanel, par, acc, panel_sum)
+        wall_repulsion(x, nf, walls, panel0, npanel, par[LJ_D], par[LJ_R0], mass, acc, panel_sum)
         v2 = 0.0
         for a in range(nf):
             v[a, 0] += half * acc[a, 0]
