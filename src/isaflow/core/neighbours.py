@@ -1,9 +1,9 @@
 """Neighbour lists shared by every method: one cell-list builder (numba).
 
-``build_pairs`` returns a half list (each pair once) of all pairs closer than
-a cutoff; ``cell_rows`` the same pairs in the same order, stored by rows of a
-cell-sorted particle order (for cache-friendly force passes).  Both bin the
-particles the same way (:func:`cell_grid`, :func:`cell_of`).
+``cell_rows`` finds all pairs closer than a cutoff, each once (a half list),
+stored by rows of a cell-sorted particle order (counting sort into the cells of
+:func:`cell_grid`, :func:`cell_of`; cache-friendly force passes);
+``build_pairs`` returns the same pairs in the same order as two index arrays.
 """
 
 import numpy as np

@@ -7,8 +7,8 @@ Arrays (units cm, N, s; masses N s^2/cm, densities N s^2/cm^4, pressures N/cm^2)
 - pairs (pi, pj, m): half list of core.neighbours.build_pairs over all
   particles within rc = 2 h + skin, wall-wall pairs dropped, pi always
   liquid (pj >= nf marks a wall particle), in runs of equal pi: every pass
-  keeps pi's running sum in a register along a run (each particle's sum still
-  adds the pairs in list order, as pj of another run never equals pi);
+  keeps pi's running sum in a register along a run (a run's particle is never
+  pj inside its run, so every sum still adds the pairs in list order);
   the passes read pi, pj as unsigned (np.uint32) so that numba indexes
   without its negative-index wraparound;
 - par (NPAR,) float64 settings, indices below (see :func:`pack`).
