@@ -3,16 +3,24 @@ pressure solve (amg, cg_jacobi, direct) and correct (numba: gradient, update), e
 
 A liquid block at rest in the single tank with a spacing giving about N liquid particles (a whole number of
 columns, so the lattice is square and starts at n = n0); 20 steps after 2 warm-up steps, median per step.  Writes benchmarks/results/mps_step_cost.csv.  Run: python benchmarks/bench_mps.py [--quick]
+
+One core, as the step-cost target: BLAS (the CG's dot products), OpenMP and numba get one thread unless the
+environment says otherwise (on the shared 2-core machine a threaded OpenBLAS made the CG solve at 20,000
+particles slower, ~150 against ~95 ms per step in one check, and changes its round-off).
 """
 
+import os
 import sys
 from pathlib import Path
 
-import numpy as np
-import pandas as pd
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "NUMBA_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
 
-from isaflow.methods.mps import boundary, settings, solver
-from isaflow.scene import load_tank
+import numpy as np  # noqa: E402
+import pandas as pd  # noqa: E402
+
+from isaflow.methods.mps import boundary, settings, solver  # noqa: E402
+from isaflow.scene import load_tank  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 SIZES = (180, 720, 2000, 5000, 20000)

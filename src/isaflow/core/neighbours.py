@@ -1,9 +1,9 @@
 """Neighbour lists shared by every method: one cell-list builder (numba).
 
-``build_pairs`` returns a half list (each pair once) of all pairs closer than
-a cutoff; ``cell_rows`` the same pairs in the same order, stored by rows of a
-cell-sorted particle order (for cache-friendly force passes).  Both bin the
-particles the same way (:func:`cell_grid`, :func:`cell_of`).
+``cell_rows`` finds all pairs closer than a cutoff, each once (a half list),
+stored by rows of a cell-sorted particle order (counting sort into the cells of
+:func:`cell_grid`, :func:`cell_of`; cache-friendly force passes);
+``build_pairs`` returns the same pairs in the same order as two index arrays.
 """
 
 import numpy as np
@@ -49,47 +49,21 @@ def build_pairs(pos, box, rc):
 
     box: (4,) ``xmin, ymin, xmax, ymax`` [cm] of the cell grid (particles
     outside are clamped into edge cells, which stays correct, only slower).
-    Returns (pi, pj, m): int32 arrays whose first m entries are the pairs.
-    O(N) for bounded density.
+    Returns (pi, pj, m): int32 arrays whose first m entries are the pairs,
+    cell by cell (ascending particles within a cell), each particle's partners
+    in its own cell (later entries), then the E, NW, N, NE cells.
+    :func:`cell_rows`' rows expanded.  O(N) for bounded density.
     """
     n = pos.shape[0]
-    ncx, ncy, csx, csy = cell_grid(box, rc)
-    head = np.full(ncx * ncy, -1, np.int64)
-    nxt = np.empty(n, np.int64)
-    for i in range(n - 1, -1, -1):
-        c = cell_of(pos[i, 0], pos[i, 1], box, ncx, ncy, csx, csy)
-        nxt[i] = head[c]
-        head[c] = i
-    cap = 8 * n + 16
-    pi = np.empty(cap, np.int32)
-    pj = np.empty(cap, np.int32)
-    rc2 = rc * rc
-    m = 0
-    for cy in range(ncy):
-        for cx in range(ncx):
-            i = head[cy * ncx + cx]
-            while i >= 0:
-                xi = pos[i, 0]
-                yi = pos[i, 1]
-                # half stencil: own cell (later entries), E, NW, N, NE
-                for k in range(5):
-                    if k == 0:
-                        j = nxt[i]
-                    else:
-                        ox = (1, -1, 0, 1)[k - 1]
-                        nx_ = cx + ox
-                        ny_ = cy + (0, 1, 1, 1)[k - 1]
-                        if nx_ < 0 or nx_ >= ncx or ny_ >= ncy:
-                            continue
-                        j = head[ny_ * ncx + nx_]
-                    while j >= 0:
-                        dx = xi - pos[j, 0]
-                        dy = yi - pos[j, 1]
-                        if dx * dx + dy * dy < rc2:
-                            pi, pj = push_pair(pi, pj, m, i, j)
-                            m += 1
-                        j = nxt[j]
-                i = nxt[i]
+    order = np.empty(n, np.int32)
+    row_start = np.empty(n + 1, np.int32)
+    pj, _ = cell_rows(pos, box, rc, order, np.empty(1, np.int32), row_start, np.empty(8 * n + 16, np.int32))
+    m = row_start[n]
+    pi = np.empty(pj.shape[0], np.int32)
+    for q in range(n):
+        i = order[q]
+        for k in range(row_start[q], row_start[q + 1]):
+            pi[k] = i
     return pi, pj, m
 
 
@@ -126,16 +100,20 @@ def cell_rows(pos, box, rc, order, cstart, row_start, nbr):
     for c in range(nc, 0, -1):
         cstart[c] = cstart[c - 1]
     cstart[0] = 0
+    xs = np.empty(n)  # coordinates in cell order: contiguous reads in the pair search
+    ys = np.empty(n)
+    for q in range(n):
+        xs[q] = pos[order[q], 0]
+        ys[q] = pos[order[q], 1]
     rc2 = rc * rc
     m = 0
     for cy in range(ncy):
         for cx in range(ncx):
             c = cy * ncx + cx
             for q in range(cstart[c], cstart[c + 1]):
-                i = order[q]
                 row_start[q] = m
-                xi = pos[i, 0]
-                yi = pos[i, 1]
+                xi = xs[q]
+                yi = ys[q]
                 # half stencil: own cell (later entries), E, NW, N, NE
                 for k in range(5):
                     if k == 0:
@@ -148,16 +126,14 @@ def cell_rows(pos, box, rc, order, cstart, row_start, nbr):
                             continue
                         a = cstart[ny_ * ncx + nx_]
                         b = cstart[ny_ * ncx + nx_ + 1]
-                    for r in range(a, b):
-                        j = order[r]
-                        dx = xi - pos[j, 0]
-                        dy = yi - pos[j, 1]
-                        if dx * dx + dy * dy < rc2:
-                            if m == nbr.shape[0]:
-                                grown = np.empty(2 * m + 16, np.int32)
-                                grown[:m] = nbr[:m]
-                                nbr = grown
-                            nbr[m] = j
-                            m += 1
+                    if m + (b - a) > nbr.shape[0]:
+                        grown = np.empty(2 * (m + b - a) + 16, np.int32)
+                        grown[:m] = nbr[:m]
+                        nbr = grown
+                    for r in range(a, b):  # branch-free: always store, advance only for a pair
+                        dx = xi - xs[r]
+                        dy = yi - ys[r]
+                        nbr[m] = order[r]
+                        m += dx * dx + dy * dy < rc2
     row_start[n] = m
     return nbr, cstart

@@ -14,8 +14,8 @@ SPH_SINGLE, SPH_FLOW = (
     for case in ("single", "flow")
 )
 SPH_STAB = list(_SPH["runs"]["stability"])
-SPH_CODE = code("methods/sph/__init__", "methods/sph/kernels", "methods/sph/particles", "methods/sph/settings",
-                "methods/sph/solver", "methods/sph/outputs")
+SPH_CODE = code("methods/sph/__init__", "methods/sph/kernels", "methods/sph/eos", "methods/sph/repulsion",
+                "methods/sph/particles", "methods/sph/settings", "methods/sph/solver", "methods/sph/outputs")
 SPH_SINGLE_RUNS = [f"results/sph/single_wcsph_{r}.nc" for r in SPH_SINGLE]
 SPH_FLOW_RUNS = [f"results/sph/flow_wcsph_{r}.nc" for r in SPH_FLOW]
 SPH_RUNS = (

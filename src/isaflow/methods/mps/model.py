@@ -13,7 +13,8 @@ from isaflow.core.geometry import crossed_wall, segment_closest
 from isaflow.core.neighbours import build_pairs  # noqa: F401  (re-exported for tests and benchmarks)
 
 from .operators import (DIM, DUMMY, FLUID, JIT, WALL, divergence, gradient, lattice_constants,  # noqa: F401
-                        laplacian, neighbour_offset_sum, number_density, probe_pressure, weight)
+                        laplacian, neighbour_offset_sum, number_density, number_density_of_pairs, pair_distances,
+                        probe_pressure, weight)
 
 # source terms of the pressure equation (settings name -> id)
 SOURCES = {"standard": 0, "hattori": 1, "mixed": 2}
@@ -46,7 +47,13 @@ def assemble(pos, kind, dirichlet, b, pi, pj, m, re, n0, lam, diag_extra=0.0):
     positive definite when diag_extra > 0, or when every cluster touches a Dirichlet particle.  Returns (unknown (N,)
     row of each particle or -1, indptr, indices, data, rhs).
     """
-    n = pos.shape[0]
+    return assemble_pairs(pair_distances(pos, pi, pj, m), kind, dirichlet, b, pi, pj, m, re, n0, lam, diag_extra)
+
+
+@njit(**JIT)
+def assemble_pairs(dist, kind, dirichlet, b, pi, pj, m, re, n0, lam, diag_extra):
+    """assemble from the pair distances dist (see operators.pair_distances)."""
+    n = kind.shape[0]
     row = np.full(n, -1, np.int64)
     nu = 0
     for i in range(n):
@@ -55,9 +62,9 @@ def assemble(pos, kind, dirichlet, b, pi, pj, m, re, n0, lam, diag_extra=0.0):
             nu += 1
     count = np.ones(nu, np.int64)  # diagonal
     for k in range(m):
-        i, j = pi[k], pj[k]
+        i, j = np.uint32(pi[k]), np.uint32(pj[k])
         if row[i] >= 0 and row[j] >= 0:
-            if np.hypot(pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1]) < re:
+            if dist[k] < re:
                 count[row[i]] += 1
                 count[row[j]] += 1
     indptr = np.zeros(nu + 1, np.int64)
@@ -70,10 +77,10 @@ def assemble(pos, kind, dirichlet, b, pi, pj, m, re, n0, lam, diag_extra=0.0):
         indices[indptr[r]] = r
         data[indptr[r]] = diag_extra
     for k in range(m):
-        i, j = pi[k], pj[k]
+        i, j = np.uint32(pi[k]), np.uint32(pj[k])
         if kind[i] == DUMMY or kind[j] == DUMMY or (row[i] < 0 and row[j] < 0):
             continue
-        r = np.hypot(pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1])
+        r = dist[k]
         if r >= re:
             continue
         wt = weight(r, re)
@@ -103,7 +110,7 @@ def collide(ps, vs, kind, pi, pj, m, dist, restitution):
     particle exchanges the normal relative velocity with restitution e if it approaches, and both are
     pushed apart to ``dist`` (equal masses; wall and dummy particles immovable).  In place."""
     for k in range(m):
-        i, j = pi[k], pj[k]
+        i, j = np.uint32(pi[k]), np.uint32(pj[k])
         if kind[i] != FLUID and kind[j] != FLUID:
             continue
         dx = ps[j, 0] - ps[i, 0]
@@ -158,7 +165,8 @@ def predict(pos, vel, kind, box, dt, gx, gy, nu, re_n, re_g, re_l, n0_n, n0_g, n
         pi, pj, m = build_pairs(ps, box, coll_dist)
         collide(ps, vs, kind, pi, pj, m, coll_dist, restitution)
     pi, pj, m = build_pairs(ps, box, rmax)
-    n_star = number_density(ps, pi, pj, m, re_n)
+    dist = pair_distances(ps, pi, pj, m)
+    n_star = number_density_of_pairs(ps.shape[0], dist, pi, pj, m, re_n)
     div = divergence(ps, vs, pi, pj, m, re_g, n0_g)
     dirichlet = np.zeros(pos.shape[0], np.bool_)
     b = np.zeros(pos.shape[0])
@@ -172,7 +180,7 @@ def predict(pos, vel, kind, box, dt, gx, gy, nu, re_n, re_g, re_l, n0_n, n0_g, n
     extra = 0.0
     if sound > 0.0:  # alpha / dt^2 with alpha = 1 / (rho0 c^2), times the row scale lambda n0 rho0 / (2 d)
         extra = lam * n0_l / (2.0 * DIM * sound**2 * dt**2)
-    system = assemble(ps, kind, dirichlet, b, pi, pj, m, re_l, n0_l, lam, extra)
+    system = assemble_pairs(dist, kind, dirichlet, b, pi, pj, m, re_l, n0_l, lam, extra)
     return ps, vs, n_star, div, dirichlet, pi, pj, m, system
 
 

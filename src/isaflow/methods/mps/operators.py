@@ -6,7 +6,8 @@
   phi^_i = min(phi_i, phi_j over neighbours) (K&O 1996's stabilised pressure gradient);
 - Laplacian <lap phi>_i = 2 d / (lambda n0) sum_j (phi_j - phi_i) w(r_ij);
 - divergence <div u>_i = d / n0 sum_j (u_j - u_i) . r_ij / |r_ij|^2 w(r_ij).
-r_ij = r_j - r_i; pairs from core.neighbours.build_pairs.  Particle kinds: FLUID,
+r_ij = r_j - r_i; pairs from core.neighbours.build_pairs (read as np.uint32: numba then indexes without
+its negative-index wraparound).  Particle kinds: FLUID,
 WALL (in the pressure equation and the gradient), DUMMY (number density only).
 Units: cm, s, density N s^2 / cm^4 (2D), pressure N / cm^2.
 """
@@ -43,15 +44,29 @@ def lattice_constants(re_over_l0, l0=1.0):
 
 
 @njit(**JIT)
+def pair_distances(pos, pi, pj, m):
+    """(m,) distance |r_j - r_i| [cm] of every pair (np.hypot), for operators sharing one pair list."""
+    dist = np.empty(m)
+    for k in range(m):
+        i, j = np.uint32(pi[k]), np.uint32(pj[k])
+        dist[k] = np.hypot(pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1])
+    return dist
+
+
+@njit(**JIT)
 def number_density(pos, pi, pj, m, re):
     """(N,) number density of every particle from the pair list (pairs beyond r_e ignored)."""
-    n = np.zeros(pos.shape[0])
+    return number_density_of_pairs(pos.shape[0], pair_distances(pos, pi, pj, m), pi, pj, m, re)
+
+
+@njit(**JIT)
+def number_density_of_pairs(n_particles, dist, pi, pj, m, re):
+    """number_density from the pair distances dist (see pair_distances)."""
+    n = np.zeros(n_particles)
     for k in range(m):
-        i, j = pi[k], pj[k]
-        r = np.hypot(pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1])
-        wt = weight(r, re)
-        n[i] += wt
-        n[j] += wt
+        wt = weight(dist[k], re)
+        n[np.uint32(pi[k])] += wt
+        n[np.uint32(pj[k])] += wt
     return n
 
 
@@ -60,7 +75,7 @@ def neighbour_offset_sum(pos, pi, pj, m, rc):
     """(N, 2) sum_j (r_j - r_i) [cm] over all neighbours closer than rc (MPS-Basic's particle-distribution test)."""
     out = np.zeros((pos.shape[0], 2))
     for k in range(m):
-        i, j = pi[k], pj[k]
+        i, j = np.uint32(pi[k]), np.uint32(pj[k])
         dx = pos[j, 0] - pos[i, 0]
         dy = pos[j, 1] - pos[i, 1]
         if dx * dx + dy * dy < rc * rc:
@@ -76,7 +91,7 @@ def divergence(pos, vel, pi, pj, m, re, n0):
     """(N,) MPS divergence of vel [1/s] (all neighbours, wall velocity 0)."""
     div = np.zeros(pos.shape[0])
     for k in range(m):
-        i, j = pi[k], pj[k]
+        i, j = np.uint32(pi[k]), np.uint32(pj[k])
         dx = pos[j, 0] - pos[i, 0]
         dy = pos[j, 1] - pos[i, 1]
         r2 = dx * dx + dy * dy
@@ -94,7 +109,7 @@ def laplacian(pos, f, kind, pi, pj, m, re, n0, lam):
     """(N, C) MPS Laplacian of f (N, C) over fluid and wall neighbours (dummies excluded)."""
     out = np.zeros_like(f)
     for k in range(m):
-        i, j = pi[k], pj[k]
+        i, j = np.uint32(pi[k]), np.uint32(pj[k])
         if kind[i] == DUMMY or kind[j] == DUMMY:
             continue
         wt = weight(np.hypot(pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1]), re)
@@ -115,7 +130,7 @@ def gradient(pos, p, kind, pi, pj, m, re, n0):
     n = pos.shape[0]
     pmin = p.copy()
     for k in range(m):
-        i, j = pi[k], pj[k]
+        i, j = np.uint32(pi[k]), np.uint32(pj[k])
         if kind[i] == DUMMY or kind[j] == DUMMY:
             continue
         if np.hypot(pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1]) < re:
@@ -123,7 +138,7 @@ def gradient(pos, p, kind, pi, pj, m, re, n0):
             pmin[j] = min(pmin[j], p[i])
     g = np.zeros((n, 2))
     for k in range(m):
-        i, j = pi[k], pj[k]
+        i, j = np.uint32(pi[k]), np.uint32(pj[k])
         dx = pos[j, 0] - pos[i, 0]
         dy = pos[j, 1] - pos[i, 1]
         if kind[i] == DUMMY or kind[j] == DUMMY:

@@ -1,6 +1,7 @@
 """Weakly compressible SPH (issue 10): the liquid of marko2017 section 2 on the project's tanks.
 
 Modules: ``kernels`` (numba pair passes and the compiled leapfrog loop),
+``eos`` (equations of state), ``repulsion`` (Lennard-Jones wall safety net),
 ``particles`` (liquid lattice, wall particles, wall contacts), ``settings``
 (config/methods/sph.yaml and its schema), ``solver`` (chunks, rest test,
 outcome -> contract.Result), ``analysis`` (measures, summary, claims, report),

@@ -5,8 +5,12 @@ Arrays (units cm, N, s; masses N s^2/cm, densities N s^2/cm^4, pressures N/cm^2)
   (boundary) particles, which never move;
 - v (nf, 2) velocities; rho (n,) densities; p (n,) pressures;
 - pairs (pi, pj, m): half list of core.neighbours.build_pairs over all
-  particles within rc = 2 h + skin, wall-wall pairs dropped, pi < pj (so pi
-  is always liquid and pj >= nf marks a wall particle);
+  particles within rc = 2 h + skin, wall-wall pairs dropped, pi always
+  liquid (pj >= nf marks a wall particle), in runs of equal pi: every pass
+  keeps pi's running sum in a register along a run (a run's particle is never
+  pj inside its run, so every sum still adds the pairs in list order);
+  the passes read pi, pj as unsigned (np.uint32) so that numba indexes
+  without its negative-index wraparound;
 - par (NPAR,) float64 settings, indices below (see :func:`pack`).
 
 Equations: marko2017 eq. 6 (density summation) or the continuity equation,
@@ -23,6 +27,8 @@ from ...core.geometry import crossed_wall
 from ...core.neighbours import build_pairs
 from ...core.smoothing import dw as kernel_dw
 from ...core.smoothing import w as kernel_w
+from .eos import density_of, pressure_of
+from .repulsion import wall_repulsion
 
 JIT = dict(cache=True, nogil=True)
 
@@ -33,47 +39,37 @@ JIT = dict(cache=True, nogil=True)
 OK, CROSSED, LEFT_BOX, NONFINITE = range(4)
 
 
-@njit(inline="always", **JIT)
-def pressure_of(rho, rho0, c0, gamma, tait, clamp):
-    """Equation of state P(rho) [N/cm^2]: Tait B((rho/rho0)^gamma - 1), B = rho0 c0^2/gamma, or linear."""
-    if tait:
-        r = rho / rho0
-        if gamma == 7.0:  # the usual exponent, without a pow call
-            r2 = r * r
-            rg = r2 * r2 * r2 * r
-        else:
-            rg = r**gamma
-        p = rho0 * c0 * c0 / gamma * (rg - 1.0)
-    else:
-        p = c0 * c0 * (rho - rho0)
-    if clamp and p < 0.0:
-        p = 0.0
-    return p
-
-
-@njit(inline="always", **JIT)
-def density_of(p, rho0, c0, gamma, tait):
-    """Inverse equation of state rho(P) [N s^2/cm^4]."""
-    if tait:
-        return rho0 * max(1.0 + p * gamma / (rho0 * c0 * c0), 1e-6) ** (1.0 / gamma)
-    return rho0 + p / (c0 * c0)
-
-
 @njit(**JIT)
 def list_pairs(x, nf, box, rc):
-    """Pair list over all particles within rc, wall-wall pairs dropped, pi < pj."""
+    """Pair list over all particles within rc, wall-wall pairs dropped, pi liquid.
+
+    build_pairs' order and orientation (pi runs over its rows), swapped only where
+    pi would be a wall particle: the passes keep pi's sums in registers along a run.
+    """
     pi, pj, m = build_pairs(x, box, rc)
     k = 0
     for q in range(m):
         a = pi[q]
         b = pj[q]
-        if a > b:
+        if a >= nf:
             a, b = b, a
         if a < nf:
             pi[k] = a
             pj[k] = b
             k += 1
     return pi, pj, k
+
+
+@njit(inline="always", **JIT)
+def pair_kernel(xa, ya, x, b, h, kind, c):
+    """(W_ab [1/cm^2], (dW/dr)/r [1/cm^4]) of particle b and a particle at (xa, ya) (0 beyond 2h); c = norm / h^2."""
+    dx = xa - x[b, 0]
+    dy = ya - x[b, 1]
+    r = np.sqrt(dx * dx + dy * dy)
+    q = r / h
+    if q >= 2.0:
+        return 0.0, 0.0
+    return c * kernel_w(kind, q), (c * kernel_dw(kind, q) / (h * r) if r > 0.0 else 0.0)
 
 
 @njit(**JIT)
@@ -83,33 +79,38 @@ def kernel_pass(x, pi, pj, m, par, wk, fk):
     kind = int(par[KERNEL])
     c = par[NORM] / (h * h)
     for k in range(m):
-        a = pi[k]
-        b = pj[k]
-        dx = x[a, 0] - x[b, 0]
-        dy = x[a, 1] - x[b, 1]
-        r = np.sqrt(dx * dx + dy * dy)
-        q = r / h
-        if q >= 2.0:
-            wk[k] = 0.0
-            fk[k] = 0.0
-        else:
-            wk[k] = c * kernel_w(kind, q)
-            fk[k] = c * kernel_dw(kind, q) / (h * r) if r > 0.0 else 0.0
+        a = np.uint32(pi[k])
+        wk[k], fk[k] = pair_kernel(x[a, 0], x[a, 1], x, np.uint32(pj[k]), h, kind, c)
 
 
 @njit(**JIT)
-def sum_density(rho, nf, pi, pj, m, wk, par):
-    """rho[:nf] = sum_b m_b W_ab over liquid and wall particles, self included (marko2017 eq. 6)."""
+def kernel_density_pass(x, rho, nf, pi, pj, m, par, wk, fk):
+    """kernel_pass and, in the same sweep, rho[:nf] = sum_b m_b W_ab over liquid and wall particles,
+    self included (marko2017 eq. 6)."""
     mass, h = par[MASS], par[H]
-    w0 = mass * par[NORM] / (h * h) * kernel_w(int(par[KERNEL]), 0.0)
+    kind = int(par[KERNEL])
+    c = par[NORM] / (h * h)
+    w0 = mass * par[NORM] / (h * h) * kernel_w(kind, 0.0)
     for a in range(nf):
         rho[a] = w0
+    run = -1  # the run's particle pi: its density is summed in ra, its position held in (xa, ya)
+    ra = xa = ya = 0.0
     for k in range(m):
-        a = pi[k]
-        b = pj[k]
-        rho[a] += mass * wk[k]
+        a = np.uint32(pi[k])
+        b = np.uint32(pj[k])
+        if a != run:
+            if run >= 0:
+                rho[run] = ra
+            run = a
+            ra, xa, ya = rho[a], x[a, 0], x[a, 1]
+        w, f = pair_kernel(xa, ya, x, b, h, kind, c)
+        wk[k] = w
+        fk[k] = f
+        ra += mass * w
         if b < nf:
-            rho[b] += mass * wk[k]
+            rho[b] += mass * w
+    if run >= 0:
+        rho[run] = ra
 
 
 @njit(**JIT)
@@ -119,34 +120,44 @@ def density_rate(x, v, rho, nf, pi, pj, m, fk, par, drho):
     hydrostatic part rho0 g (y_a - y_b) / c0^2 removed.  Uses the cached fk of the pairs."""
     mass, h, c0, rho0, g, delta = par[MASS], par[H], par[C0], par[RHO0], par[GRAV], par[DELTA]
     drho[:nf] = 0.0
+    run = -1  # the run's particle pi: its rate is summed in da, its state held in registers
+    da = xa = ya = vxa = vya = ra = 0.0
     for k in range(m):
         f = fk[k]
         if f == 0.0:
             continue
-        a = pi[k]
-        b = pj[k]
-        dx = x[a, 0] - x[b, 0]
-        dy = x[a, 1] - x[b, 1]
+        a = np.uint32(pi[k])
+        b = np.uint32(pj[k])
+        if a != run:
+            if run >= 0:
+                drho[run] = da
+            run = a
+            da = drho[a]
+            xa, ya, vxa, vya, ra = x[a, 0], x[a, 1], v[a, 0], v[a, 1], rho[a]
+        dx = xa - x[b, 0]
+        dy = ya - x[b, 1]
         if b >= nf:
-            drho[a] += mass * f * (v[a, 0] * dx + v[a, 1] * dy)
+            da += mass * f * (vxa * dx + vya * dy)
             continue
-        dd = mass * f * ((v[a, 0] - v[b, 0]) * dx + (v[a, 1] - v[b, 1]) * dy)
-        drho[a] += dd
+        dd = mass * f * ((vxa - v[b, 0]) * dx + (vya - v[b, 1]) * dy)
+        da += dd
         drho[b] += dd
         if delta > 0.0:
-            d = (rho[b] - rho[a]) - rho0 * g * dy / (c0 * c0)
+            d = (rho[b] - ra) - rho0 * g * dy / (c0 * c0)
             t = -2.0 * delta * h * c0 * mass * d * f
-            drho[a] += t / rho[b]
-            drho[b] -= t / rho[a]
+            da += t / rho[b]
+            drho[b] -= t / ra
+    if run >= 0:
+        drho[run] = da
 
 
 @njit(**JIT)
-def forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum):
+def forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum, p_rho2):
     """Pressures (liquid: equation of state; walls: Adami et al. 2012 eq. 27) and accelerations.
 
     rho[:nf] is read; rho[nf:] and p are overwritten.  acc (nf, 2) cm/s^2
     includes gravity; wall_force (nw, 2) N: force of each wall particle on the
-    liquid; wsum (nw, 3) scratch.  Every pair force is applied with opposite
+    liquid; wsum (nw, 3) and p_rho2 (n,) (P / rho^2 per particle) scratch.  Every pair force is applied with opposite
     signs to both particles (eq. 9 in its symmetric form).
     """
     mass, rho0, c0, gamma = par[MASS], par[RHO0], par[C0], par[GAMMA]
@@ -157,9 +168,9 @@ def forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum):
     # walls at rest: p_w = (sum_f p_f W_wf + g . sum_f rho_f r_wf W_wf) / sum_f W_wf
     wsum[:] = 0.0
     for k in range(m):
-        b = pj[k]
+        b = np.uint32(pj[k])
         if b >= nf and wk[k] > 0.0:
-            a = pi[k]
+            a = np.uint32(pi[k])
             q = b - nf
             wsum[q, 0] += wk[k]
             wsum[q, 1] += p[a] * wk[k]
@@ -172,6 +183,8 @@ def forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum):
             pw = 0.0
         p[nf + q] = pw
         rho[nf + q] = density_of(pw, rho0, c0, gamma, tait)
+    for a in range(p.shape[0]):
+        p_rho2[a] = p[a] / (rho[a] * rho[a])
     alpha = par[ALPHA]
     wall_visc = par[WALL_VISC] > 0
     eps2 = 0.01 * h * h
@@ -179,24 +192,32 @@ def forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum):
         acc[a, 0] = 0.0
         acc[a, 1] = -g
     wall_force[:] = 0.0
+    run = -1  # the run's particle pi: its acceleration is summed in (sx, sy), its state held in registers
+    sx = sy = xa = ya = vxa = vya = ra = pa = 0.0
     for k in range(m):
         f = fk[k]
         if f == 0.0:
             continue
-        a = pi[k]
-        b = pj[k]
-        dx = x[a, 0] - x[b, 0]
-        dy = x[a, 1] - x[b, 1]
+        a = np.uint32(pi[k])
+        b = np.uint32(pj[k])
+        if a != run:
+            if run >= 0:
+                acc[run, 0] = sx
+                acc[run, 1] = sy
+            run = a
+            sx, sy = acc[a, 0], acc[a, 1]
+            xa, ya, vxa, vya, ra, pa = x[a, 0], x[a, 1], v[a, 0], v[a, 1], rho[a], p_rho2[a]
+        dx = xa - x[b, 0]
+        dy = ya - x[b, 1]
         wall = b >= nf
         if wall:
-            dvx = v[a, 0]
-            dvy = v[a, 1]
+            dvx = vxa
+            dvy = vya
         else:
-            dvx = v[a, 0] - v[b, 0]
-            dvy = v[a, 1] - v[b, 1]
-        ra = rho[a]
+            dvx = vxa - v[b, 0]
+            dvy = vya - v[b, 1]
         rb = rho[b]
-        s = p[a] / (ra * ra) + p[b] / (rb * rb)
+        s = pa + p_rho2[b]
         vr = dvx * dx + dvy * dy
         if vr < 0.0 and alpha > 0.0 and (wall_visc or not wall):
             mu = h * vr / (dx * dx + dy * dy + eps2)
@@ -204,60 +225,27 @@ def forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum):
         s *= mass * f
         ax = -s * dx
         ay = -s * dy
-        acc[a, 0] += ax
-        acc[a, 1] += ay
+        sx += ax
+        sy += ay
         if wall:
             wall_force[b - nf, 0] += mass * ax
             wall_force[b - nf, 1] += mass * ay
         else:
             acc[b, 0] -= ax
             acc[b, 1] -= ay
+    if run >= 0:
+        acc[run, 0] = sx
+        acc[run, 1] = sy
 
 
 @njit(**JIT)
 def evaluate(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum):
     """Kernels, densities (summed, eq. 6, or rho[:nf] as given) and forces of a state (see forces)."""
-    kernel_pass(x, pi, pj, m, par, wk, fk)
     if par[SUMMATION] > 0:
-        sum_density(rho, nf, pi, pj, m, wk, par)
-    forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum)
-
-
-@njit(**JIT)
-def wall_repulsion(x, nf, walls, panel0, npanel, par, acc, panel_force):
-    """Lennard-Jones wall repulsion (marko2017 eq. 7, Monaghan 1994: M = 12, N = 4) as a safety net.
-
-    A liquid particle closer than r0 = par[LJ_R0] to a wall segment gets
-    D ((r0/d)^12 - (r0/d)^4) / d [cm/s^2] along the wall's normal through it
-    (D = par[LJ_D], cm^2/s^2).  The force of the wall on the liquid is added to
-    panel_force[panel0[w] + k] (N) for the panel k of the wall's npanel[w] equal panels.
-    """
-    r0 = par[LJ_R0]
-    if r0 <= 0.0:
-        return
-    D = par[LJ_D]
-    mass = par[MASS]
-    for a in range(nf):
-        px = x[a, 0]
-        py = x[a, 1]
-        for w in range(walls.shape[0]):
-            ex = walls[w, 2] - walls[w, 0]
-            ey = walls[w, 3] - walls[w, 1]
-            L2 = ex * ex + ey * ey
-            t = ((px - walls[w, 0]) * ex + (py - walls[w, 1]) * ey) / L2
-            t = min(1.0, max(0.0, t))
-            dx = px - (walls[w, 0] + t * ex)
-            dy = py - (walls[w, 1] + t * ey)
-            d = np.sqrt(dx * dx + dy * dy)
-            if d >= r0 or d == 0.0:
-                continue
-            q4 = (r0 / d) ** 4
-            f = D * (q4 * q4 * q4 - q4) / (d * d)
-            acc[a, 0] += f * dx
-            acc[a, 1] += f * dy
-            k = panel0[w] + min(npanel[w] - 1, int(t * npanel[w]))
-            panel_force[k, 0] += mass * f * dx
-            panel_force[k, 1] += mass * f * dy
+        kernel_density_pass(x, rho, nf, pi, pj, m, par, wk, fk)
+    else:
+        kernel_pass(x, pi, pj, m, par, wk, fk)
+    forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum, np.empty(x.shape[0]))
 
 
 @njit(**JIT)
@@ -286,6 +274,7 @@ def advance(x, v, rho, p, nf, walls, box, grid_box, par, n_steps, xref, pi, pj, 
     rate0 = np.zeros(nf)
     rate1 = np.zeros(nf)
     rho_n = np.zeros(nf)
+    p_rho2 = np.empty(x.shape[0])
     diag[0] = 0.0
     diag[2] = 0.0
     diag[3] = -1.0
@@ -323,15 +312,15 @@ def advance(x, v, rho, p, nf, walls, box, grid_box, par, n_steps, xref, pi, pj, 
                 fk = np.empty(pi.shape[0])
             xref[:nf] = x[:nf]
             diag[2] += 1.0
-        kernel_pass(x, pi, pj, m, par, wk, fk)
         if summation:
-            sum_density(rho, nf, pi, pj, m, wk, par)
+            kernel_density_pass(x, rho, nf, pi, pj, m, par, wk, fk)
         else:
+            kernel_pass(x, pi, pj, m, par, wk, fk)
             density_rate(x, v, rho, nf, pi, pj, m, fk, par, rate1)
             for a in range(nf):
                 rho[a] = rho_n[a] + half * (rate0[a] + rate1[a])
-        forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum)
-        wall_repulsion(x, nf, walls, panel0, npanel, par, acc, panel_sum)
+        forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum, p_rho2)
+        wall_repulsion(x, nf, walls, panel0, npanel, par[LJ_D], par[LJ_R0], mass, acc, panel_sum)
         v2 = 0.0
         for a in range(nf):
             v[a, 0] += half * acc[a, 0]
