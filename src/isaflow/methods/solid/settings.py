@@ -43,7 +43,8 @@ SCHEMA = {
                           plane={"enum": ["strain"]}, paper_dt_ns={"type": "array", "items": POS},
                           dt_check_steps=COUNT),
         "vessel": _section(dx_mm=POS, ring_particles=COUNT, water_radius_particles=COUNT, pressure_Pa=POS,
-                           K_GPa=POS, rho_water_kg_m3=POS, steps=COUNT, dt_ns=POS),
+                           K_GPa=POS, rho_water_kg_m3=POS, steps=COUNT, dt_ns=POS,
+                           solid_model={"enum": ["paper", "hooke", "objective"]}, history_us=POS, record_every=COUNT),
     },
 }
 
