@@ -93,3 +93,74 @@ def bar_and_hertz(cfg, runs, outputs):
     """Both figures (workflow entry point): outputs are the bar's [png, pdf], then Hertz's."""
     bar_figure(cfg, runs, outputs[:2])
     hertz_figure(cfg, runs, outputs[2:])
+
+
+def vessel_figure(config_path, runs, outputs):
+    """Fig. 7 analogue: (a) the ring's inner-wall radial displacement against time (undamped, pressure
+    applied at t = 0), the settled value, Lame's and the paper's 58.7 us; (b) the settled ring."""
+    cfg = settings.load(config_path)
+    ds = next(d for (case, _), d in read_runs(runs).items() if case == "vessel")
+    v = variant_of("solid", ds.attrs["variant"])
+    t, u = ds["time"].values * 1e6, ds["u_inner_t"].values * 1e4
+    h = {k: float(ds[k].values.ravel()[0]) for k in ("u_inner_settled", "u_lame_inner", "t_paper", "u_paper_end")}
+    fig, (a, b) = plt.subplots(1, 2, figsize=(10, 4.2), gridspec_kw={"width_ratios": [1.6, 1]})
+    a.plot(t, u, color=v.colour, lw=1.2, label="inner particles, undamped (mean)")
+    a.plot(t, ds["u_outer_t"].values * 1e4, color=v.colour, lw=0.8, ls=":", label="outermost layer, undamped (mean)")
+    a.axhline(h["u_inner_settled"] * 1e4, color=v.colour, ls="--", lw=1, label="settled (kinetic damping)")
+    a.axhline(h["u_lame_inner"] * 1e4, color=THEORY, lw=1.4, label="Lame thick cylinder (plane strain)")
+    a.axvline(h["t_paper"] * 1e6, color=PAPER, ls="-.", lw=1.2,
+              label=f"paper's run: {cfg['vessel']['steps']} x {cfg['vessel']['dt_ns']:g} ns = {h['t_paper'] * 1e6:.1f} us")
+    a.plot([h["t_paper"] * 1e6], [h["u_paper_end"] * 1e4], "o", color=PAPER, ms=5)
+    a.set(xlabel="time since the pressure was applied [us]", ylabel="radial displacement [um]",
+          title="(a) ring radial displacement against time", xlim=(0, t.max()))
+    a.set_ylim(min(0.0, u.min() * 1.1), u.max() * 1.35)
+    a.legend(fontsize=7, loc="upper right", ncol=2)
+    p0, p = ds["pos0"].values, ds["pos"].values
+    r = np.hypot(p0[:, 0], p0[:, 1])
+    ur = ((p - p0) * p0 / r[:, None]).sum(1) * 1e4
+    sc = b.scatter(p0[:, 0], p0[:, 1], c=ur, s=9, marker="s", cmap="viridis")
+    fig.colorbar(sc, ax=b, label="settled radial displacement [um]", shrink=0.85)
+    b.set_aspect("equal")
+    b.set(xlabel="x [cm]", ylabel="y [cm]", title="(b) settled ring (square lattice)")
+    fig.suptitle(v.label, fontsize=8)
+    fig.tight_layout()
+    save(fig, outputs)
+
+
+def floor_figure(config_path, runs, outputs):
+    """Elastic floor: (a) deflection of the plate's middle row per load source against beam theory,
+    (b) the nodal loads as load per length."""
+    cfg = settings.load(config_path)
+    dx = cfg["floor"]["dx_cm"]
+    fig, (a, b) = plt.subplots(1, 2, figsize=(10, 4.0))
+    first = True
+    for (case, var), ds in sorted(read_runs(runs).items()):
+        if not case.startswith("floor_"):
+            continue
+        x = ds["x_mid"].values
+        if first:
+            a.plot(x, ds["w_theory_uniform"].values * 10, color=THEORY, lw=1.6,
+                   label="Euler-Bernoulli, uniform W / span")
+            first = False
+        if var == "oneway":
+            src = variant_of(ds.attrs["load_method"], ds.attrs["load_variant"])
+            colour, name = src.colour, f"{ds.attrs['load_method']} {ds.attrs['load_variant']}"
+        else:
+            colour, name = variant_of("solid", var).colour, "uniform W / span"
+        a.plot(x[::4], ds["w_mid"].values[::4] * 10, "o", ms=3, color=colour, label=f"plate, loads: {name}")
+        a.plot(x, ds["w_theory_actual"].values * 10, ls="--", lw=0.9, color=colour,
+               label=f"beam theory, loads: {name}")
+        b.step(x, ds["nodal_load"].values / dx, where="mid", color=colour, lw=1, label=name)
+    a.invert_yaxis()
+    a.set(xlabel="x [cm]", ylabel="deflection (down) [mm]", title="(a) plate deflection, middle row")
+    b.set(xlabel="x [cm]", ylabel="load per length [N/cm per cm thickness]", title="(b) applied floor load")
+    a.legend(fontsize=6, loc="lower center")
+    b.legend(fontsize=6, loc="lower center")
+    fig.tight_layout()
+    save(fig, outputs)
+
+
+def vessel_and_floor(cfg, runs, outputs):
+    """Both figures (workflow entry point): outputs are the vessel's [png, pdf], then the floor's."""
+    vessel_figure(cfg, runs, outputs[:2])
+    floor_figure(cfg, runs, outputs[2:])

@@ -30,7 +30,7 @@ def _section(**fields):
 
 SCHEMA = {
     "type": "object", "additionalProperties": False,
-    "required": ["material", "solver", "bar", "shear", "hertz", "vessel"],
+    "required": ["material", "solver", "bar", "shear", "hertz", "vessel", "floor"],
     "properties": {
         "material": _section(E_GPa=POS, nu={"type": "number", "minimum": 0, "exclusiveMaximum": 0.5}, rho_kg_m3=POS),
         "solver": _section(tol=POS, max_steps=COUNT, max_steps_mechanism=COUNT),
@@ -45,6 +45,8 @@ SCHEMA = {
         "vessel": _section(dx_mm=POS, ring_particles=COUNT, water_radius_particles=COUNT, pressure_Pa=POS,
                            K_GPa=POS, rho_water_kg_m3=POS, steps=COUNT, dt_ns=POS,
                            solid_model={"enum": ["paper", "hooke", "objective"]}, history_us=POS, record_every=COUNT),
+        "floor": _section(span_cm=POS, dx_cm=POS, layers=COUNT, supports={"enum": ["simply_supported"]},
+                          solid_model={"enum": ["paper", "hooke", "objective"]}, weight_N=POS, max_steps=COUNT),
     },
 }
 
