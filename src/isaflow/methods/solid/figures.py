@@ -129,9 +129,7 @@ def vessel_figure(config_path, runs, outputs):
 
 def floor_figure(config_path, runs, outputs):
     """Elastic floor: (a) deflection of the plate's middle row per load source against beam theory,
-    (b) the nodal loads as load per length."""
-    cfg = settings.load(config_path)
-    dx = cfg["floor"]["dx_cm"]
+    (b) the nodal loads, summed from x = 0."""
     fig, (a, b) = plt.subplots(1, 2, figsize=(10, 4.0))
     first = True
     for (case, var), ds in sorted(read_runs(runs).items()):
@@ -139,7 +137,7 @@ def floor_figure(config_path, runs, outputs):
             continue
         x = ds["x_mid"].values
         if first:
-            a.plot(x, ds["w_theory_uniform"].values * 10, color=THEORY, lw=1.6,
+            a.plot(x, ds["w_theory_uniform"].values * 10, color="k", lw=1.6,
                    label="Euler-Bernoulli, uniform W / span")
             first = False
         if var == "oneway":
@@ -150,12 +148,13 @@ def floor_figure(config_path, runs, outputs):
         a.plot(x[::4], ds["w_mid"].values[::4] * 10, "o", ms=3, color=colour, label=f"plate, loads: {name}")
         a.plot(x, ds["w_theory_actual"].values * 10, ls="--", lw=0.9, color=colour,
                label=f"beam theory, loads: {name}")
-        b.step(x, ds["nodal_load"].values / dx, where="mid", color=colour, lw=1, label=name)
+        b.plot(x, np.cumsum(ds["nodal_load"].values), color=colour, lw=1.2, label=name)
     a.invert_yaxis()
     a.set(xlabel="x [cm]", ylabel="deflection (down) [mm]", title="(a) plate deflection, middle row")
-    b.set(xlabel="x [cm]", ylabel="load per length [N/cm per cm thickness]", title="(b) applied floor load")
-    a.legend(fontsize=6, loc="lower center")
-    b.legend(fontsize=6, loc="lower center")
+    b.set(xlabel="x [cm]", ylabel="floor load from x = 0 to x [N per cm thickness]",
+          title="(b) applied floor load, cumulative")
+    a.legend(fontsize=6, loc="upper center")
+    b.legend(fontsize=6, loc="upper left")
     fig.tight_layout()
     save(fig, outputs)
 
