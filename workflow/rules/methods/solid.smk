@@ -22,11 +22,12 @@ SOLID_FLOOR_LOADS = {
                                           else f"dx{_SOLID_SPH1['spacing']:g}") + ".nc",
     "mps": f"results/mps/single_standard_dx{_SOLID_MPS1:.3g}.nc",
 }
-SOLID_VESSEL_RUNS = ["results/solid/vessel_pressure_load.nc"]
+SOLID_VESSEL_RUNS = ["results/solid/vessel_pressure_load.nc", "results/solid/vessel_water_particles.nc"]
 SOLID_FLOOR_RUNS = ["results/solid/floor_uniform_uniform_load.nc"] + [
     f"results/solid/floor_{src}_oneway.nc" for src in SOLID_FLOOR_LOADS]
 SOLID_NEW_RUNS = SOLID_VESSEL_RUNS + SOLID_FLOOR_RUNS
-SOLID_NEW_CODE = SOLID_CODE + code("methods/solid/vessel", "methods/solid/floor", "methods/solid/theory")
+SOLID_NEW_CODE = SOLID_CODE + code("methods/solid/vessel", "methods/solid/water", "methods/solid/floor",
+                                    "methods/solid/theory", "core/smoothing", "core/neighbours")
 SOLID_FIGURES += figure("solid_vessel") + figure("solid_floor")
 SOLID_REPORT_FIGURES_44 = [f for name in ("solid_vessel", "solid_floor")
                            for f in report_figure(name, "solid_figure", "Methods compared")]
@@ -59,7 +60,7 @@ rule solid_vessel:
     output:
         "results/solid/vessel_{variant}.nc",
     wildcard_constraints:
-        variant="pressure_load",
+        variant="pressure_load|water_particles",
     params:
         func="methods.solid.outputs.run_case",
         kw=lambda wc: dict(case="vessel", variant=wc.variant),

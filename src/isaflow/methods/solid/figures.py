@@ -96,33 +96,53 @@ def bar_and_hertz(cfg, runs, outputs):
 
 
 def vessel_figure(config_path, runs, outputs):
-    """Fig. 7 analogue: (a) the ring's inner-wall radial displacement against time (undamped, pressure
-    applied at t = 0), the settled value, Lame's and the paper's 58.7 us; (b) the settled ring."""
+    """Fig. 7 analogue: (a) the ring's inner-wall radial displacement against time (undamped, from rest)
+    per variant, the settled value, Lame's and the paper's 58.7 us; (b) the SPH water's mean pressure
+    (variant water_particles); (c) the settled ring (pressure_load)."""
     cfg = settings.load(config_path)
-    ds = next(d for (case, _), d in read_runs(runs).items() if case == "vessel")
-    v = variant_of("solid", ds.attrs["variant"])
-    t, u = ds["time"].values * 1e6, ds["u_inner_t"].values * 1e4
-    h = {k: float(ds[k].values.ravel()[0]) for k in ("u_inner_settled", "u_lame_inner", "t_paper", "u_paper_end")}
-    fig, (a, b) = plt.subplots(1, 2, figsize=(10, 4.2), gridspec_kw={"width_ratios": [1.6, 1]})
-    a.plot(t, u, color=v.colour, lw=1.2, label="inner particles, undamped (mean)")
-    a.plot(t, ds["u_outer_t"].values * 1e4, color=v.colour, lw=0.8, ls=":", label="outermost layer, undamped (mean)")
-    a.axhline(h["u_inner_settled"] * 1e4, color=v.colour, ls="--", lw=1, label="settled (kinetic damping)")
-    a.axhline(h["u_lame_inner"] * 1e4, color=THEORY, lw=1.4, label="Lame thick cylinder (plane strain)")
-    a.axvline(h["t_paper"] * 1e6, color=PAPER, ls="-.", lw=1.2,
-              label=f"paper's run: {cfg['vessel']['steps']} x {cfg['vessel']['dt_ns']:g} ns = {h['t_paper'] * 1e6:.1f} us")
-    a.plot([h["t_paper"] * 1e6], [h["u_paper_end"] * 1e4], "o", color=PAPER, ms=5)
-    a.set(xlabel="time since the pressure was applied [us]", ylabel="radial displacement [um]",
-          title="(a) ring radial displacement against time", xlim=(0, t.max()))
-    a.set_ylim(min(0.0, u.min() * 1.1), u.max() * 1.35)
-    a.legend(fontsize=7, loc="upper right", ncol=2)
+    vs = {var: d for (case, var), d in read_runs(runs).items() if case == "vessel"}
+    fig, (a, b, c) = plt.subplots(1, 3, figsize=(13, 4.4), gridspec_kw={"width_ratios": [1.6, 1.1, 1]})
+    one = lambda ds, k: float(ds[k].values.ravel()[0])  # noqa: E731
+    ds0 = next(iter(vs.values()))
+    t_paper = one(ds0, "t_paper") * 1e6
+    for var, ds in sorted(vs.items()):
+        v = variant_of("solid", var)
+        t, u = ds["time"].values * 1e6, ds["u_inner_t"].values * 1e4
+        a.plot(t, u, color=v.colour, lw=1.1, label=f"{var}: inner particles (mean)")
+        a.plot([t_paper], [one(ds, "u_paper_end") * 1e4], "o", color=v.colour, ms=5)
+        if var == "pressure_load":
+            a.axhline(one(ds, "u_inner_settled") * 1e4, color=v.colour, ls="--", lw=1,
+                      label=f"{var}: settled (kinetic damping)")
+        else:
+            a.axhline(one(ds, "u_inner_mean_cycles") * 1e4, color=v.colour, ls="--", lw=1,
+                      label=f"{var}: mean over whole cycles")
+            a.axhline(one(ds, "u_lame_compressible") * 1e4, color="0.45", ls=":", lw=1.4,
+                      label="Lame at the pressure the water keeps")
+            b.plot(t, ds["p_water_t"].values / 1e-4 / 1e3, color=v.colour, lw=1.1, label="mean water pressure")
+            b.axhline(one(ds, "p_equilibrium") / 1e-4 / 1e3, color="0.45", ls=":", lw=1.4,
+                      label="p0 / (1 + 2 K u_L / (a p0))")
+            b.axhline(cfg["vessel"]["pressure_Pa"] / 1e3, color=THEORY, lw=1.2, label="p0 (paper: 101,135 Pa)")
+    a.axhline(one(ds0, "u_lame_inner") * 1e4, color=THEORY, lw=1.4, label="Lame thick cylinder at p0")
+    for ax in (a, b):
+        ax.axvline(t_paper, color=PAPER, ls="-.", lw=1.2, label=f"paper's run: {cfg['vessel']['steps']} x "
+                   f"{cfg['vessel']['dt_ns']:g} ns = {t_paper:.1f} us")
+        ax.set_xlim(0, float(ds0["time"].values.max() * 1e6))
+        ax.set_xlabel("time since the start from rest [us]")
+    a.set(ylabel="radial displacement [um]", title="(a) ring inner wall against time")
+    a.set_ylim(0.0 if a.get_ylim()[0] > -0.1 else None, a.get_ylim()[1] * 1.45)
+    a.legend(fontsize=6, loc="upper right", ncol=2)
+    b.set(ylabel="pressure [kPa]", title="(b) SPH water pressure (water_particles)")
+    lo, hi = b.get_ylim()
+    b.set_ylim(lo - 0.75 * (hi - lo), hi)
+    b.legend(fontsize=6, loc="lower right")
+    ds = vs.get("pressure_load", ds0)
     p0, p = ds["pos0"].values, ds["pos"].values
     r = np.hypot(p0[:, 0], p0[:, 1])
     ur = ((p - p0) * p0 / r[:, None]).sum(1) * 1e4
-    sc = b.scatter(p0[:, 0], p0[:, 1], c=ur, s=9, marker="s", cmap="viridis")
-    fig.colorbar(sc, ax=b, label="settled radial displacement [um]", shrink=0.85)
-    b.set_aspect("equal")
-    b.set(xlabel="x [cm]", ylabel="y [cm]", title="(b) settled ring (square lattice)")
-    fig.suptitle(v.label, fontsize=8)
+    sc = c.scatter(p0[:, 0], p0[:, 1], c=ur, s=7, marker="s", cmap="viridis")
+    fig.colorbar(sc, ax=c, label="radial displacement [um]", shrink=0.8)
+    c.set_aspect("equal")
+    c.set(xlabel="x [cm]", ylabel="y [cm]", title=f"(c) settled ring ({ds.attrs['variant']})")
     fig.tight_layout()
     save(fig, outputs)
 

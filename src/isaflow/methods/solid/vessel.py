@@ -109,8 +109,12 @@ def history(cfg, dt):
 def run_vessel(cfg, variant):
     """The 'pressure_load' vessel: settled state (kinetic damping) and the undamped time history at the
     paper's step; the Lame field at the inner particles' radii; the times that say whether 58.7 us settles."""
+    if variant == "water_particles":
+        from .water import run_water_vessel
+
+        return run_water_vessel(cfg)
     if variant != "pressure_load":
-        raise KeyError(f"vessel variant '{variant}' is not implemented (choose from pressure_load)")
+        raise KeyError(f"vessel variant '{variant}' is not implemented (choose from pressure_load, water_particles)")
     from .cases import _result
 
     v = cfg["vessel"]
