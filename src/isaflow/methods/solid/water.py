@@ -11,6 +11,8 @@ equation, so as the ring expands the water's density and pressure drop (by K dA 
 artificial viscosity alpha (settings).  Units cm, N, s.
 """
 
+import time
+
 import numpy as np
 from numba import njit
 
@@ -107,6 +109,7 @@ def coupled_history(cfg, dt, steps, every):
     vw, rho = np.zeros_like(xw), np.full(nw, rho0)
     fw, fs, drho = np.zeros((nw, 2)), np.zeros((st.block.n, 2)), np.zeros(nw)
     t, ui, pw = [0.0], [0.0], [p0]
+    t0 = time.perf_counter()
     for step in range(1, steps + 1):
         pos = np.vstack([xw, st.pos[:, :2]])
         vel = np.vstack([vw, st.vel[:, :2]])
@@ -120,6 +123,7 @@ def coupled_history(cfg, dt, steps, every):
             t.append(step * dt)
             ui.append(radial(st, inner).mean())
             pw.append(float(np.mean(p0 + K * (rho / rho0 - 1.0))))
+    st.wall_time = time.perf_counter() - t0  # the coupled loop: water and ring
     return np.array(t), np.array(ui), np.array(pw), st, inner, rho
 
 
