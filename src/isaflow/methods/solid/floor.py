@@ -91,7 +91,14 @@ def run_floor(cfg, variant, loads=None, case=None):
             raise ValueError(f"{loads}: floor length {length:g} cm, the plate spans {span:g} cm")
         P = nodal(x, fy, dx, nx)
         W = float(ds["weight"].values.sum())
-        src = {"load_source": str(loads), "load_method": ds.attrs.get("method", ""),
+        try:  # the liquid's depth above the floor, for deflection / depth (one-way coupling's premise)
+            from isaflow.metrics import level_of
+
+            depth = float(level_of(ds)) - float(ds["wall_segment"].values[[str(w) for w in ds["wall"].values].index(
+                "floor"), 1])
+        except (KeyError, ValueError):
+            depth = float("nan")
+        src = {"depth_cm": depth, "load_source": str(loads), "load_method": ds.attrs.get("method", ""),
                "load_variant": ds.attrs.get("variant", ""), "load_wall_time_s": float(ds["wall_time"])}
     else:
         raise KeyError(f"floor variant '{variant}' is not implemented (choose from uniform_load, oneway)")
