@@ -2,6 +2,7 @@
 
 
 import numpy as np
+from matplotlib.colors import to_hex
 
 from isaflow import runfile
 from isaflow.figures.style import PAPER, THEORY, plt, save
@@ -150,8 +151,8 @@ def vessel_figure(config_path, runs, outputs):
 def floor_figure(config_path, runs, outputs):
     """Elastic floor: (a) deflection of the plate's middle row per load source against beam theory,
     (b) the nodal loads, summed from x = 0."""
-    fig, (a, b) = plt.subplots(1, 2, figsize=(10, 4.0))
-    first = True
+    fig, (a, b) = plt.subplots(1, 2, figsize=(10, 4.4))
+    first, used = True, set()
     for (case, var), ds in sorted(read_runs(runs).items()):
         if not case.startswith("floor_"):
             continue
@@ -162,10 +163,15 @@ def floor_figure(config_path, runs, outputs):
             first = False
         if var == "oneway":
             src = variant_of(ds.attrs["load_method"], ds.attrs["load_variant"])
-            colour, name = src.colour, f"{ds.attrs['load_method']} {ds.attrs['load_variant']}"
+            colour, marker, name = src.colour, src.marker, f"{ds.attrs['load_method']} {ds.attrs['load_variant']}"
         else:
-            colour, name = variant_of("solid", var).colour, "uniform W / span"
-        a.plot(x[::4], ds["w_mid"].values[::4] * 10, "o", ms=3, color=colour, label=f"plate, loads: {name}")
+            v = variant_of("solid", var)
+            colour, marker, name = v.colour, v.marker, "uniform W / span"
+        if to_hex(colour) in used:  # two methods' registry colours coincide (isa paper, mps standard): next free
+            colour = next(c for c in (to_hex(f"C{i}") for i in range(10)) if c not in used)
+        used.add(to_hex(colour))
+        a.plot(x[::4], ds["w_mid"].values[::4] * 10, marker, ms=3.5, ls="none", color=colour,
+               label=f"plate, loads: {name}")
         a.plot(x, ds["w_theory_actual"].values * 10, ls="--", lw=0.9, color=colour,
                label=f"beam theory, loads: {name}")
         b.plot(x, np.cumsum(ds["nodal_load"].values), color=colour, lw=1.2, label=name)
