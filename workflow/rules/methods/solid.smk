@@ -107,7 +107,8 @@ rule solid_figures_44:
     input:
         cfg=SOLID_CFG,
         runs=SOLID_NEW_RUNS,
-        code=code("methods/solid/figures", "methods/solid/theory", "figures/style"),
+        code=code("methods/solid/figures", "methods/solid/theory", "figures/style", "methods/__init__",
+                  "methods/solid/__init__"),
     output:
         SOLID_REPORT_FIGURES_44,
     params:
