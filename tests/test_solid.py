@@ -166,10 +166,215 @@ def test_claims_table(tmp_path):
     for case in ["bar_tension", "bar_compression", "shear", "hertz", "hertz_dt15ns", "hertz_dt56ns"]:
         for v in ["paper", "hooke"]:
             outputs.write_run(CFG_PATH, case, v, tmp_path / f"{case}_{v}.nc")
-    out = claims.write_claims(CFG_PATH, sorted(tmp_path.glob("*.nc")), tmp_path / "claims.csv")
+    # 4.4 and the elastic floor on a cheaper copy of the settings: a 40 cm plate, a 900 us history
+    cfg = tmp_path / "solid.yaml"
+    cfg.write_text(CFG_PATH.read_text().replace("span_cm: {value: 100.0", "span_cm: {value: 40.0")
+                   .replace("history_us: {value: 2000.0", "history_us: {value: 900.0"))
+    outputs.write_run(cfg, "vessel", "pressure_load", tmp_path / "vessel_pressure_load.nc")
+    outputs.write_run(cfg, "vessel", "water_particles", tmp_path / "vessel_water_particles.nc")
+    outputs.write_run(cfg, "floor_uniform", "uniform_load", tmp_path / "floor_uniform_uniform_load.nc")
+    rigid = rigid_floor_run(tmp_path / "rigid" / "single.nc", span=40.0, panels=4, weight=3600.0) \
+        if (tmp_path / "rigid").mkdir() is None else None
+    outputs.write_run(cfg, "floor_sph", "oneway", tmp_path / "floor_sph_oneway.nc", loads=rigid)
+    out = claims.write_claims(cfg, sorted(tmp_path.glob("*.nc")), tmp_path / "claims.csv")
     rows = list(csv.DictReader(open(out)))
+    s44 = [r for r in rows if r["section"] == "4.4"]
+    assert len(s44) == 3 and all(not r["verdict"].startswith("not testable") for r in s44)
+    assert "58.7 us" in s44[0]["measured"] and "Lame" in s44[1]["measured"]
+    fl = [r for r in rows if r["section"] == "floor"]
+    assert len(fl) == 1 and "sph:" in fl[0]["measured"]
+    report = claims.write_report(out, sorted(tmp_path.glob("*.nc")), tmp_path / "65_solid.md")
+    text = Path(report).read_text()
+    assert "solid_vessel.png" in text and "solid_floor.png" in text and "| vessel | water_particles |" in text
     assert list(rows[0]) == claims.COLUMNS
     ok = ("reproduced", "not reproduced")
     assert all(r["verdict"] in ok or r["verdict"].startswith(("not testable here (", "reproduced only after"))
                for r in rows)
     assert len(rows) >= 15
+
+
+# ---- section 4.4 pressure vessel (variant pressure_load) and the elastic floor ----
+
+from isaflow.methods.solid import floor as F  # noqa: E402
+from isaflow.methods.solid import vessel as V  # noqa: E402
+
+
+def test_vessel_ring_is_symmetric_and_loaded_by_p_times_perimeter():
+    # the wetted faces' loads cancel (the ring keeps the lattice's symmetry) and each quadrant's load
+    # is p times the projected inner diameter, 2 a p per half ring (the staircase projects exactly)
+    v = CFG["vessel"]
+    st, inner = V.pressure_state(CFG)
+    dx, a, b = V.geometry(v)
+    assert np.abs(st.fext.sum(0)).max() < 1e-9 * np.abs(st.fext).max()
+    up = st.fext[st.block.ref[:, 1] > 0, 1].sum()
+    # lattice sites with r < a along a row: 2 floor(sqrt(a^2 - y^2)) + 1 per row; the load on the upper half is
+    # p dx x (count of wetted top faces) = p x (projected width of the water in the upper half)
+    assert up == pytest.approx(v["pressure_Pa"] * 1e-4 * 2 * a, rel=dx / a)
+    area = st.block.n * dx**2 / (np.pi * (b**2 - a**2))
+    assert area == pytest.approx(1.0, abs=0.02)  # Gauss circle: count error ~ perimeter / dx points, < 2 %
+
+
+@pytest.fixture(scope="module")
+def vessel_settled():
+    st, inner, status, msg, resid = V.settle(CFG)
+    return st, inner, status
+
+
+@pytest.mark.xfail(strict=True, reason="measured +14.2 % (settled 1.173 um against Lame 1.026 um at the inner "
+                                       "particles' radii): a first-order surface-layer error of the 5-particle "
+                                       "lattice ring, +6.6 % at dx / 2, +2.8 % at dx / 4")
+def test_vessel_pressure_load_settles_to_lame(vessel_settled):
+    """Settled inner-wall displacement against Lame at the inner particles' own radii, tolerance 5 %.
+
+    Derived before the run: (1) the ring's particle count differs from the annulus area by the Gauss-circle
+    error, ~ (perimeter / dx) / N ~ 1.5 %, which changes the wall's effective thickness and u by about as much;
+    (2) the staircase surfaces perturb the stresses over one particle layer of five, a second-order effect in
+    the mean, (dx / (b - a))^2 = 4 %; sum about 5 %.  The solid model is 'objective' (G gamma in every lattice
+    orientation; the 'hooke' shear springs give G gamma / 2 at 45 deg and +59 % here)."""
+    st, inner, status = vessel_settled
+    assert status == "converged"
+    r = np.hypot(*st.block.ref[inner, :2].T)
+    assert V.radial(st, inner).mean() == pytest.approx(V.lame(CFG, r).mean(), rel=0.05)
+
+
+def test_vessel_pushed_outwards_and_error_shrinks_with_dx(vessel_settled):
+    # the paper's observation (all steel particles pushed outwards), and the Lame error falls under
+    # refinement: at dx / 2 (ring 10 particles thick) below 0.6 of the error at dx (first order: 0.5;
+    # the 0.6 was set after measuring 14.2 % -> 6.6 %)
+    st, inner, _ = vessel_settled
+    assert (V.radial(st, np.ones(st.block.n, bool)) > 0).all()
+    v = CFG["vessel"]
+    err = V.radial(st, inner).mean() / V.lame(CFG, np.hypot(*st.block.ref[inner, :2].T)).mean() - 1
+    fine = {**CFG, "vessel": {**v, "dx_mm": v["dx_mm"] / 2, "ring_particles": 2 * v["ring_particles"],
+                              "water_radius_particles": 2 * v["water_radius_particles"]}}
+    stf, innf, status, *_ = V.settle(fine)
+    err_f = V.radial(stf, innf).mean() / V.lame(fine, np.hypot(*stf.block.ref[innf, :2].T)).mean() - 1
+    assert status == "converged" and 0 < err_f < 0.6 * err
+
+
+def test_vessel_time_step_rule():
+    # eq. 26: dt <= dx / (4 c) for the history run; the paper's 146.8 ns is below it (1.135 us for 23.4 mm steel)
+    st, _ = V.pressure_state(CFG)
+    assert CFG["vessel"]["dt_ns"] * 1e-9 < st.dt_max
+    assert st.dt_max == pytest.approx(2.34 / (4 * np.sqrt(207e9 / 7800) * 100), rel=1e-9)
+    with pytest.raises(ValueError, match="above the step rule"):
+        V.history(CFG, 1.01 * st.dt_max)
+
+
+def test_vessel_undamped_history_starts_at_rest_and_overshoots():
+    # sudden pressure on an undamped elastic ring: u(t) rises from 0 and overshoots its static value
+    # (a suddenly applied load peaks at twice the static response); short history to stay fast
+    cfg = {**CFG, "vessel": {**CFG["vessel"], "history_us": 400.0}}
+    t, ui, uo, st = V.history(cfg, CFG["vessel"]["dt_ns"] * 1e-9)
+    assert ui[0] == 0.0 and ui[1] > 0.0
+    assert ui.max() > 1.5 * V.lame(CFG, V.geometry(CFG["vessel"])[1])
+
+
+def test_nodal_loads_keep_force_and_moment():
+    rng = np.random.default_rng(3)
+    x, f = rng.uniform(0, 100, 50), rng.uniform(-10, 0, 50)
+    P = F.nodal(x, f, 1.0, 101)
+    assert P.sum() == pytest.approx(f.sum(), rel=1e-12)
+    assert (P * np.arange(101)).sum() == pytest.approx((f * x).sum(), rel=1e-12)
+
+
+@pytest.fixture(scope="module")
+def floor_uniform():
+    return F.run_floor(CFG, "uniform_load")
+
+
+@pytest.mark.xfail(strict=True, reason="measured -16.7 %: the 5-layer lattice plate is stiffer than beam theory "
+                                       "(0.408 mm against 0.490 mm at mid-span), -4.8 % with 10 layers of 0.5 cm "
+                                       "(second order in dx); in pure bending the lattice is +6.7 % stiff at 5 "
+                                       "layers, +2.3 % at 9, +0.7 % at 17")
+def test_floor_uniform_load_beam_theory(floor_uniform):
+    """Mid-span deflection of the 5 x 1 cm steel plate under W / span against Euler-Bernoulli (plane strain)
+    under the same nodal loads, tolerance 5 %.
+
+    Derived before the run: the lattice's second moment sum(y_i^2) dx = 10 dx^4 against t^3 / 12 = 10.4 dx^4
+    (-4 % stiffness), Timoshenko shear deflection 0.8 (E / kappa G) (t / L)^2 = +0.6 %, support and load
+    transfer over one particle of 100 (~1 %): about 5 %."""
+    r = floor_uniform
+    assert r.status == "converged"
+    assert r.history["load_total"][1][0] == pytest.approx(CFG["floor"]["weight_N"], rel=1e-12)
+    assert r.history["w_centre"][1][0] == pytest.approx(r.history["w_centre_actual"][1][0], rel=0.05)
+
+
+def test_floor_deflection_in_the_asked_range(floor_uniform):
+    # the settings aim at 0.1-1 % of the span under W / span (issue 13); check the plate itself
+    w = floor_uniform.history["w_centre"][1][0] / CFG["floor"]["span_cm"]
+    assert 1e-3 < w < 1e-2
+
+
+def rigid_floor_run(path, span=100.0, panels=10, weight=9000.0, method="sph", variant="wcsph"):
+    """A synthetic rigid-floor run file: hydrostatic floor contacts (W / panels at each panel centre),
+    the tank's three walls, the liquid's weight; what floor.floor_contacts reads."""
+    import xarray as xr
+
+    x = (np.arange(panels) + 0.5) * span / panels
+    ds = xr.Dataset(
+        {"wall_segment": (("wall", "end"), [[0, span, 0, 0], [0, 0, span, 0], [span, 0, span, span]]),
+         "contact_wall": (("contact",), np.ones(panels, np.int32)),
+         "contact_point": (("contact", "xy"), np.column_stack([x, np.zeros(panels)])),
+         "contact_force": (("contact", "xy"), np.column_stack([np.zeros(panels), np.full(panels, weight / panels)])),
+         "weight": (("particle",), np.full(180, weight / 180)), "wall_time": ((), 1.5)},
+        coords={"wall": ["left", "floor", "right"], "xy": ["x", "y"]},
+        attrs={"method": method, "variant": variant})
+    ds.to_netcdf(path, engine="netcdf4")
+    return path
+
+
+def test_floor_oneway_reads_the_floor_contacts(tmp_path):
+    # a short plate (span 40 cm) so the test settles in a second; loads: the synthetic hydrostatic contacts
+    cfg = {**CFG, "floor": {**CFG["floor"], "span_cm": 40.0}}
+    run = rigid_floor_run(tmp_path / "rigid.nc", span=40.0, panels=4, weight=3600.0)
+    r = F.run_floor(cfg, "oneway", loads=run, case="floor_sph")
+    assert r.status == "converged" and r.variant == "oneway" and r.params["load_method"] == "sph"
+    assert r.history["load_total"][1][0] == pytest.approx(3600.0, rel=1e-12)
+    assert r.history["nodal_load"][1].sum() == pytest.approx(3600.0)
+    # the panel centres (5, 15, 25, 35 cm) are particle centres: the theory under the applied loads is the
+    # beam under the four panel point loads exactly
+    h = r.history
+    th = theory.beam_point_deflection(h["x_mid"][1], [5.0, 15.0, 25.0, 35.0], np.full(4, 900.0), 40.0,
+                                      F.stiffness(cfg))
+    assert h["w_theory_actual"][1] == pytest.approx(th, rel=1e-9, abs=1e-15)
+    bad = rigid_floor_run(tmp_path / "rigid50.nc", span=50.0)
+    with pytest.raises(ValueError, match="floor length"):
+        F.run_floor(cfg, "oneway", loads=bad)
+
+
+def test_water_particles_at_rest_balance_and_load_the_ring():
+    # variant water_particles: at rest at p0 every water particle has a full lattice support (water + ring,
+    # the ring 5 dx > 2 h thick), so its pressure forces cancel to round-off; the ring takes the reaction,
+    # whose radial total is the pressure on the inner wall, p0 2 pi a (1 % check: measured 0.1 %, the 1 % was
+    # set after measuring, a consistency check); forces are pairwise, so water + ring forces sum to zero
+    from isaflow.core import smoothing as SM
+    from isaflow.methods.solid import water as Wt
+
+    v = CFG["vessel"]
+    dx, a, _ = V.geometry(v)
+    st, _ = V.pressure_state(CFG)
+    xw = Wt.water_sites(v["water_radius_particles"], dx)
+    nw = len(xw)
+    rho0, K, p0 = v["rho_water_kg_m3"] * 1e-8, v["K_GPa"] * 1e5, v["pressure_Pa"] * 1e-4
+    h = v["water_h_over_dx"] * dx
+    kind = SM.kernel_id(v["water_kernel"])
+    pos = np.vstack([xw, st.pos[:, :2]])
+    fw, fs, drho = np.zeros((nw, 2)), np.zeros((st.block.n, 2)), np.zeros(nw)
+    Wt.water_forces(pos, np.zeros_like(pos), np.full(nw, rho0), nw, rho0 * dx**2, h, kind, SM.NORM[kind, 2] / h**2,
+                    K, rho0, p0, v["water_alpha"], np.sqrt(K / rho0), fw, fs, drho)
+    assert np.abs(fw).max() < 1e-9 * p0 * dx
+    assert np.abs(fw.sum(0) + fs.sum(0)).max() < 1e-9 * p0 * dx
+    ref = st.block.ref[:, :2]
+    radial_total = (fs * ref / np.hypot(*ref.T)[:, None]).sum()
+    assert radial_total == pytest.approx(p0 * 2 * np.pi * a, rel=0.01)
+
+
+def test_water_particles_pressure_drops_as_ring_expands_and_step_rule():
+    from isaflow.methods.solid import water as Wt
+
+    dt = CFG["vessel"]["dt_ns"] * 1e-9
+    t, ui, pw, st, inner, rho = Wt.coupled_history(CFG, dt, 400, 100)
+    assert (np.diff(ui) > 0).all() and (np.diff(pw) < 0).all()  # the paper's 400 steps: still expanding
+    with pytest.raises(ValueError, match="above the step rule"):
+        Wt.coupled_history(CFG, 1.01 * st.dt_max, 1, 1)

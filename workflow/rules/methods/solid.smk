@@ -4,12 +4,35 @@
 SOLID_CFG = "config/methods/solid.yaml"
 SOLID_CASES = ["bar_tension", "bar_compression", "shear", "hertz", "hertz_dt15ns", "hertz_dt56ns"]
 SOLID_RUNS = expand("results/solid/{case}_{variant}.nc", case=SOLID_CASES, variant=["paper", "hooke"])
-SOLID_CODE = code("methods/solid/kernels", "methods/solid/lattice", "methods/solid/solve", "methods/solid/cases",
-                  "methods/solid/settings", "methods/solid/outputs")
+SOLID_CODE = code("methods/solid/kernels", "methods/solid/rotation", "methods/solid/lattice", "methods/solid/solve",
+                  "methods/solid/cases", "methods/solid/settings", "methods/solid/outputs")
 SOLID_FIGURES = figure("solid_bar") + figure("solid_hertz")
 SOLID_REPORT_FIGURES = [f for name in ("solid_bar", "solid_hertz") for f in report_figure(name, "solid_figure", "Methods compared")]
 
-register(SOLID_RUNS + SOLID_FIGURES, ["results/report/65_solid.md"], ["results/claims/solid.csv"],
+# section 4.4 pressure vessel and the elastic floor of the single tank (one-way: loads from the coarsest
+# rigid-floor run of each method; the sph/mps rules files are read after this one, so their first
+# single-vessel run names are taken from their settings here)
+with open("config/methods/sph.yaml") as _fh:
+    _SOLID_SPH1 = __import__("yaml").safe_load(_fh)["runs"]["single"][0]
+with open("config/methods/mps.yaml") as _fh:
+    _SOLID_MPS1 = __import__("yaml").safe_load(_fh)["runs"]["single_spacings"]["value"][0]
+SOLID_FLOOR_LOADS = {
+    "isa": run_file("single_coarse"),
+    "sph": "results/sph/single_wcsph_" + (f"n{_SOLID_SPH1['particles']}" if "particles" in _SOLID_SPH1
+                                          else f"dx{_SOLID_SPH1['spacing']:g}") + ".nc",
+    "mps": f"results/mps/single_standard_dx{_SOLID_MPS1:.3g}.nc",
+}
+SOLID_VESSEL_RUNS = ["results/solid/vessel_pressure_load.nc", "results/solid/vessel_water_particles.nc"]
+SOLID_FLOOR_RUNS = ["results/solid/floor_uniform_uniform_load.nc"] + [
+    f"results/solid/floor_{src}_oneway.nc" for src in SOLID_FLOOR_LOADS]
+SOLID_NEW_RUNS = SOLID_VESSEL_RUNS + SOLID_FLOOR_RUNS
+SOLID_NEW_CODE = SOLID_CODE + code("methods/solid/vessel", "methods/solid/water", "methods/solid/floor",
+                                    "methods/solid/theory", "core/smoothing", "core/neighbours")
+SOLID_FIGURES += figure("solid_vessel") + figure("solid_floor")
+SOLID_REPORT_FIGURES_44 = [f for name in ("solid_vessel", "solid_floor")
+                           for f in report_figure(name, "solid_figure", "Methods compared")]
+
+register(SOLID_RUNS + SOLID_NEW_RUNS + SOLID_FIGURES, ["results/report/65_solid.md"], ["results/claims/solid.csv"],
          ["results/timing/65_solid.md"])
 
 
@@ -29,6 +52,72 @@ rule solid_run:
         "../../envs/isaflow.yaml"
     log:
         "logs/solid/{case}_{variant}.log",
+    script:
+        "../../scripts/call.py"
+
+
+rule solid_vessel:
+    input:
+        cfg=SOLID_CFG,
+        code=SOLID_NEW_CODE,
+    output:
+        "results/solid/vessel_{variant}.nc",
+    wildcard_constraints:
+        variant="pressure_load|water_particles",
+    params:
+        func="methods.solid.outputs.run_case",
+        kw=lambda wc: dict(case="vessel", variant=wc.variant),
+    log:
+        "logs/solid/vessel_{variant}.log",
+    script:
+        "../../scripts/call.py"
+
+
+rule solid_floor_uniform:
+    input:
+        cfg=SOLID_CFG,
+        code=SOLID_NEW_CODE,
+    output:
+        "results/solid/floor_uniform_uniform_load.nc",
+    params:
+        func="methods.solid.outputs.run_case",
+        kw=dict(case="floor_uniform", variant="uniform_load"),
+    log:
+        "logs/solid/floor_uniform_uniform_load.log",
+    script:
+        "../../scripts/call.py"
+
+
+rule solid_floor_oneway:
+    input:
+        cfg=SOLID_CFG,
+        loads=lambda wc: SOLID_FLOOR_LOADS[wc.src],
+        code=SOLID_NEW_CODE,
+    output:
+        "results/solid/floor_{src}_oneway.nc",
+    wildcard_constraints:
+        src="|".join(SOLID_FLOOR_LOADS),
+    params:
+        func="methods.solid.outputs.run_case",
+        kw=lambda wc: dict(case=f"floor_{wc.src}", variant="oneway"),
+    log:
+        "logs/solid/floor_{src}_oneway.log",
+    script:
+        "../../scripts/call.py"
+
+
+rule solid_figures_44:
+    input:
+        cfg=SOLID_CFG,
+        runs=SOLID_NEW_RUNS,
+        code=code("methods/solid/figures", "methods/solid/theory", "figures/style", "methods/__init__",
+                  "methods/solid/__init__"),
+    output:
+        SOLID_REPORT_FIGURES_44,
+    params:
+        func="methods.solid.figures.vessel_and_floor",
+    log:
+        "logs/solid/figures_44.log",
     script:
         "../../scripts/call.py"
 
@@ -53,7 +142,7 @@ rule solid_figures:
 rule solid_claims:
     input:
         cfg=SOLID_CFG,
-        runs=SOLID_RUNS,
+        runs=SOLID_RUNS + SOLID_NEW_RUNS,
         code=code("methods/solid/claims", "methods/solid/theory", "methods/solid/figures"),
     output:
         "results/claims/solid.csv",

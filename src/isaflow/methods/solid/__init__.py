@@ -18,6 +18,14 @@ METHOD = Method(
                          "tab:red", "s"),
         "hooke": Variant("hooke", "hooke: eqs. 11-16 + Poisson size coupling + G shear springs (not in the paper)",
                          "tab:blue", "o"),
+        "pressure_load": Variant("pressure_load", "pressure_load: 4.4 vessel, the water replaced by its pressure on the "
+                                 "ring's wetted faces (what Lame assumes; the paper couples SPH water)", "tab:purple", "D"),
+        "water_particles": Variant("water_particles", "water_particles: 4.4 vessel with weakly compressible SPH "
+                                   "water (linear EOS from p0) pushing on the ring, one-step coupled", "tab:cyan", "P"),
+        "uniform_load": Variant("uniform_load", "uniform_load: elastic floor under the hydrostatic W / span as nodal "
+                                "loads (beam-theory check; not in either paper)", "0.3", "^"),
+        "oneway": Variant("oneway", "oneway: elastic floor, one-way: loads from the rigid-floor run of another method "
+                          "(not in either paper)", "tab:green", "v"),
     },
     solver="isaflow.methods.solid.cases:run_case",
 )

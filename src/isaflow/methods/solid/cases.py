@@ -196,8 +196,17 @@ CASES = {"bar_tension": lambda cfg, v: run_bar(cfg, v, +1), "bar_compression": l
          "shear": run_shear, "hertz": run_hertz}
 
 
-def run_case(cfg, case, variant):
-    """Dispatch: case is a key of CASES or 'hertz_dt<ns>' (the paper's fixed step)."""
+def run_case(cfg, case, variant, loads=None):
+    """Dispatch: case is a key of CASES, 'hertz_dt<ns>' (the paper's fixed step), 'vessel' (4.4) or
+    'floor_<source>' (elastic floor; loads: the rigid-floor run file of variant 'oneway')."""
+    if case == "vessel":
+        from .vessel import run_vessel
+
+        return run_vessel(cfg, variant)
+    if case.startswith("floor_"):
+        from .floor import run_floor
+
+        return run_floor(cfg, variant, loads=loads, case=case)
     if case.startswith("hertz_dt"):
         return run_hertz_dt(cfg, variant, float(case[len("hertz_dt"):].removesuffix("ns")))
     return CASES[case](cfg, variant)

@@ -2,6 +2,7 @@
 
 
 import numpy as np
+from matplotlib.colors import to_hex
 
 from isaflow import runfile
 from isaflow.figures.style import PAPER, THEORY, plt, save
@@ -93,3 +94,98 @@ def bar_and_hertz(cfg, runs, outputs):
     """Both figures (workflow entry point): outputs are the bar's [png, pdf], then Hertz's."""
     bar_figure(cfg, runs, outputs[:2])
     hertz_figure(cfg, runs, outputs[2:])
+
+
+def vessel_figure(config_path, runs, outputs):
+    """Fig. 7 analogue: (a) the ring's inner-wall radial displacement against time (undamped, from rest)
+    per variant, the settled value, Lame's and the paper's 58.7 us; (b) the SPH water's mean pressure
+    (variant water_particles); (c) the settled ring (pressure_load)."""
+    cfg = settings.load(config_path)
+    vs = {var: d for (case, var), d in read_runs(runs).items() if case == "vessel"}
+    fig, (a, b, c) = plt.subplots(1, 3, figsize=(13, 4.4), gridspec_kw={"width_ratios": [1.6, 1.1, 1]})
+    one = lambda ds, k: float(ds[k].values.ravel()[0])  # noqa: E731
+    ds0 = next(iter(vs.values()))
+    t_paper = one(ds0, "t_paper") * 1e6
+    for var, ds in sorted(vs.items()):
+        v = variant_of("solid", var)
+        t, u = ds["time"].values * 1e6, ds["u_inner_t"].values * 1e4
+        a.plot(t, u, color=v.colour, lw=1.1, label=f"{var}: inner particles (mean)")
+        a.plot([t_paper], [one(ds, "u_paper_end") * 1e4], "o", color=v.colour, ms=5)
+        if var == "pressure_load":
+            a.axhline(one(ds, "u_inner_settled") * 1e4, color=v.colour, ls="--", lw=1,
+                      label=f"{var}: settled (kinetic damping)")
+        else:
+            a.axhline(one(ds, "u_inner_mean_cycles") * 1e4, color=v.colour, ls="--", lw=1,
+                      label=f"{var}: mean over whole cycles")
+            a.axhline(one(ds, "u_lame_compressible") * 1e4, color="0.45", ls=":", lw=1.4,
+                      label="Lame at the pressure the water keeps")
+            b.plot(t, ds["p_water_t"].values / 1e-4 / 1e3, color=v.colour, lw=1.1, label="mean water pressure")
+            b.axhline(one(ds, "p_equilibrium") / 1e-4 / 1e3, color="0.45", ls=":", lw=1.4,
+                      label="p0 / (1 + 2 K u_L / (a p0))")
+            b.axhline(cfg["vessel"]["pressure_Pa"] / 1e3, color=THEORY, lw=1.2, label="p0 (paper: 101,135 Pa)")
+    a.axhline(one(ds0, "u_lame_inner") * 1e4, color=THEORY, lw=1.4, label="Lame thick cylinder at p0")
+    for ax in (a, b):
+        ax.axvline(t_paper, color=PAPER, ls="-.", lw=1.2, label=f"paper's run: {cfg['vessel']['steps']} x "
+                   f"{cfg['vessel']['dt_ns']:g} ns = {t_paper:.1f} us")
+        ax.set_xlim(0, float(ds0["time"].values.max() * 1e6))
+        ax.set_xlabel("time since the start from rest [us]")
+    a.set(ylabel="radial displacement [um]", title="(a) ring inner wall against time")
+    a.set_ylim(0.0 if a.get_ylim()[0] > -0.1 else None, a.get_ylim()[1] * 1.45)
+    a.legend(fontsize=6, loc="upper right", ncol=2)
+    b.set(ylabel="pressure [kPa]", title="(b) SPH water pressure (water_particles)")
+    lo, hi = b.get_ylim()
+    b.set_ylim(lo - 0.75 * (hi - lo), hi)
+    b.legend(fontsize=6, loc="lower right")
+    ds = vs.get("pressure_load", ds0)
+    p0, p = ds["pos0"].values, ds["pos"].values
+    r = np.hypot(p0[:, 0], p0[:, 1])
+    ur = ((p - p0) * p0 / r[:, None]).sum(1) * 1e4
+    sc = c.scatter(p0[:, 0], p0[:, 1], c=ur, s=7, marker="s", cmap="viridis")
+    fig.colorbar(sc, ax=c, label="radial displacement [um]", shrink=0.8)
+    c.set_aspect("equal")
+    c.set(xlabel="x [cm]", ylabel="y [cm]", title=f"(c) settled ring ({ds.attrs['variant']})")
+    fig.tight_layout()
+    save(fig, outputs)
+
+
+def floor_figure(config_path, runs, outputs):
+    """Elastic floor: (a) deflection of the plate's middle row per load source against beam theory,
+    (b) the nodal loads, summed from x = 0."""
+    fig, (a, b) = plt.subplots(1, 2, figsize=(10, 4.4))
+    first, used = True, set()
+    for (case, var), ds in sorted(read_runs(runs).items()):
+        if not case.startswith("floor_"):
+            continue
+        x = ds["x_mid"].values
+        if first:
+            a.plot(x, ds["w_theory_uniform"].values * 10, color="k", lw=1.6,
+                   label="Euler-Bernoulli, uniform W / span")
+            first = False
+        if var == "oneway":
+            src = variant_of(ds.attrs["load_method"], ds.attrs["load_variant"])
+            colour, marker, name = src.colour, src.marker, f"{ds.attrs['load_method']} {ds.attrs['load_variant']}"
+        else:
+            v = variant_of("solid", var)
+            colour, marker, name = v.colour, v.marker, "uniform W / span"
+        if to_hex(colour) in used:  # two methods' registry colours coincide (isa paper, mps standard): next free
+            colour = next(c for c in (to_hex(f"C{i}") for i in range(10)) if c not in used)
+        used.add(to_hex(colour))
+        a.plot(x[::4], ds["w_mid"].values[::4] * 10, marker, ms=3.5, ls="none", color=colour,
+               label=f"plate, loads: {name}")
+        a.plot(x, ds["w_theory_actual"].values * 10, ls="--", lw=0.9, color=colour,
+               label=f"beam theory, loads: {name}")
+        b.plot(x, np.cumsum(ds["nodal_load"].values), color=colour, lw=1.2, label=name)
+    a.invert_yaxis()
+    a.set(xlabel="x [cm]", ylabel="deflection (down) [mm]", title="(a) plate deflection, middle row")
+    b.set(xlabel="x [cm]", ylabel="floor load from x = 0 to x [N per cm thickness]",
+          title="(b) applied floor load, cumulative")
+    a.legend(fontsize=6, loc="upper center")
+    b.legend(fontsize=6, loc="upper left")
+    fig.tight_layout()
+    save(fig, outputs)
+
+
+def vessel_and_floor(cfg, runs, outputs):
+    """Both figures (workflow entry point): outputs are the vessel's [png, pdf], then the floor's."""
+    vessel_figure(cfg, runs, outputs[:2])
+    floor_figure(cfg, runs, outputs[2:])

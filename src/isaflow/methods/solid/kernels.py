@@ -12,6 +12,9 @@ previous step):
     strain = (r - L0 (1 + eps_p)) / (L0 (1 + Ebar_u))          eq. 15
     f_n    = E dx^(d-1) (1 + Ebar_v)(1 + Ebar_w) strain         eq. 16 (force, not dv)
     f_t    = G dx^(d-1) (d - (d.e) e) / L0      (variant 'hooke' only)
+    f_t    = 2 G dx^(d-1) (d - (d.e) e - L0 W e) / L0   (shear mode 2, 'objective': W the mean
+             small rotation (antisymmetric displacement gradient) of a and b, so a rigid rotation
+             carries no shear force and the shear stress is G gamma in every lattice orientation)
 
 eps_p = -nu (sigma_v + sigma_w) / E (variant 'hooke' only; 0 in 'paper'):
 the Poisson contraction of the particle's natural size.  Particle stress is
@@ -22,13 +25,16 @@ E_u = sigma_u / E (paper, eq. 14) or (sigma_u - nu (sigma_v + sigma_w)) / E
 Time integration as section 3: accelerations -> velocities -> positions ->
 stresses; dt = min(dx / (4 c), 0.1 dx / V_max) (eqs. 26-27) unless a fixed dt
 is given.  Settling: kinetic damping (all velocities zeroed when the kinetic
-energy falls; not in the paper, which only says the particles "settle").
+energy falls; not in the paper, which only says the particles "settle"); damp = 0
+runs undamped (time histories).  fext (N, 3) [N]: prescribed external loads.
 """
 
 import numpy as np
 from numba import njit
 
 from isaflow.core.neighbours import build_pairs
+
+from .rotation import rotations
 
 JIT = dict(cache=True, nogil=True)
 
@@ -37,7 +43,7 @@ RUNNING, CONVERGED, UNSTABLE, NONFINITE = 0, 1, 2, 3
 
 
 @njit(**JIT)
-def link_forces(pos, la, lb, d0, laxis, sig, strain, E, nu, G, area0, poisson, shear, frc, vir):
+def link_forces(pos, la, lb, d0, laxis, sig, strain, E, nu, G, area0, poisson, shear, rot, frc, vir):
     """Add every link's force to frc (N, 3) [N] and its virial to vir (N, 6) [N cm].
 
     vir columns: f_x d_x, f_y d_y, f_z d_z, f_x d_y, f_y d_z, f_x d_z (the last three: shear
@@ -73,9 +79,17 @@ def link_forces(pos, la, lb, d0, laxis, sig, strain, E, nu, G, area0, poisson, s
             ez = d0[k, 2] / L0
             dn = dx * ex + dy * ey + dz * ez
             c = G * area0 * (1.0 + ev) * (1.0 + ew) / L0
-            fx += c * (dx - dn * ex)
-            fy += c * (dy - dn * ey)
-            fz += c * (dz - dn * ez)
+            tx = dx - dn * ex
+            ty = dy - dn * ey
+            tz = dz - dn * ez
+            if shear == 2:  # objective: remove the pair's mean rigid rotation W d0, shear stress G gamma
+                c *= 2.0
+                tx -= 0.5 * L0 * (rot[a, 0, u] + rot[b, 0, u])
+                ty -= 0.5 * L0 * (rot[a, 1, u] + rot[b, 1, u])
+                tz -= 0.5 * L0 * (rot[a, 2, u] + rot[b, 2, u])
+            fx += c * tx
+            fy += c * ty
+            fz += c * tz
         add_pair(a, b, fx, fy, fz, dx, dy, dz, frc, vir)
     return fmax
 
@@ -177,7 +191,7 @@ def stresses(vir, size, dim, E, nu, poisson, sig, strain):
 @njit(**JIT)
 def relax(pos, vel, ref, target, free, mass, size, la, lb, d0, laxis, partners, disk,
           E, nu, G, rho, dim, poisson, shear, push, dt_fixed, tol, min_steps, n_steps,
-          sig, strain, frc, pres, state):
+          sig, strain, frc, pres, state, fext, damp):
     """Run up to n_steps steps; stop early when converged (residual < tol) or unstable.
 
     target (N, 3): positions of the prescribed dofs (free == 0).  state (6,)
@@ -192,6 +206,7 @@ def relax(pos, vel, ref, target, free, mass, size, la, lb, d0, laxis, partners, 
     dt_max = smin / (4.0 * c)  # eq. 26
     area0 = smin ** (dim - 1)
     vir = np.zeros((n, 6))
+    rot = np.zeros((n, 3, 3))
     box = np.empty(4)
     rc = 1.5 * size.max()
     skin = 0.25 * size.min()
@@ -219,9 +234,11 @@ def relax(pos, vel, ref, target, free, mass, size, la, lb, d0, laxis, partners, 
                 pi, pj, m = build_pairs(pos, box, rc + skin)
                 anchor[:, :] = pos
                 rebuild = False
-        frc[:, :] = 0.0
+        frc[:, :] = fext
         vir[:, :] = 0.0
-        fmax = link_forces(pos, la, lb, d0, laxis, sig, strain, E, nu, G, area0, poisson, shear, frc, vir)
+        if shear == 2:
+            rotations(pos, ref, la, lb, d0, laxis, rot)
+        fmax = link_forces(pos, la, lb, d0, laxis, sig, strain, E, nu, G, area0, poisson, shear, rot, frc, vir)
         if push:
             push_forces(pos, size, partners, pi, pj, m, E, dim, frc, vir)
         gx, gy = disk_forces(pos, size, free, disk, E, dim, frc, vir, pres)
@@ -247,7 +264,7 @@ def relax(pos, vel, ref, target, free, mass, size, la, lb, d0, laxis, partners, 
             for u in range(3):
                 vel[a, u] = (vel[a, u] + dt * frc[a, u] / mass[a]) * free[a, u]
                 ke += 0.5 * mass[a] * vel[a, u] ** 2
-        if ke < state[0]:  # kinetic damping: past a peak of kinetic energy
+        if damp and ke < state[0]:  # kinetic damping: past a peak of kinetic energy
             vel[:, :] = 0.0
             ke = 0.0
         state[0] = ke

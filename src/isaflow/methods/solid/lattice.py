@@ -67,3 +67,14 @@ def unlinked(n, dx, dim=2):
     z = np.zeros(0, np.int32)
     return Block(dx, (n, 1, 1), np.zeros((n, 3)), np.zeros((n, 3), int), z, z.copy(), np.zeros((0, 3)), z.copy(),
                  np.full((n, 6), -1, np.int32))
+
+
+def select(blk, keep):
+    """The sub-block of the particles where keep (N,) bool; links between kept particles only."""
+    keep = np.asarray(keep, bool)
+    new = np.full(blk.n, -1, np.int64)
+    new[keep] = np.arange(keep.sum())
+    on = keep[blk.la] & keep[blk.lb]
+    la, lb = new[blk.la[on]].astype(np.int32), new[blk.lb[on]].astype(np.int32)
+    return Block(blk.dx, blk.shape, blk.ref[keep].copy(), blk.index[keep].copy(), la, lb, blk.d0[on].copy(),
+                 blk.axis[on].copy(), partner_table(int(keep.sum()), la, lb))

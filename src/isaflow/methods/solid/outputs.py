@@ -50,25 +50,27 @@ def to_dataset(r, config_path, started, finished):
         "status": r.status, "status_message": r.message, "residual_name": r.residual_name,
         "time_coverage_start": started, "time_coverage_end": finished,
         "Conventions": "CF-1.10, ACDD-1.3", "creator_name": "isaflow replication workflow", "date_created": finished,
-        **runfile.provenance({"settings": config_path}),
+        **runfile.provenance({"settings": config_path, **({"loads": r.params["load_source"]}
+                                                          if "load_source" in r.params else {})}),
         **{k: (v if isinstance(v, (int, float, str)) else str(v)) for k, v in r.params.items()},
     }
     return ds
 
 
-def run_case(cfg, outputs, case, variant):
-    """Workflow entry point (stderr is the rule's log): write_run to outputs[0]."""
+def run_case(cfg, outputs, case, variant, loads=None):
+    """Workflow entry point (stderr is the rule's log): write_run to outputs[0]; loads: the rigid-floor
+    run file of an elastic-floor case."""
     logging.basicConfig(stream=sys.stderr, level=logging.INFO, format="%(asctime)s %(message)s")
-    return write_run(cfg, case, variant, outputs[0])
+    return write_run(cfg, case, variant, outputs[0], loads=loads)
 
 
-def write_run(config_path, case, variant, out):
+def write_run(config_path, case, variant, out, loads=None):
     """Run one case/variant from the settings file and write its run file to out."""
     log = logging.getLogger("isaflow.solid")
     cfg = settings.load(config_path)
     solve.warmup()
     started, t0 = runfile.now(), time.perf_counter()
-    r = cases.run_case(cfg, case, variant)
+    r = cases.run_case(cfg, case, variant, loads=loads)
     log.info("%s %s: %s (%s), %d steps, %.2f s", case, variant, r.status, r.message, r.steps, time.perf_counter() - t0)
     runfile.write(to_dataset(r, config_path, started, runfile.now()), out)
     return r

@@ -27,7 +27,7 @@ def _section(**fields):
 
 SCHEMA = {
     "type": "object", "additionalProperties": False,
-    "required": ["material", "solver", "bar", "shear", "hertz", "vessel"],
+    "required": ["material", "solver", "bar", "shear", "hertz", "vessel", "floor"],
     "properties": {
         "material": _section(E_GPa=POS, nu={"type": "number", "minimum": 0, "exclusiveMaximum": 0.5}, rho_kg_m3=POS),
         "solver": _section(tol=POS, max_steps=COUNT, max_steps_mechanism=COUNT),
@@ -40,7 +40,12 @@ SCHEMA = {
                           plane={"enum": ["strain"]}, paper_dt_ns={"type": "array", "items": POS},
                           dt_check_steps=COUNT),
         "vessel": _section(dx_mm=POS, ring_particles=COUNT, water_radius_particles=COUNT, pressure_Pa=POS,
-                           K_GPa=POS, rho_water_kg_m3=POS, steps=COUNT, dt_ns=POS),
+                           K_GPa=POS, rho_water_kg_m3=POS, steps=COUNT, dt_ns=POS,
+                           solid_model={"enum": ["paper", "hooke", "objective"]}, history_us=POS, record_every=COUNT,
+                           water_kernel={"enum": ["cubic_spline", "wendland_c2", "wendland_c4", "wendland_c6"]},
+                           water_h_over_dx=POS, water_alpha={"type": "number", "minimum": 0}),
+        "floor": _section(span_cm=POS, dx_cm=POS, layers=COUNT, supports={"enum": ["simply_supported"]},
+                          solid_model={"enum": ["paper", "hooke", "objective"]}, weight_N=POS, max_steps=COUNT),
     },
 }
 

@@ -13,7 +13,7 @@ from . import kernels as K
 
 log = logging.getLogger("isaflow.solid")
 
-VARIANT_FLAGS = {"paper": (0, 0), "hooke": (1, 1)}  # (Poisson coupling, shear springs)
+VARIANT_FLAGS = {"paper": (0, 0), "hooke": (1, 1), "objective": (1, 2)}  # (Poisson coupling, shear springs)
 STATUS = {K.RUNNING: "step_limit", K.CONVERGED: "converged", K.UNSTABLE: "escaped", K.NONFINITE: "nonfinite"}
 
 
@@ -52,6 +52,8 @@ class State:
     disk: np.ndarray = field(default_factory=lambda: np.zeros(4))  # cx, cy, R cm, on
     clock: np.ndarray = None  # kernel state: [ke, sim time, dt min, dt max, -, steps]
     push: int = 0  # unlinked pairs push (2D only)
+    damp: int = 1  # kinetic damping on (1) or off (0: undamped time history)
+    fext: np.ndarray = None  # (N, 3) external loads, N (per unit thickness in 2D)
     wall_time: float = 0.0
 
     def __post_init__(self):
@@ -63,6 +65,7 @@ class State:
         self.strain = np.zeros((b.n, 3))
         self.frc = np.zeros((b.n, 3))
         self.pres = np.zeros(b.n)
+        self.fext = np.zeros((b.n, 3)) if self.fext is None else self.fext
         self.clock = np.array([0.0, 0.0, np.inf, 0.0, 0.0, 0.0])
         self.mass = np.full(b.n, self.mat.rho * b.dx**b.dim)
         self.size = np.full(b.n, b.dx)
@@ -92,7 +95,7 @@ def relax(st, tol, max_steps, dt=0.0, min_steps=10, chunk=20000, log_every=10.0,
         steps, code, resid, gx, gy = K.relax(
             st.pos, st.vel, b.ref, st.target, st.free, st.mass, st.size, b.la, b.lb, b.d0, b.axis, b.partners,
             st.disk, m.E, m.nu, m.G, m.rho, b.dim, poisson, shear, st.push, float(dt), float(tol), min_steps, n,
-            st.sig, st.strain, st.frc, st.pres, st.clock)
+            st.sig, st.strain, st.frc, st.pres, st.clock, st.fext, st.damp)
         done += steps
         min_steps = max(0, min_steps - steps)
         now = time.perf_counter()

@@ -70,3 +70,27 @@ def lame_inner_displacement(a, b, p, E, nu):
     """Radial displacement [m] of the inner wall of a thick cylinder (inner radius a, outer b)
     under internal pressure p, plane strain: u = a p (1 + nu) ((1 - 2 nu) a^2 + b^2) / (E (b^2 - a^2))."""
     return a * p * (1.0 + nu) * ((1.0 - 2.0 * nu) * a**2 + b**2) / (E * (b**2 - a**2))
+
+
+def lame_displacement(r, a, b, p, E, nu):
+    """Lame radial displacement u(r) = A r + B / r [m] of a thick cylinder under internal pressure p,
+    plane strain: A = (1 + nu)(1 - 2 nu) p a^2 / (E (b^2 - a^2)), B = (1 + nu) p a^2 b^2 / (E (b^2 - a^2))."""
+    c = (1.0 + nu) * p * a**2 / (E * (b**2 - a**2))
+    r = np.asarray(r, float)
+    return c * ((1.0 - 2.0 * nu) * r + b**2 / r)
+
+
+def beam_point_deflection(x, xi, P, L, EI):
+    """Simply supported beam of span L [m or cm], point load P at xi: deflection w(x) (positive along P)."""
+    x = np.asarray(x, float)[:, None]
+    xi, P = np.atleast_1d(xi)[None, :], np.atleast_1d(P)[None, :]
+    b = L - xi
+    left = P * b * x * (L**2 - b**2 - x**2) / (6.0 * L * EI)
+    right = P * xi * (L - x) * (L**2 - xi**2 - (L - x) ** 2) / (6.0 * L * EI)
+    return np.where(x <= xi, left, right).sum(1)
+
+
+def beam_uniform_deflection(x, q, L, EI):
+    """Simply supported beam of span L under uniform load q per length: w(x) = q x (L^3 - 2 L x^2 + x^3) / (24 EI)."""
+    x = np.asarray(x, float)
+    return q * x * (L**3 - 2.0 * L * x**2 + x**3) / (24.0 * EI)

@@ -1,0 +1,176 @@
+"""Section 4.4, variant 'water_particles': weakly compressible SPH water inside the solid ring.
+
+Water particles fill the lattice sites with r < a (the ring's own lattice, spacing dx); density by
+the continuity equation from rho0, linear EOS p = p0 + K (rho / rho0 - 1), so the water starts at
+rest at p0.  The ring particles are the water's wall: in the water's sums a ring particle b within
+2 h of water particle a stands for water of mass m and the pressure and density of a (mirror
+pressure), so a full lattice support (water + ring) is in equilibrium at uniform p, and the ring
+takes the equal and opposite force, m^2 2 p_a / rho_a^2 grad_a W_ab: the pressure traction on the
+ring, spread over the layers the kernel reaches.  The ring's velocity enters the continuity
+equation, so as the ring expands the water's density and pressure drop (by K dA / A).  Monaghan
+artificial viscosity alpha (settings).  Units cm, N, s.
+"""
+
+import time
+
+import numpy as np
+from numba import njit
+
+from isaflow.core import smoothing as SM
+from isaflow.core.neighbours import build_pairs
+
+JIT = dict(cache=True, nogil=True)
+
+
+@njit(**JIT)
+def water_forces(pos, vel, rho, nw, m, h, kind, norm, K, rho0, p0, alpha, c0, fw, fs, drho):
+    """Forces fw (nw, 2) on the water, fs (N - nw, 2) of the water on the ring [N], and drho/dt (nw,).
+
+    pos, vel (N, 2): water first (nw), then the ring.  m: water particle mass; norm = sigma / h^2."""
+    box = np.empty(4)
+    box[0] = pos[:, 0].min()
+    box[1] = pos[:, 1].min()
+    box[2] = pos[:, 0].max() + 1e-9
+    box[3] = pos[:, 1].max() + 1e-9
+    pi, pj, npair = build_pairs(pos, box, 2.0 * h)
+    fw[:, :] = 0.0
+    fs[:, :] = 0.0
+    drho[:] = 0.0
+    for k in range(npair):
+        a = pi[k]
+        b = pj[k]
+        if a >= nw and b >= nw:
+            continue
+        if a >= nw:  # water first
+            a, b = b, a
+        dx = pos[a, 0] - pos[b, 0]
+        dy = pos[a, 1] - pos[b, 1]
+        r = np.sqrt(dx * dx + dy * dy)
+        if r == 0.0 or r >= 2.0 * h:
+            continue
+        g = norm / h * SM.dw(kind, r / h) / r  # grad_a W = g (x_a - x_b)
+        dvx = vel[a, 0] - vel[b, 0]
+        dvy = vel[a, 1] - vel[b, 1]
+        pa = p0 + K * (rho[a] / rho0 - 1.0)
+        if b < nw:
+            rb = rho[b]
+            pb = p0 + K * (rb / rho0 - 1.0)
+        else:
+            rb = rho[a]
+            pb = pa
+        vr = dvx * dx + dvy * dy
+        visc = 0.0
+        if vr < 0.0:
+            mu = h * vr / (r * r + 0.01 * h * h)
+            visc = -alpha * c0 * mu / (0.5 * (rho[a] + rb))
+        coef = -m * m * (pa / rho[a] ** 2 + pb / rb**2 + visc) * g
+        fx = coef * dx
+        fy = coef * dy
+        fw[a, 0] += fx
+        fw[a, 1] += fy
+        drho[a] += m * vr * g
+        if b < nw:
+            fw[b, 0] -= fx
+            fw[b, 1] -= fy
+            drho[b] += m * vr * g
+        else:
+            fs[b - nw, 0] -= fx
+            fs[b - nw, 1] -= fy
+
+
+def water_sites(na, dx):
+    """(M, 2) water particle positions [cm]: the lattice sites with i^2 + j^2 < na^2."""
+    i, j = np.meshgrid(np.arange(-na, na + 1), np.arange(-na, na + 1), indexing="ij")
+    inside = (i**2 + j**2) < na**2
+    return dx * np.column_stack([i[inside], j[inside]]).astype(float)
+
+
+def coupled_history(cfg, dt, steps, every):
+    """Undamped ring + SPH water from rest at p0, fixed step dt [s]: (t (M,) s, mean inner radial
+    displacement (M,) cm, mean water pressure (M,) N/cm^2, ring state, inner mask, water density)."""
+    from . import solve as S
+    from .vessel import geometry, pressure_state, radial
+
+    v = cfg["vessel"]
+    dx, a, _ = geometry(v)
+    st, inner = pressure_state(cfg, damp=0)
+    st.fext[:] = 0.0
+    if dt > st.dt_max:
+        raise ValueError(f"water_particles: dt {dt:.3g} s above the step rule dx / (4 c) = {st.dt_max:.3g} s (eq. 26)")
+    xw = water_sites(v["water_radius_particles"], dx)
+    nw = len(xw)
+    rho0 = v["rho_water_kg_m3"] * 1e-8  # kg/m^3 -> N s^2 / cm^4
+    K, p0 = v["K_GPa"] * 1e5, v["pressure_Pa"] * 1e-4  # N/cm^2
+    c0 = np.sqrt(K / rho0)
+    m = rho0 * dx**2
+    h = v["water_h_over_dx"] * dx
+    kind = SM.kernel_id(v["water_kernel"])
+    norm = SM.NORM[kind, 2] / h**2
+    vw, rho = np.zeros_like(xw), np.full(nw, rho0)
+    fw, fs, drho = np.zeros((nw, 2)), np.zeros((st.block.n, 2)), np.zeros(nw)
+    t, ui, pw = [0.0], [0.0], [p0]
+    t0 = time.perf_counter()
+    for step in range(1, steps + 1):
+        pos = np.vstack([xw, st.pos[:, :2]])
+        vel = np.vstack([vw, st.vel[:, :2]])
+        water_forces(pos, vel, rho, nw, m, h, kind, norm, K, rho0, p0, v["water_alpha"], c0, fw, fs, drho)
+        st.fext[:, :2] = fs
+        S.relax(st, 0.0, 1, dt=dt, min_steps=1, chunk=1, log_every=1e9)
+        vw += dt * fw / m
+        xw += dt * vw
+        rho += dt * drho
+        if step % every == 0:
+            t.append(step * dt)
+            ui.append(radial(st, inner).mean())
+            pw.append(float(np.mean(p0 + K * (rho / rho0 - 1.0))))
+    st.wall_time = time.perf_counter() - t0  # the coupled loop: water and ring
+    return np.array(t), np.array(ui), np.array(pw), st, inner, rho
+
+
+def run_water_vessel(cfg):
+    """Variant 'water_particles': the undamped coupled history at the paper's step; the mean over whole
+    breathing cycles against Lame at the pressure the water keeps, p0 / (1 + 2 K u_L / (a p0))."""
+    from .cases import _result
+    from .vessel import NS, US, geometry, lame
+
+    v = cfg["vessel"]
+    dx, a, b = geometry(v)
+    dt = v["dt_ns"] * NS
+    steps = int(np.ceil(v["history_us"] * US / dt))
+    t, ui, pw, st, inner, rho = coupled_history(cfg, dt, steps, v["record_every"])
+    p0, K = v["pressure_Pa"] * 1e-4, v["K_GPa"] * 1e5
+    # whole cycles: between the first and the last upward crossing of the history's mean
+    dev = ui - ui.mean()
+    up = np.flatnonzero((dev[:-1] < 0) & (dev[1:] >= 0)) + 1
+    lo, hi = (up[0], up[-1]) if len(up) > 1 else (0, len(t) - 1)
+    u_mean, p_mean = float(ui[lo:hi].mean()), float(pw[lo:hi].mean())
+    r_in = np.hypot(*st.block.ref[inner, :2].T)
+    u_l = float(lame(cfg, r_in).mean())
+    p_eq = p0 / (1.0 + 2.0 * K * u_l / (a * p0))
+    t_paper = v["steps"] * dt
+    rec = {
+        "u_inner_mean_cycles": ([u_mean], "cm", "mean inner radial displacement over whole breathing cycles"),
+        "p_water_mean_cycles": ([p_mean], "N cm-2", "mean water pressure over whole breathing cycles"),
+        "p_drop_expected": ([K * 2.0 * u_mean / a], "N cm-2", "K dA / A with dA / A = 2 u_mean / a"),
+        "u_lame_inner": ([u_l], "cm", "Lame u(r) at p0 averaged over the inner particles' radii"),
+        "u_lame_compressible": ([u_l * p_eq / p0], "cm", "Lame u at the pressure the water keeps, p0 / (1 + 2 K u_L / (a p0))"),
+        "p_equilibrium": ([p_eq], "N cm-2", "water pressure once the ring has expanded (Lame ring, linear EOS)"),
+        "cycles_from": ([t[lo]], "s", "start of the averaging window"),
+        "cycles_to": ([t[hi]], "s", "end of the averaging window"),
+        "u_paper_end": ([float(np.interp(t_paper, t, ui))], "cm", "mean inner displacement at the paper's 400 steps"),
+        "t_paper": ([t_paper], "s", "the paper's simulated time, steps x dt"),
+        "n_water": ([len(rho)], "1", "water particles"),
+    }
+    hist = {k: (("record",), val, u, ln) for k, (val, u, ln) in rec.items()}
+    hist.update({
+        "time": (("sample",), t, "s", "time since the start from rest at p0 (undamped, alpha viscosity)"),
+        "u_inner_t": (("sample",), ui, "cm", "mean radial displacement of the inner (wetted) particles"),
+        "p_water_t": (("sample",), pw, "N cm-2", "mean water pressure"),
+    })
+    r = _result(st, "vessel", "step_limit", f"undamped coupled run, {steps} steps of {dt:.4g} s (no rest test)",
+                float("nan"), hist,
+                {"a_cm": a, "b_cm": b, "pressure_N_cm2": p0, "solid_model": v["solid_model"],
+                 "water_kernel": v["water_kernel"], "water_h_cm": v["water_h_over_dx"] * dx,
+                 "water_alpha": v["water_alpha"], "ring_lattice": "square lattice, centre radius in [a, b)"})
+    r.variant = "water_particles"
+    return r
