@@ -67,6 +67,8 @@ rule solid_vessel:
     params:
         func="methods.solid.outputs.run_case",
         kw=lambda wc: dict(case="vessel", variant=wc.variant),
+    conda:
+        "../../envs/isaflow.yaml"
     log:
         "logs/solid/vessel_{variant}.log",
     script:
@@ -82,6 +84,8 @@ rule solid_floor_uniform:
     params:
         func="methods.solid.outputs.run_case",
         kw=dict(case="floor_uniform", variant="uniform_load"),
+    conda:
+        "../../envs/isaflow.yaml"
     log:
         "logs/solid/floor_uniform_uniform_load.log",
     script:
@@ -100,6 +104,8 @@ rule solid_floor_oneway:
     params:
         func="methods.solid.outputs.run_case",
         kw=lambda wc: dict(case=f"floor_{wc.src}", variant="oneway"),
+    conda:
+        "../../envs/isaflow.yaml"
     log:
         "logs/solid/floor_{src}_oneway.log",
     script:
@@ -116,6 +122,8 @@ rule solid_figures_44:
         SOLID_REPORT_FIGURES_44,
     params:
         func="methods.solid.figures.vessel_and_floor",
+    conda:
+        "../../envs/isaflow.yaml"
     log:
         "logs/solid/figures_44.log",
     script:
