@@ -4,10 +4,17 @@ params.func names 'module.function' under isaflow (e.g. 'tables.error_table',
 'figures.single.single_vessel_figure', 'report.flow.flow_section').  It is
 called as func(**named inputs except 'code', outputs=[output files],
 **params.kw); single-file inputs are passed as a path, others as a list.
-stderr (warnings, tracebacks) goes to the rule's log.
+stderr (warnings, tracebacks) goes to the rule's log.  BLAS and OpenMP run on the rule's threads.
 """
 import importlib
+import os
 import sys
+
+# BLAS/OpenMP threads = the rule's threads (1 unless it asks for more), set before numpy loads: a threaded
+# OpenBLAS sums in an order that varies from run to run (LAPACK dgbcon's estimates differed by one ulp
+# between two runs), and two runs of the same commit must give byte-identical physics outputs.
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ[_var] = str(snakemake.threads)  # noqa: F821
 
 sys.stderr = open(snakemake.log[0], "w")  # noqa: F821
 
