@@ -11,12 +11,14 @@ import os
 import sys
 
 # BLAS/OpenMP threads = the rule's threads (1 unless it asks for more), set before numpy loads: a threaded
-# OpenBLAS sums in an order that varies from run to run (LAPACK dgbcon's estimates differed by one ulp
-# between two runs), and two runs of the same commit must give byte-identical physics outputs.
+# OpenBLAS sums in an order that varies from run to run, and two runs of the same commit must give
+# byte-identical physics outputs.
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ[_var] = str(snakemake.threads)  # noqa: F821
 
 sys.stderr = open(snakemake.log[0], "w")  # noqa: F821
+# the command run files record: the rule and function, not Snakemake's temporary copy of this script
+sys.argv = ["snakemake", f"rule {snakemake.rule}:", f"isaflow.{snakemake.params.func}", "->", *snakemake.output]  # noqa: F821
 
 mod, name = snakemake.params.func.rsplit(".", 1)  # noqa: F821
 func = getattr(importlib.import_module(f"isaflow.{mod}"), name)

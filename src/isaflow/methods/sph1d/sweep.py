@@ -49,7 +49,7 @@ def run_sweep(s):
             "error": (("variant", "kernel", "ratio", "n"), err,
                       {"units": "1", "long_name": "relative quadratic error ||p - p_exact||_2 / ||p_exact||_2"}),
             "cond": (("variant", "kernel", "ratio", "n"), cond,
-                     {"units": "1", "long_name": "1-norm condition number of A (LAPACK dgbcon estimate)"}),
+                     {"units": "1", "long_name": "1-norm condition number of A (Higham's lower-bound estimate)"}),
             "neighbours": (("ratio",), neighbours_per_side(ratios),
                            {"units": "1", "long_name": "neighbours per side inside the support 2 h"}),
             "kappa": (("kernel", "ratio"), np.where(one, kappa, np.nan),
