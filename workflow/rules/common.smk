@@ -1,5 +1,6 @@
 # Config validation and input functions shared by all rules.
 import glob
+import os
 
 from snakemake.utils import validate
 
@@ -47,7 +48,10 @@ def figure(name):
 def report_figure(name, caption, category):
     """figure(name) with the PNG marked for the Snakemake report (caption: workflow/report/<caption>.rst)."""
     png, pdf = figure(name)
-    return [report(png, caption=f"../report/{caption}.rst", category=category), pdf]
+    # Snakemake resolves a caption against the directory of the rule file that calls this (rules/ or
+    # rules/methods/), so give it the path from there
+    rst = os.path.join(workflow.basedir, "workflow", "report", f"{caption}.rst")
+    return [report(png, caption=os.path.relpath(rst, str(workflow.current_basedir)), category=category), pdf]
 
 
 def run_file(run):
