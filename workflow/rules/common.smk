@@ -45,13 +45,18 @@ def figure(name):
     return [f"figures/{name}.png", f"figures/{name}.pdf"]
 
 
-def report_figure(name, caption, category):
-    """figure(name) with the PNG marked for the Snakemake report (caption: workflow/report/<caption>.rst)."""
-    png, pdf = figure(name)
+def report_file(path, caption, category):
+    """path marked for the Snakemake report with the caption workflow/report/<caption>.rst."""
     # Snakemake resolves a caption against the directory of the rule file that calls this (rules/ or
     # rules/methods/), so give it the path from there
     rst = os.path.join(workflow.basedir, "workflow", "report", f"{caption}.rst")
-    return [report(png, caption=os.path.relpath(rst, str(workflow.current_basedir)), category=category), pdf]
+    return report(path, caption=os.path.relpath(rst, str(workflow.current_basedir)), category=category)
+
+
+def report_figure(name, caption, category):
+    """figure(name) with the PNG marked for the Snakemake report."""
+    png, pdf = figure(name)
+    return [report_file(png, caption, category), pdf]
 
 
 def run_file(run):

@@ -49,7 +49,7 @@ rule table1:
         benchmarks=[f"results/benchmarks/run/{r}.tsv" for r in TABLE1_RUNS],
         code=code("tables", "report/__init__"),
     output:
-        report("figures/table1.csv", caption="../report/table.rst", category="Claims"),
+        report_file("figures/table1.csv", "table", "Claims"),
         "figures/table1.md",
     conda:
         "../envs/isaflow.yaml"

@@ -27,7 +27,7 @@ rule report_claims:
         config="config/config.yaml",
         code=code("report/__init__", "report/claims", "metrics"),
     output:
-        report("results/claims/papadopoulos2016.csv", caption="../report/claims.rst", category="Claims"),
+        report_file("results/claims/papadopoulos2016.csv", "claims", "Claims"),
         "results/report/findings.md",
     params:
         func="report.claims.paper_claims",
