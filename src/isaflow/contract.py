@@ -10,6 +10,22 @@ range of a wall; a continuum method (SPH, MPS) integrates its wall pressure
 over panels of the wall (core.panels) and reports one contact per panel, at
 the panel's centre.  The same hydrostatic theory (theory.contact_theory) then
 judges both.
+
+Every tank method also states how its liquid differs from the tank it runs on,
+in ``Result.params`` (run-file attributes), so that no difference is silent:
+- ``layer_pitch`` [cm]: vertical distance between the particle layers of its
+  initial lattice (square lattice: dy; MPS: l0; ISA's rhombic lattice: a / 2);
+  the free surface of a particle method is its top particle centres plus half
+  of it (metrics.surface_of);
+- ``held_weight`` [N]: the liquid weight the method holds (sum of m g);
+- ``initial_depth`` [cm]: the depth of its initial liquid in the first vessel,
+  top layer plus half a pitch above the floor (the tank's ``liquid.depth``
+  unless rows were rounded);
+- ``tank_difference``: one line saying what differs from the tank ("none" if
+  nothing), e.g. "depth rounded to whole rows: 75 cm (tank 72.5 cm), weight held
+  at 9000 N".
+Dynamic methods judge rest with isaflow.rest (one criterion for all) and
+record ``rest_energy_ratio``, ``rest_window`` and ``time_to_rest`` [s].
 """
 
 from dataclasses import dataclass, field
