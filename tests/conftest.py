@@ -5,13 +5,14 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from isaflow import cli, runfile, scene
-from isaflow.methods.isa import solver
+from isaflow import run, runfile
+from isaflow.methods.isa import scene, solver
 
 ROOT = Path(__file__).resolve().parents[1]
-SCENES = ROOT / "config" / "scenes"
+TANKS = ROOT / "config" / "tanks"
+ISA_SETTINGS = ROOT / "config" / "methods" / "isa.yaml"
 
-# the coarse lattice's force laws (config/scenes/single_coarse.yaml): cm, N
+# the coarse lattice's force laws (config/methods/isa.yaml, resolution coarse): cm, N
 L_B, R_B = 5.0, 10000.0  # wall: l_bu, R_bu (k_b = 2000 N/cm)
 L_P, R_P = 7.0710678, 3535.5339  # pair: l_pu = a / sqrt(2), R_pu (k_p = 500 N/cm)
 OUTCOMES = ["converged", "cycle", "step_limit", "escaped", "nonfinite"]  # the ISA solver's outcomes
@@ -26,29 +27,93 @@ TINY = {
     "forces": {"wall": {"law": "linear", "l_u": L_B, "r_u": R_B}, "pair": {"law": "linear", "l_u": L_P, "r_u": R_P}},
     "solver": {"variant": "capped", "du": 0.01, "f_tol": 0.1, "max_steps": 20000},
 }
+TINY_TANK = {"name": "tiny", "walls": BOX, "liquid": {"weight": 200.0, "depth": 10.0}}
 
 
-def solve_scene(path, overrides=()):
-    """Solve a scene file in memory; returns (Scene, Run)."""
-    sc = scene.load(path, overrides)
+def solve_scene(tank, resolution, variant="paper", overrides=()):
+    """Solve an ISA scene (tank name, resolution of config/methods/isa.yaml, update rule) in memory;
+    returns (Scene, Result)."""
+    sc = scene.of_run(tank, resolution, variant, overrides, ISA_SETTINGS)
     pos0, weight, start, _ = scene.initial_state(sc)
     return sc, solver.solve(sc, pos0, weight, start_step=start)
 
 
+def run_isa(out, tank="single", resolution="coarse", variant="paper", overrides=(), start=None,
+            accept=("converged", "cycle", "step_limit")):
+    """Run ISA through isaflow.run (the command line's path) into ``out``; returns the exit code."""
+    return run.run("isa", str(TANKS / f"{tank}.yaml"), variant, resolution, str(out), str(ISA_SETTINGS),
+                   list(overrides), None if start is None else str(start), accept, log=lambda m: None)
+
+
+def run_declared(out, run_id, start=None, overrides=()):
+    """Run a run declared in config/methods/isa.yaml (its tank, rule, resolution, overrides) into ``out``,
+    continuing ``start``; extra overrides ('key=value') after the declaration's; returns the exit code."""
+    from isaflow import settings as S
+    from isaflow.methods.isa.settings import VALUES
+
+    decl = S.read(ISA_SETTINGS, VALUES)["runs"][run_id]
+    sets = {**decl.get("set", {}), **dict(S._parse(o, "test", "override") for o in overrides)}
+    return run.run("isa", str(TANKS / f"{decl['tank']}.yaml"), decl["variant"], decl["resolution"], str(out),
+                   str(ISA_SETTINGS), sets, None if start is None else str(start),
+                   ("converged", "cycle", "step_limit"), log=lambda m: None)
+
+
 @pytest.fixture(scope="session")
 def single_runs(tmp_path_factory):
-    """Run files of both single-vessel scenes with both update rules."""
+    """Run files of both paper lattices (resolutions coarse and refined) with both update rules,
+    keyed by their old scene names."""
     out = {}
     tmp = tmp_path_factory.mktemp("runs")
-    for name in ("single_coarse", "single_refined"):
+    for res in ("coarse", "refined"):
         for variant in ("paper", "capped"):
-            path = tmp / f"{name}_{variant}.nc"
-            code = cli.run(str(SCENES / f"{name}.yaml"), str(path), [f"solver.variant={variant}"], quiet=True)
-            assert code == 0
-            out[name, variant] = runfile.read(path)
+            path = tmp / f"single_{res}_{variant}.nc"
+            assert run_isa(path, "single", res, variant) == 0
+            out[f"single_{res}", variant] = runfile.read(path)
     return out
 
 
 def box_walls(width=100.0, height=100.0):
     """(3, 4) left, floor, right walls of an open-top box [cm]."""
     return np.array([[0, height, 0, 0], [0, 0, width, 0], [width, 0, width, height]], float)
+
+
+def settings_spec(spec):
+    """An ISA settings mapping (config/methods/isa.yaml's dialect, one resolution 'r') of a scene mapping
+    (walls, particles, forces, solver as in methods.isa.scene.SCHEMA): lets a test run any scene through
+    isaflow.run, the path every run takes."""
+    src = "inferred: test scene"
+    leaf = lambda v: {"value": v, "source": src}  # noqa: E731
+    part, sol = spec["particles"], spec["solver"]
+    lat = part.get("lattice", {"a": 10.0, "rows": 1, "row_lengths": [1], "center_x": 0.0, "bottom_y": 0.0})
+    return {
+        "particles": {"weight": leaf(part["weight"]), "points": leaf(part.get("points")),
+                      "lattice": {k: leaf(v) for k, v in lat.items()}},
+        "forces": {w: {k: leaf(v) for k, v in spec["forces"][w].items()} for w in ("wall", "pair")},
+        "solver": {k: leaf(sol.get(k, d)) for k, d in (("du", None), ("f_tol", None), ("max_steps", None),
+                                                       ("f_ref", None), ("dt_max", None), ("skin", None),
+                                                       ("chunk", 1000), ("stop_on_cycle", True), ("history", {}))},
+        "resolutions": {"r": {"source": src, "set": {}}},
+        "variants": {"paper": {"set": {}}, "capped": {"set": {}}, "fire": {"set": {}}},
+    }
+
+
+def write_spec(tmp_path, spec, name="scene"):
+    """(tank path, settings path) of a scene mapping written as a tank and an ISA settings file."""
+    import yaml
+
+    n = len(spec["particles"].get("points", [])) or 1
+    tank = {"name": "test_tank", "walls": spec["walls"], "liquid": {"weight": spec["particles"]["weight"] * n,
+                                                                     "depth": 10.0}}
+    if spec.get("vessels"):
+        tank["vessels"] = spec["vessels"]
+    tp, sp = tmp_path / f"{name}_tank.yaml", tmp_path / f"{name}_settings.yaml"
+    tp.write_text(yaml.safe_dump(tank))
+    sp.write_text(yaml.safe_dump(settings_spec(spec)))
+    return tp, sp
+
+
+def run_spec(tmp_path, spec, out, overrides=(), start=None, accept=("converged", "cycle", "step_limit")):
+    """Run a scene mapping through isaflow.run (its solver.variant is the update rule); returns the exit code."""
+    tp, sp = write_spec(tmp_path, spec, f"scene_{abs(hash(str(out))) % 10**8}")
+    return run.run("isa", str(tp), spec["solver"]["variant"], "r", str(out), str(sp), list(overrides),
+                   None if start is None else str(start), accept, log=lambda m: None)

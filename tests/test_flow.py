@@ -4,28 +4,28 @@ equivalence, and the CI tolerance check at the end of the complete flow."""
 import numpy as np
 import pytest
 
-from isaflow import cli, metrics, runfile
+from isaflow import metrics, runfile
 
-from conftest import SCENES
+from conftest import run_declared
 
 PAPER = {"particles_left": 14, "level_second": 32.0}
 A = 10.0  # coarse lattice diagonal, cm
 
 
-def run(tmp, name, scene, *sets):
+def run(tmp, name, run_id, start=None):
     out = tmp / f"{name}.nc"
-    assert cli.run(str(SCENES / scene), str(out), list(sets), quiet=True) == 0
+    assert run_declared(out, run_id, start) == 0
     return out
 
 
 @pytest.fixture(scope="module")
 def chain(tmp_path_factory):
-    """Application 1 -> 3 -> 4 (paper's update) and 4 with the capped variant."""
+    """Application 1 -> 3 -> 4 (paper's update) and 4 with the capped variant (config/methods/isa.yaml runs)."""
     tmp = tmp_path_factory.mktemp("flow")
-    app1 = run(tmp, "app1", "single_coarse.yaml")
-    app3 = run(tmp, "app3", "flow_step50.yaml", f"particles.from_run={app1}", "solver.max_steps=100000")
-    app4 = run(tmp, "app4", "flow_step50.yaml", f"particles.from_run={app3}")
-    app4c = run(tmp, "app4c", "flow_step50.yaml", f"particles.from_run={app3}", "solver.variant=capped")
+    app1 = run(tmp, "app1", "single_coarse")
+    app3 = run(tmp, "app3", "flow_incomplete", app1)
+    app4 = run(tmp, "app4", "flow_complete", app3)
+    app4c = run(tmp, "app4c", "flow_complete_capped", app3)
     return {k: runfile.read(v) for k, v in dict(app1=app1, app3=app3, app4=app4, app4c=app4c).items()}
 
 
@@ -65,9 +65,14 @@ def test_restart_from_a_state_file_repeats_an_uninterrupted_run(tmp_path, chain)
     app1 = tmp_path / "app1.nc"
     runfile.write(chain["app1"], app1)
     start = int(chain["app1"]["steps"])
-    whole = run(tmp_path, "whole", "flow_step50.yaml", f"particles.from_run={app1}", f"solver.max_steps={start + 7000}")
-    leg1 = run(tmp_path, "leg1", "flow_step50.yaml", f"particles.from_run={app1}", f"solver.max_steps={start + 3000}")
-    leg2 = run(tmp_path, "leg2", "flow_step50.yaml", f"particles.from_run={leg1}", f"solver.max_steps={start + 7000}")
+    def leg(name, start_file, max_steps):
+        out = tmp_path / f"{name}.nc"
+        assert run_declared(out, "flow_incomplete", start_file, [f"solver.max_steps={max_steps}"]) == 0
+        return out
+
+    whole = leg("whole", app1, start + 7000)
+    leg1 = leg("leg1", app1, start + 3000)
+    leg2 = leg("leg2", leg1, start + 7000)
     a, b = runfile.read(whole), runfile.read(leg2)
     assert int(a["steps"]) == int(b["steps"]) == start + 7000
     np.testing.assert_array_equal(a["pos"].values, b["pos"].values)
@@ -76,7 +81,7 @@ def test_restart_from_a_state_file_repeats_an_uninterrupted_run(tmp_path, chain)
 
 def test_second_vessel_level_matches_the_paper(chain):
     for key in ("app4", "app4c"):
-        e = metrics.load_errors(chain[key], "second")
+        e = metrics.load_errors(chain[key], "second", "level")
         assert abs(e["depth"] - PAPER["level_second"]) <= A / 4
 
 
@@ -85,8 +90,8 @@ def test_level_matches_the_liquid_moved(chain):
     the rhombic lattice keeps its density through the flow (the paper's incompressibility check)."""
     ds = chain["app4c"]
     moved = metrics.flow_measures(ds)["particles_second"]
-    level1 = metrics.load_errors(chain["app1"])["level"]
-    assert metrics.load_errors(ds, "second")["depth"] == pytest.approx(moved / 180 * level1 / 2, abs=A / 4)
+    level1 = metrics.load_errors(chain["app1"], None, "level")["level"]
+    assert metrics.load_errors(ds, "second", "level")["depth"] == pytest.approx(moved / 180 * level1 / 2, abs=A / 4)
 
 
 @pytest.mark.parametrize("key", ["app4", "app4c"])
@@ -101,14 +106,14 @@ def test_all_floors_together_carry_the_weight(chain, key):
                    "floor carries 0.7 % more than its own particles' weight (the bound N f_tol / W holds for the "
                    "whole liquid only)")
 def test_second_vessel_floor_carries_its_liquid(chain):
-    e = metrics.load_errors(chain["app4c"], "second")
+    e = metrics.load_errors(chain["app4c"], "second", "level")
     assert abs(e["floor_err"]) <= (e["weight"] / 50.0) * 0.1 / e["weight"]  # N_2 f_tol / W_2
 
 
 @pytest.mark.xfail(strict=True, reason="the second vessel's lattice keeps the lateral stress of the inflow "
                    "(stress ratio ~1.75): side walls carry ~30 % more than hydrostatics (docs/replication.md)")
 def test_second_vessel_side_walls_match_hydrostatics(chain):
-    e = metrics.load_errors(chain["app4c"], "second")
+    e = metrics.load_errors(chain["app4c"], "second", "level")
     assert abs(e["side_err"]) <= (A / 4) / e["depth"]
 
 

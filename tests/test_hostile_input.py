@@ -1,10 +1,11 @@
-"""Hostile input (issue 9, item 1): every bad scene, override, start file and output path is refused
+"""Hostile input: every bad tank, settings file, override, start file and output path is refused
 before any work with exit code 2, one line naming the file and the field, and nothing written.
 
 Cases run in process through ``cli.main`` (argument parsing, checks, exit code) with stderr captured;
 two run through a real subprocess to show that no traceback reaches the user.  The corpus of small
-malformed files is tests/data/hostile/; large files and field-level cases are built here from a
-valid scene (conftest.TINY).  Accepted on purpose (documented in docs/hostile_input.md): hostile but
+malformed files is tests/data/hostile/ (each file is tried as a tank and as a settings file); large
+files and field-level cases are built here from a valid scene (conftest.TINY written as a tank and an
+ISA settings file).  Accepted on purpose (documented in docs/hostile_input.md): hostile but
 well-formed physics (coincident particles, particles on walls, R_u = 1e308) - those are outcomes, not
 bad input.
 """
@@ -21,23 +22,25 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from conftest import ROOT, TINY
+from conftest import ROOT, TINY, settings_spec, write_spec
 
 from isaflow import cli, runfile
 
 CORPUS = Path(__file__).parent / "data" / "hostile"
 
 
-def write_scene(tmp_path, spec, name="scene.yaml"):
-    path = tmp_path / name
-    path.write_text(yaml.safe_dump(spec))
-    return path
+def files(tmp_path, spec=TINY):
+    """(tank, settings) files of a scene mapping."""
+    return write_spec(tmp_path, spec)
 
 
-def refused(tmp_path, capsys, scene, *args, out=None, field=None):
-    """Run the CLI; assert exit 2, one 'error:' line naming the scene file and field, and no output."""
-    out = tmp_path / "out" / "run.nc" if out is None else out
-    argv = ["run", str(scene), "-o", str(out), "-q", *args]
+def argv_of(tank, settings, out, *args, variant="capped"):
+    return ["run", "--method", "isa", "--tank", str(tank), "--settings", str(settings), "--variant", variant,
+            "--resolution", "r", "-o", str(out), *args]
+
+
+def refused(tmp_path, capsys, argv, out, field=None):
+    """Run the CLI; assert exit 2, one 'error:' line naming the field, and no output."""
     existed = os.path.lexists(out)
     t0 = time.perf_counter()
     code = cli.main(argv)
@@ -55,6 +58,12 @@ def refused(tmp_path, capsys, scene, *args, out=None, field=None):
         assert not [p for p in parent.glob(".*partial*")], "a temporary file was left"
     return lines[0], elapsed
 
+
+def refused_spec(tmp_path, capsys, spec, *args, out=None, field=None):
+    """Refusal of a scene mapping written as tank + settings files."""
+    tank, settings = files(tmp_path, spec)
+    out = tmp_path / "out" / "run.nc" if out is None else out
+    return refused(tmp_path, capsys, argv_of(tank, settings, out, *args, variant=spec["solver"]["variant"]), out, field)
 
 
 def mutate(path_value_pairs):
@@ -89,19 +98,25 @@ FILE_CASES = {
 }
 
 
+@pytest.mark.parametrize("role", ["tank", "settings"])
 @pytest.mark.parametrize("name", sorted(FILE_CASES))
-def test_malformed_files_are_refused(tmp_path, capsys, name):
-    line, elapsed = refused(tmp_path, capsys, CORPUS / name, field=FILE_CASES[name])
+def test_malformed_files_are_refused(tmp_path, capsys, name, role):
+    tank, settings = files(tmp_path)
+    bad = CORPUS / name
+    out = tmp_path / "out" / "run.nc"
+    argv = argv_of(bad if role == "tank" else tank, bad if role == "settings" else settings, out)
+    line, elapsed = refused(tmp_path, capsys, argv, out, field=FILE_CASES[name])
     assert name in line
     # the alias bomb expands to 9^9 strings; it is refused at its first anchor (it took > 30 s before)
     assert elapsed < 5.0
 
 
 @pytest.mark.parametrize("case", ["missing", "directory", "fifo", "deep_flow", "too_large", "unreadable"])
-def test_unusable_scene_files_are_refused(tmp_path, capsys, case):
-    path = tmp_path / "scene.yaml"
+def test_unusable_tank_files_are_refused(tmp_path, capsys, case):
+    path = tmp_path / "t" / "tank.yaml"
+    path.parent.mkdir()
     expect = {"missing": "no such file", "directory": "a directory", "fifo": "not a regular file",
-              "deep_flow": "nesting deeper than 32", "too_large": "larger than", "unreadable": "scene"}[case]
+              "deep_flow": "nesting deeper than 32", "too_large": "larger than", "unreadable": "tank"}[case]
     if case == "directory":
         path.mkdir()
     elif case == "fifo":
@@ -112,74 +127,105 @@ def test_unusable_scene_files_are_refused(tmp_path, capsys, case):
         path.write_text("description: '" + "x" * 1_100_000 + "'\n")
     elif case == "unreadable":
         path = Path("/proc/self/mem")  # a "regular" file that cannot be read
-        expect = "cannot read scene"
-    line, elapsed = refused(tmp_path, capsys, path, field=expect)
+        expect = "cannot read tank"
+    _, settings = files(tmp_path)
+    out = tmp_path / "out" / "run.nc"
+    line, elapsed = refused(tmp_path, capsys, argv_of(path, settings, out), out, field=expect)
     assert str(path) in line and elapsed < 5.0
 
 
 # ---- fields: types, integers, non-finite and out-of-range numbers, names ----------------------
+# (changes of the scene mapping, text the refusal names, the file it names: tank or settings)
 NAN, INF = float("nan"), float("inf")
 FIELD_CASES = {
-    "name_trailing_newline": ([("name", "tiny\n")], "'name'"),
-    "name_uppercase": ([("name", "Tiny")], "'name'"),
-    "unknown_top_key": ([("extra", 1)], "'(top level)'"),
-    "unknown_solver_key": ([("solver.stepsize", 1)], "'solver'"),
-    "missing_solver": ([("solver", DELETE)], "'(top level)'"),
-    "rows_integral_float": ([("particles.lattice.rows", 3.0)], "'particles.lattice.rows'"),
-    "every_integral_float": ([("solver.history", {"every": 5.0})], "'solver.history.every'"),
-    "max_steps_float": ([("solver.max_steps", 1e20)], "'solver.max_steps'"),
-    "max_steps_beyond_int64": ([("solver.max_steps", 10**20)], "'solver.max_steps'"),
-    "max_steps_beyond_limit": ([("solver.max_steps", 10**16)], "'solver.max_steps'"),
-    "weight_nan": ([("particles.weight", NAN)], "'particles.weight'"),
-    "weight_inf": ([("particles.weight", INF)], "'particles.weight'"),
-    "weight_minus_inf": ([("particles.weight", -INF)], "'particles.weight'"),
-    "weight_zero": ([("particles.weight", 0.0)], "'particles.weight'"),
-    "weight_huge_int": ([("particles.weight", 10**400)], "'particles.weight'"),
-    "weight_bool": ([("particles.weight", True)], "'particles.weight'"),
-    "weight_string": ([("particles.weight", "50")], "'particles.weight'"),
-    "wall_l_u_nan": ([("forces.wall.l_u", NAN)], "'forces.wall.l_u'"),
-    "wall_r_u_inf": ([("forces.wall.r_u", INF)], "'forces.wall.r_u'"),
-    "pair_l_u_nan": ([("forces.pair.l_u", NAN)], "'forces.pair.l_u'"),
-    "pair_r_u_negative": ([("forces.pair.r_u", -1.0)], "'forces.pair.r_u'"),
-    "law_not_linear": ([("forces.pair.law", "cubic")], "'forces.pair.law'"),
-    "du_nan": ([("solver.du", NAN)], "'solver.du'"),
-    "du_inf": ([("solver.du", INF)], "'solver.du'"),
-    "f_tol_nan": ([("solver.f_tol", NAN)], "'solver.f_tol'"),
-    "f_tol_inf": ([("solver.f_tol", INF)], "'solver.f_tol'"),
-    "dt_max_nan": ([("solver.dt_max", NAN)], "'solver.dt_max'"),
-    "f_ref_inf": ([("solver.f_ref", INF)], "'solver.f_ref'"),
-    "skin_nan": ([("solver.skin", NAN)], "'solver.skin'"),
-    "chunk_too_small": ([("solver.chunk", 50)], "'solver.chunk'"),
-    "accept_unknown": ([("solver.accept", ["converged", "done"])], "'solver.accept.1'"),
-    "variant_unknown": ([("solver.variant", "newton")], "'solver.variant'"),
-    "lattice_a_nan": ([("particles.lattice.a", NAN)], "'particles.lattice.a'"),
-    "center_x_inf": ([("particles.lattice.center_x", INF)], "'particles.lattice.center_x'"),
-    "row_lengths_zero": ([("particles.lattice.row_lengths", [0, 2])], "'particles.lattice.row_lengths.0'"),
-    "points_nan": ([("particles", {"weight": 50.0, "points": [[1.0, NAN]]})], "'particles.points.0.1'"),
-    "lattice_and_points": ([("particles.points", [[5.0, 5.0]])], "'particles'"),
-    "wall_coordinate_nan": ([("walls.0.from", [0.0, NAN])], "'walls.0.from.1'"),
-    "wall_coordinate_huge": ([("walls.0.from", [0.0, 1e300])], "'walls'"),
-    "wall_zero_length": ([("walls.1.to", [0, 0])], "'walls' (floor)"),
-    "wall_names_duplicate": ([("walls.1.name", "left")], "'walls'"),
-    "wall_name_control_char": ([("walls.1.name", "flo\x00or")], "'walls.1.name'"),
-    "description_lone_surrogate": ([("description", "a\ud800b")], "'description'"),
-    "vessel_x_nan": ([("vessels", [{"name": "v", "x": [0.0, NAN]}])], "'vessels.0.x.1'"),
-    "vessel_x_reversed": ([("vessels", [{"name": "v", "x": [20.0, 0.0]}])], "'vessels' (v)"),
-    "outside_the_walls": ([("particles.lattice.center_x", 50.0)], "outside the walls' bounding box"),
-    "stiffness_overflows": ([("forces.wall.l_u", 1e-300), ("forces.wall.r_u", 1e300)], "'forces.wall'"),
-    "stiffness_underflows": ([("forces.pair.l_u", 1e300), ("forces.pair.r_u", 1e-300)], "'forces.pair'"),
+    "name_trailing_newline": ([("name", "tiny\n")], "'name'", "tank"),
+    "name_uppercase": ([("name", "Tiny")], "'name'", "tank"),
+    "unknown_top_key": ([("forces.extra", {"value": 1})], "'forces'", "settings"),
+    "unknown_solver_key": ([("solver.stepsize", 1)], "'solver'", "settings"),
+    "rows_integral_float": ([("particles.lattice.rows", 3.0)], "'particles.lattice.rows.value'", "settings"),
+    "every_integral_float": ([("solver.history", {"every": 5.0})], "'solver.history.value.every'", "settings"),
+    "max_steps_float": ([("solver.max_steps", 1e20)], "'solver.max_steps.value'", "settings"),
+    "max_steps_beyond_int64": ([("solver.max_steps", 10**20)], "'solver.max_steps.value'", "settings"),
+    "max_steps_beyond_limit": ([("solver.max_steps", 10**16)], "'solver.max_steps.value'", "settings"),
+    "weight_nan": ([("particles.weight", NAN)], "'particles.weight.value'", "settings"),
+    "weight_inf": ([("particles.weight", INF)], "'particles.weight.value'", "settings"),
+    "weight_minus_inf": ([("particles.weight", -INF)], "'particles.weight.value'", "settings"),
+    "weight_zero": ([("particles.weight", 0.0)], "'particles.weight.value'", "settings"),
+    "weight_huge_int": ([("particles.weight", 10**400)], "'particles.weight.value'", "settings"),
+    "weight_bool": ([("particles.weight", True)], "'particles.weight.value'", "settings"),
+    "weight_string": ([("particles.weight", "50")], "'particles.weight.value'", "settings"),
+    "wall_l_u_nan": ([("forces.wall.l_u", NAN)], "'forces.wall.l_u.value'", "settings"),
+    "wall_r_u_inf": ([("forces.wall.r_u", INF)], "'forces.wall.r_u.value'", "settings"),
+    "pair_l_u_nan": ([("forces.pair.l_u", NAN)], "'forces.pair.l_u.value'", "settings"),
+    "pair_r_u_negative": ([("forces.pair.r_u", -1.0)], "'forces.pair.r_u.value'", "settings"),
+    "law_not_linear": ([("forces.pair.law", "cubic")], "'forces.pair.law.value'", "settings"),
+    "du_nan": ([("solver.du", NAN)], "'solver.du.value'", "settings"),
+    "du_inf": ([("solver.du", INF)], "'solver.du.value'", "settings"),
+    "f_tol_nan": ([("solver.f_tol", NAN)], "'solver.f_tol.value'", "settings"),
+    "f_tol_inf": ([("solver.f_tol", INF)], "'solver.f_tol.value'", "settings"),
+    "dt_max_nan": ([("solver.dt_max", NAN)], "'solver.dt_max.value'", "settings"),
+    "f_ref_inf": ([("solver.f_ref", INF)], "'solver.f_ref.value'", "settings"),
+    "skin_nan": ([("solver.skin", NAN)], "'solver.skin.value'", "settings"),
+    "chunk_too_small": ([("solver.chunk", 50)], "'solver.chunk.value'", "settings"),
+    "lattice_a_nan": ([("particles.lattice.a", NAN)], "'particles.lattice.a.value'", "settings"),
+    "center_x_inf": ([("particles.lattice.center_x", INF)], "'particles.lattice.center_x.value'", "settings"),
+    "row_lengths_zero": ([("particles.lattice.row_lengths", [0, 2])], "'particles.lattice.row_lengths.value.0'",
+                         "settings"),
+    "points_nan": ([("particles", {"weight": 50.0, "points": [[1.0, NAN]]})], "'particles.points.value.0.1'",
+                   "settings"),
+    "wall_coordinate_nan": ([("walls.0.from", [0.0, NAN])], "'walls.0.from.1'", "tank"),
+    "wall_coordinate_huge": ([("walls.0.from", [0.0, 1e300])], "'walls'", "tank"),
+    "wall_zero_length": ([("walls.1.to", [0, 0])], "'walls' (floor)", "tank"),
+    "wall_names_duplicate": ([("walls.1.name", "left")], "'walls'", "tank"),
+    "wall_name_control_char": ([("walls.1.name", "flo\x00or")], "'walls.1.name'", "tank"),
+    "description_lone_surrogate": ([("description", "a\ud800b")], "'description'", "tank"),
+    "vessel_x_nan": ([("vessels", [{"name": "v", "x": [0.0, NAN]}])], "'vessels.0.x.1'", "tank"),
+    "vessel_x_reversed": ([("vessels", [{"name": "v", "x": [20.0, 0.0]}])], "'vessels' (v)", "tank"),
+    "outside_the_walls": ([("particles.lattice.center_x", 50.0)], "outside the walls' bounding box", "settings"),
+    "stiffness_overflows": ([("forces.wall.l_u", 1e-300), ("forces.wall.r_u", 1e300)], "'forces.wall'", "settings"),
+    "stiffness_underflows": ([("forces.pair.l_u", 1e300), ("forces.pair.r_u", 1e-300)], "'forces.pair'", "settings"),
 }
 
 
-@pytest.mark.parametrize("case", sorted(FIELD_CASES))
-def test_bad_fields_are_refused_naming_the_field(tmp_path, capsys, case):
-    changes, field = FIELD_CASES[case]
-    spec = mutate(changes)
-    path = tmp_path / "scene.yaml"
+def write_case(tmp_path, spec):
+    """(tank, settings) of a mutated scene: settings keys outside the dialect go in raw (unknown-key cases)."""
+    raw = {k: spec["solver"].pop(k) for k in list(spec["solver"]) if k not in
+           ("variant", "du", "f_tol", "max_steps", "f_ref", "dt_max", "skin", "chunk", "stop_on_cycle", "history")}
+    extra_forces = spec["forces"].pop("extra", None)
+    tank_spec = {"name": spec.get("name", "tiny"), "walls": spec["walls"], "liquid": {"weight": 200.0, "depth": 10.0}}
+    for k in ("vessels", "description"):
+        if k in spec:
+            tank_spec[k] = spec[k]
+    sp = settings_spec(spec)
+    for k, v in raw.items():
+        sp["solver"][k] = {"value": v, "source": "inferred: test"}
+    if extra_forces is not None:
+        sp["forces"]["extra"] = extra_forces
+    tank, settings = tmp_path / "tank.yaml", tmp_path / "settings.yaml"
     # PyYAML writes NaN/inf as .nan/.inf and huge ints as digits, as a user would type them
-    path.write_text(yaml.dump(spec, allow_unicode=False))
-    line, _ = refused(tmp_path, capsys, path, field=field)
-    assert "scene.yaml" in line
+    tank.write_text(yaml.dump(tank_spec, allow_unicode=False))
+    settings.write_text(yaml.dump(sp, allow_unicode=False))
+    return tank, settings
+
+
+@pytest.mark.parametrize("case", sorted(FIELD_CASES))
+def test_bad_fields_are_refused_naming_the_file_and_field(tmp_path, capsys, case):
+    changes, field, role = FIELD_CASES[case]
+    tank, settings = write_case(tmp_path, mutate(changes))
+    out = tmp_path / "out" / "run.nc"
+    line, _ = refused(tmp_path, capsys, argv_of(tank, settings, out), out, field=field)
+    assert f"{role}.yaml" in line
+
+
+def test_unknown_variant_resolution_and_outcome_are_refused(tmp_path, capsys):
+    tank, settings = files(tmp_path)
+    out = tmp_path / "out" / "run.nc"
+    refused(tmp_path, capsys, argv_of(tank, settings, out, variant="bogus"), out, field="no variant 'bogus'")
+    argv = argv_of(tank, settings, out)
+    argv[argv.index("--resolution") + 1] = "bogus"
+    refused(tmp_path, capsys, argv, out, field="no resolution 'bogus'")
+    refused(tmp_path, capsys, argv_of(tank, settings, out, "--accept", "converged,done"), out,
+            field="unknown outcome 'done'")
 
 
 # ---- resources: refused with the estimate, before anything is allocated ------------------------
@@ -203,8 +249,9 @@ RESOURCE_CASES = {
 def test_runs_that_cannot_fit_in_memory_are_refused_with_the_estimate(tmp_path, capsys, case, monkeypatch):
     monkeypatch.setenv("ISAFLOW_MEMORY_LIMIT_MB", "4096")  # a 4 GB machine: the refusals hold anywhere
     changes, field = RESOURCE_CASES[case]
-    path = write_scene(tmp_path, mutate(changes))
-    line, elapsed = refused(tmp_path, capsys, path, field=field)
+    tank, settings = write_case(tmp_path, mutate(changes))
+    out = tmp_path / "out" / "run.nc"
+    line, elapsed = refused(tmp_path, capsys, argv_of(tank, settings, out), out, field=field)
     assert ("the run needs about" in line and "GB available" in line) or "cells" in line
     assert elapsed < 5.0  # nothing was allocated (a 10^10-particle lattice would take minutes and 160 GB)
 
@@ -213,18 +260,18 @@ def test_runs_that_cannot_fit_in_memory_are_refused_with_the_estimate(tmp_path, 
 SET_CASES = {
     "no_equals": ("solver.du", "key=value"),
     "malformed_yaml": ("solver.du=[1,", "not valid YAML"),
-    "python_tag": ("name=!!python/object/apply:os.system [ls]", "explicit YAML tags"),
-    "alias": ("solver.accept=&a [*a]", "anchors and aliases"),
-    "into_a_scalar": ("solver.du.x=1", "'solver.du' is not a mapping"),
-    "into_a_list": ("walls.0.from=[1, 2]", "'walls' is not a mapping"),
-    "missing_field": ("solver.bogus.x=1", "no field 'bogus'"),
-    "empty_key": ("=1", "empty field name"),
-    "empty_segment": ("solver..du=1", "empty field name"),
+    "python_tag": ("solver.du=!!python/object/apply:os.system [ls]", "explicit YAML tags"),
+    "alias": ("solver.history=&a [*a]", "anchors and aliases"),
+    "into_a_scalar": ("solver.du.x=1", "no such setting"),
+    "into_a_list": ("walls.0.from=[1, 2]", "no such setting"),
+    "missing_field": ("solver.bogus.x=1", "no such setting"),
+    "empty_key": ("=1", "no such setting"),
+    "empty_segment": ("solver..du=1", "no such setting"),
     "deep_value": ("solver.du=" + "[" * 100 + "]" * 100, "nesting deeper than 32"),
     "control_char": ("solver.du=0.\x0701", "control characters"),
-    "nan_value": ("solver.du=.nan", "'solver.du'"),
-    "inf_value": ("solver.f_tol=.inf", "'solver.f_tol'"),
-    "replace_a_block_with_a_scalar": ("solver=5", "'solver'"),
+    "nan_value": ("solver.du=.nan", "'solver.du"),
+    "inf_value": ("solver.f_tol=.inf", "'solver.f_tol"),
+    "replace_a_block_with_a_scalar": ("solver=5", "no such setting"),
     "two_documents": ("solver.du=1\n---\n2", "more than one YAML document"),
 }
 
@@ -232,21 +279,19 @@ SET_CASES = {
 @pytest.mark.parametrize("case", sorted(SET_CASES))
 def test_bad_overrides_are_refused(tmp_path, capsys, case):
     item, expect = SET_CASES[case]
-    path = write_scene(tmp_path, TINY)
-    line, _ = refused(tmp_path, capsys, path, "--set", item, field=expect)
-    assert "scene.yaml" in line
+    line, _ = refused_spec(tmp_path, capsys, TINY, "--set", item, field=expect)
+    assert "settings.yaml" in line
 
 
-# ---- start files (particles.from_run) ---------------------------------------------------------
+# ---- start files (--start) --------------------------------------------------------------------
 @pytest.fixture(scope="module")
 def tiny_run(tmp_path_factory):
     """A valid run file of TINY stopped at step 300 (so a continuation has steps left)."""
     tmp = tmp_path_factory.mktemp("start")
-    path = write_scene(tmp, TINY)
+    tank, settings = files(tmp)
     out = tmp / "tiny.nc"
-    spec = {**TINY["solver"], "max_steps": 300, "accept": ["converged", "step_limit"]}
-    assert cli.run(str(path), str(out), [f"solver={yaml.safe_dump(spec, default_flow_style=True).strip()}"],
-                   quiet=True) == 0
+    assert cli.main(argv_of(tank, settings, out, "--set", "solver.max_steps=300", "--accept",
+                            "converged,step_limit")) == 0
     return out
 
 
@@ -312,16 +357,15 @@ START_CASES = ["missing", "directory", "fifo", "text_file", "truncated", "partia
 @pytest.mark.parametrize("case", START_CASES)
 def test_bad_start_files_are_refused(tmp_path, capsys, tiny_run, case):
     start, extra, expect = start_case(tmp_path, tiny_run, case)
-    path = write_scene(tmp_path, {**TINY, "particles": {"weight": 50.0, "from_run": str(start)}})
     sets = [a for e in extra for a in ("--set", e)]
-    line, _ = refused(tmp_path, capsys, path, *sets, field=expect)
-    assert "scene.yaml" in line and ("particles" in line or "solver" in line)
+    line, _ = refused_spec(tmp_path, capsys, TINY, "--start", str(start), *sets, field=expect)
+    assert "start" in line
 
 
 def test_a_good_start_file_continues(tmp_path, capsys, tiny_run):
-    path = write_scene(tmp_path, {**TINY, "particles": {"weight": 50.0, "from_run": str(tiny_run)}})
+    tank, settings = files(tmp_path)
     out = tmp_path / "cont.nc"
-    assert cli.main(["run", str(path), "-o", str(out), "-q"]) == 0
+    assert cli.main(argv_of(tank, settings, out, "--start", str(tiny_run))) == 0
     ds = runfile.read(out)
     assert int(ds["start_step"]) == 300 and ds.attrs["start_sha256"] == runfile.sha256(tiny_run)
 
@@ -366,7 +410,7 @@ def test_unusable_output_paths_are_refused_before_the_solve(tmp_path, capsys, ca
     before = os.lstat(out) if os.path.lexists(out) else None
     solved = []
     monkeypatch.setattr("isaflow.methods.isa.solver.solve", lambda *a, **k: solved.append(1))
-    line, _ = refused(tmp_path, capsys, write_scene(tmp_path, TINY), out=out, field=expect)
+    line, _ = refused_spec(tmp_path, capsys, TINY, out=out, field=expect)
     assert not solved and str(out) in line
     if before is not None:  # the device, FIFO, link or directory is untouched
         after = os.lstat(out)
@@ -374,50 +418,58 @@ def test_unusable_output_paths_are_refused_before_the_solve(tmp_path, capsys, ca
 
 
 def test_output_onto_an_input_is_refused(tmp_path, capsys, tiny_run):
-    scene_path = write_scene(tmp_path, TINY)
-    refused(tmp_path, capsys, scene_path, out=scene_path, field="would overwrite the scene")
+    tank, settings = files(tmp_path)
+    refused(tmp_path, capsys, argv_of(tank, settings, tank), tank, field="would overwrite the tank")
+    refused(tmp_path, capsys, argv_of(tank, settings, settings), settings, field="would overwrite the settings")
     start = tmp_path / "start.nc"
     start.write_bytes(Path(tiny_run).read_bytes())
-    path = write_scene(tmp_path, {**TINY, "particles": {"weight": 50.0, "from_run": str(start)}}, "cont.yaml")
-    refused(tmp_path, capsys, path, out=start, field="would overwrite particles.from_run")
+    refused(tmp_path, capsys, argv_of(tank, settings, start, "--start", str(start)), start,
+            field="would overwrite the start file")
     assert runfile.read(start)["steps"] == 300  # untouched
 
 
-def test_config_file_must_exist(tmp_path, capsys):
-    refused(tmp_path, capsys, write_scene(tmp_path, TINY), "--config", str(tmp_path / "none.yaml"), field="--config")
+def test_settings_file_must_exist(tmp_path, capsys):
+    tank, _ = files(tmp_path)
+    out = tmp_path / "out" / "r.nc"
+    refused(tmp_path, capsys, argv_of(tank, tmp_path / "none.yaml", out), out, field="no such file")
 
 
 # ---- the real command line: no traceback, exit 2 ---------------------------------------------
-@pytest.mark.parametrize("args", [["run", str(CORPUS / "binary.yaml"), "-o", "X"],
-                                  ["run", str(CORPUS / "alias_bomb.yaml"), "-o", "X", "--set", "solver.du=.nan"]])
+@pytest.mark.parametrize("args", [["--tank", str(CORPUS / "binary.yaml")],
+                                  ["--tank", str(CORPUS / "alias_bomb.yaml"), "--set", "solver.du=.nan"]])
 def test_command_line_refuses_without_a_traceback(tmp_path, args):
-    args = [a.replace("X", str(tmp_path / "run.nc")) for a in args]
-    proc = subprocess.run([sys.executable, "-m", "isaflow.cli", *args], capture_output=True, text=True, cwd=ROOT,
-                          timeout=120)
+    out = tmp_path / "run.nc"
+    proc = subprocess.run([sys.executable, "-m", "isaflow.cli", "run", "--method", "isa", "--variant", "paper",
+                           "--resolution", "coarse", "-o", str(out), *args], capture_output=True, text=True,
+                          cwd=ROOT, timeout=120)
     assert proc.returncode == 2 and "Traceback" not in proc.stderr
-    assert len(proc.stderr.strip().splitlines()) == 1 and not (tmp_path / "run.nc").exists()
+    assert len(proc.stderr.strip().splitlines()) == 1 and not out.exists()
 
 
 def test_argument_errors_exit_2(capsys):
-    for argv in ([], ["run"], ["run", "x.yaml"], ["bogus"]):
+    for argv in ([], ["run"], ["run", "x.yaml"], ["bogus"], ["run", "--method", "isa"]):
         with pytest.raises(SystemExit) as exc:
             cli.main(argv)
         assert exc.value.code == 2
     assert "Traceback" not in capsys.readouterr().err
+    assert cli.main(["run", "--method", "isa", "-o", "x.nc"]) == 2
+    assert "--tank, --variant, --resolution required" in capsys.readouterr().err
 
 
 def test_undecodable_command_line_arguments_are_refused(tmp_path, capsys):
-    bad = os.fsdecode(b"scene\xff.yaml")  # how Python hands over non-UTF-8 argv bytes
-    assert cli.main(["run", bad, "-o", str(tmp_path / "r.nc")]) == 2
+    bad = os.fsdecode(b"tank\xff.yaml")  # how Python hands over non-UTF-8 argv bytes
+    assert cli.main(["run", "--method", "isa", "--tank", bad, "--variant", "paper", "--resolution", "coarse", "-o",
+                     str(tmp_path / "r.nc")]) == 2
     assert "not valid Unicode" in capsys.readouterr().err
 
 
 def test_accepted_hostile_physics_is_an_outcome_not_an_input_error(tmp_path, capsys):
     """R_u = 1e308 N overflows the force (the study's float_limit case): a valid input whose run ends as
-    'nonfinite' - reported against solver.accept (exit 1), never written as a NaN file."""
+    'nonfinite' - reported against the accepted outcomes (exit 1), never written as a NaN file."""
     spec = mutate([("forces.wall.r_u", 1e308), ("particles", {"weight": 50.0, "points": [[10.0, 0.1]]})])
+    tank, settings = files(tmp_path, spec)
     out = tmp_path / "run.nc"
-    assert cli.main(["run", str(write_scene(tmp_path, spec)), "-o", str(out), "-q"]) == 1
+    assert cli.main(argv_of(tank, settings, out)) == 1
     assert "outcome 'nonfinite' is not accepted" in capsys.readouterr().err and not out.exists()
 
 
@@ -439,10 +491,10 @@ def test_a_nan_position_ends_the_compiled_loop_as_nonfinite_naming_the_particle(
 def test_a_run_started_at_its_step_limit_computes_its_forces_once(tmp_path):
     """Called directly (the command line refuses such a start file), the solver evaluates the forces
     of the start state instead of returning zeros, and takes no step."""
-    from isaflow import scene as scenes
+    from isaflow.methods.isa import scene as scenes
     from isaflow.methods.isa import solver
 
-    sc = scenes.load(write_scene(tmp_path, TINY))
+    sc = scenes.from_spec(TINY)
     pos0, weight, _, _ = scenes.initial_state(sc)
     res = solver.solve(sc, pos0, weight, start_step=TINY["solver"]["max_steps"])
     assert res.steps == TINY["solver"]["max_steps"] and res.force_evals == 1
@@ -453,6 +505,7 @@ def test_a_run_started_at_its_step_limit_computes_its_forces_once(tmp_path):
 
 # Method settings files (config/methods/*.yaml) go through the same reader and checks as scenes.
 METHOD_SETTINGS = {
+    "isa": ("config/methods/isa.yaml", "isaflow.settings"),
     "sph": ("config/methods/sph.yaml", "isaflow.methods.sph.settings"),
     "mps": ("config/methods/mps.yaml", "isaflow.methods.mps.settings"),
     "sph1d": ("config/methods/sph1d.yaml", "isaflow.methods.sph1d.settings"),
@@ -477,5 +530,10 @@ def test_bad_method_settings_are_refused_naming_the_file(tmp_path, method, mutat
     bad = tmp_path / f"{method}_{mutation}.yaml"
     bad.write_text(SETTINGS_MUTATIONS[mutation]((ROOT / src).read_text()))
     with pytest.raises(ValueError, match=f"^{bad}: ") as err:
-        importlib.import_module(module).load(bad)
+        if method == "isa":
+            from isaflow.methods.isa.settings import VALUES
+
+            importlib.import_module(module).read(bad, VALUES)
+        else:
+            importlib.import_module(module).load(bad)
     assert "\n" not in str(err.value)

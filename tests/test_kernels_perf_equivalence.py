@@ -8,7 +8,7 @@ computes exactly what the straightforward algorithm computes.  Units cm, N.
 import numpy as np
 import pytest
 
-from isaflow.scene import rhombic_lattice
+from isaflow.methods.isa.scene import rhombic_lattice
 from isaflow.methods.isa import forces as F
 from isaflow.core import geometry as GEO
 from isaflow.core import neighbours as NB

@@ -15,20 +15,25 @@ import sys
 import threading
 
 import pytest
-import yaml
-from conftest import ROOT, TINY
+from conftest import ROOT, TINY, write_spec
 
 from isaflow import runfile
 
 TIMEOUT = 120  # s for any one wait (numba loads its cache in a few seconds)
 
 
+def command(tmp_path, out):
+    """The command line of TINY's run (its tank and settings files live in tmp_path/inputs)."""
+    inputs = tmp_path / "inputs"
+    inputs.mkdir(exist_ok=True)
+    tank, settings = write_spec(inputs, TINY)
+    return [sys.executable, "-m", "isaflow.cli", "run", "--method", "isa", "--tank", str(tank), "--settings",
+            str(settings), "--variant", "capped", "--resolution", "r", "-o", str(out)]
+
+
 def start_run(tmp_path, out, pause="60"):
-    scene = tmp_path / "scene.yaml"
-    scene.write_text(yaml.safe_dump(TINY))
     env = {**os.environ, runfile.PAUSE_HOOK: pause}
-    proc = subprocess.Popen([sys.executable, "-m", "isaflow.cli", "run", str(scene), "-o", str(out), "-q"],
-                            stderr=subprocess.PIPE, text=True, cwd=ROOT, env=env)
+    proc = subprocess.Popen(command(tmp_path, out), stderr=subprocess.PIPE, text=True, cwd=ROOT, env=env)
     lines = queue.Queue()
     threading.Thread(target=lambda: [lines.put(x) for x in proc.stderr], daemon=True).start()
     while True:
@@ -42,12 +47,12 @@ def start_run(tmp_path, out, pause="60"):
 
 
 def leftovers(directory):
-    return sorted(p.name for p in directory.iterdir() if p.name != "scene.yaml")
+    return sorted(p.name for p in directory.iterdir() if p.name != "inputs")
 
 
 def assert_nothing_opens_as_a_run_file(directory):
     for p in directory.iterdir():
-        if p.name != "scene.yaml":
+        if p.name != "inputs":
             with pytest.raises(runfile.RunFileError):
                 runfile.read(p)
 
@@ -78,8 +83,7 @@ def test_sigkill_during_the_write_leaves_nothing_that_reads_as_a_run_file(tmp_pa
     assert not out.exists() and len(left) == 1 and runfile.PARTIAL in left[0] and not left[0].endswith(".nc")
     assert_nothing_opens_as_a_run_file(tmp_path)
     # the next run of the same output removes the dead writer's temporary file
-    proc = subprocess.run([sys.executable, "-m", "isaflow.cli", "run", str(tmp_path / "scene.yaml"), "-o", str(out),
-                           "-q"], capture_output=True, text=True, cwd=ROOT, timeout=TIMEOUT)
+    proc = subprocess.run(command(tmp_path, out), capture_output=True, text=True, cwd=ROOT, timeout=TIMEOUT)
     assert proc.returncode == 0, proc.stderr
     assert leftovers(tmp_path) == ["run.nc"]
     assert runfile.read(out).attrs["isaflow_complete"] == "yes"

@@ -10,7 +10,8 @@ from isaflow import runfile
 from isaflow.core import units
 from isaflow.methods import registry
 from isaflow.methods.mps import boundary, model, pressure, settings, solver
-from isaflow.scene import SceneError, load_tank
+from isaflow.inputs import InputError as SceneError
+from isaflow.tank import load as load_tank
 
 ROOT = __import__("pathlib").Path(__file__).resolve().parents[1]
 TANK = ROOT / "config" / "tanks" / "single.yaml"

@@ -8,7 +8,9 @@ from hydrostatic theory are strict xfails: they fail loudly if they vanish.
 import numpy as np
 import pytest
 
-from isaflow import metrics, theory
+from isaflow import theory
+from isaflow.methods.isa import metrics
+from isaflow.methods.isa import theory as isa_theory
 
 PAPER_LEVEL = {"single_coarse": 72.5, "single_refined": 75.0}
 A = {"single_coarse": 10.0, "single_refined": 5.0}
@@ -83,7 +85,7 @@ def test_literal_update_settles_in_a_cycle_at_the_stability_floor(single_runs, n
     ds = single_runs[name, "paper"]
     a = ds.attrs
     assert a["status"] == "cycle" and a["cycle_period"] == 2
-    lam, floor = theory.step_floor(ds["pos"].values, ds["wall_segment"].values, a["wall_l_u"], a["wall_r_u"],
+    lam, floor = isa_theory.step_floor(ds["pos"].values, ds["wall_segment"].values, a["wall_l_u"], a["wall_r_u"],
                                    a["pair_l_u"], a["pair_r_u"], a["du"])
     tail = ds["hist_fmax"].values[-20:]
     lo, hi = ds["hist_fmax_lo"].values[-20:].min(), ds["hist_fmax_hi"].values[-20:].max()
@@ -126,4 +128,4 @@ def test_mechanism_limit_is_the_papers_geometry():
     u = 1 - 1 / np.sqrt(2)
     assert u == pytest.approx(0.293, abs=5e-4) and 1 - u**2 == pytest.approx(0.9141, abs=2e-4)
     rhomb = np.array([[0.0, 0.0], [5.0, 5.0], [0.0, 10.0], [-5.0, 5.0]])  # a = 10 cm
-    assert theory.polygon_area(rhomb, np.array([[0, 1, 2, 3]]))[0] == pytest.approx(50.0)
+    assert isa_theory.polygon_area(rhomb, np.array([[0, 1, 2, 3]]))[0] == pytest.approx(50.0)

@@ -27,47 +27,35 @@ def test_assemble_puts_the_claims_first_and_every_part_after(tmp_path):
     assert order == sorted(order)
 
 
-def _method_tables(tmp_path, sph_left, sph_status):
-    single = pd.DataFrame([
-        dict(method="isa", variant="paper", run="a", spacing_cm=10, particles=180, status="cycle", steps=8000,
-             dynamic=False, wall_time_s=0.03, side_err=0.001, contact_rms=0.1, side_height_err_cm=0.1, level_err_hydro_cm=0),
-        dict(method="isa", variant="capped", run="b", spacing_cm=10, particles=180, status="converged", steps=9964,
-             dynamic=False, wall_time_s=0.04, side_err=-0.045, contact_rms=0.17, side_height_err_cm=2.3,
-             level_err_hydro_cm=0),
-        dict(method="sph", variant="wcsph", run="c", spacing_cm=2.5, particles=1160, status="step_limit", steps=9,
-             dynamic=True, wall_time_s=9.0, side_err=0.005, contact_rms=0.002, side_height_err_cm=0.4,
-             level_err_hydro_cm=0),
-    ])
-    flow = pd.DataFrame([
-        dict(method="isa", variant="capped", run="flow_complete_capped", spacing_cm=10, particles=180, status="converged",
-             left_fraction=30 / 180, depth=31.4, slope_deg=-10.2, surface_range_cm=39.8, side_err=0.32),
-        dict(method="sph", variant="wcsph", run="flow_wcsph_dx2.5", spacing_cm=2.5, particles=1160, status=sph_status,
-             left_fraction=sph_left, depth=32.2, slope_deg=-0.5, surface_range_cm=3.0, side_err=0.08),
-    ])
-    paths = [tmp_path / "single.csv", tmp_path / "flow.csv"]
-    single.to_csv(paths[0], index=False)
-    flow.to_csv(paths[1], index=False)
-    return [str(p) for p in paths]
+def _compare_table(tmp_path, sph_left, sph_status):
+    rows = [
+        dict(method="isa", variant="capped", run="flow_complete_capped", tank="flow_step50", spacing_cm=10,
+             particles=180, status="converged", left_fraction=30 / 180, second_slope_deg=-10.2,
+             second_surface_range_cm=39.8, compare=True),
+        dict(method="sph", variant="wcsph", run="flow_wcsph_dx2.5", tank="flow_step50", spacing_cm=2.5, particles=1160,
+             status=sph_status, left_fraction=sph_left, second_slope_deg=-0.5, second_surface_range_cm=3.0,
+             compare=True),
+    ]
+    path = tmp_path / "runs.csv"
+    pd.DataFrame(rows).to_csv(path, index=False)
+    return str(path)
 
 
-def test_methods_section_judges_equilibria_and_time_averaged_states_only(tmp_path):
-    """A static run in a cycle (here with a lucky 0.1 % side error) is not judged; a dynamic run at its time
-    limit is; the liquid's share left at its time limit bounds its share at rest, so 17 % against 5 % is
-    'not reproduced' (tolerance one floor row, 10/180 = 5.6 %); 10 % against 5 % would be within it."""
-    from isaflow.report import methods
+def test_damping_claim_bounds_the_liquid_left_at_its_time_limit(tmp_path):
+    """The liquid's share left at its time limit bounds its share at rest, so 17 % against 5 % is
+    'not reproduced' (tolerance one floor row, 10/180 = 5.6 %)."""
+    from isaflow.methods.isa.report import claims
 
-    out = [str(tmp_path / "70.md"), str(tmp_path / "claims.csv")]
-    methods.methods_section(*_method_tables(tmp_path, 0.05, "step_limit"), out)
-    text = open(out[0]).read()
-    assert "isa 4.50%; sph 0.50%" in text
-    row = pd.read_csv(out[1]).iloc[0]
+    out = [str(tmp_path / "claims.csv")]
+    claims.damping_claim(_compare_table(tmp_path, 0.05, "step_limit"), out)
+    row = pd.read_csv(out[0]).iloc[0]
     assert row["verdict"] == "not reproduced" and "upper bound" in row["measured"]
 
 
-def test_methods_verdict_needs_the_heap_gone_as_well(tmp_path):
+def test_damping_verdict_needs_the_heap_gone_as_well(tmp_path):
     """Mass left within a floor row is not enough: the ISA surface range (39.8 cm) must be within a/2 = 5 cm."""
-    from isaflow.report import methods
+    from isaflow.methods.isa.report import claims
 
-    out = [str(tmp_path / "70.md"), str(tmp_path / "claims.csv")]
-    methods.methods_section(*_method_tables(tmp_path, 0.12, "converged"), out)
-    assert pd.read_csv(out[1]).iloc[0]["verdict"] == "not reproduced"
+    out = [str(tmp_path / "claims.csv")]
+    claims.damping_claim(_compare_table(tmp_path, 0.12, "converged"), out)
+    assert pd.read_csv(out[0]).iloc[0]["verdict"] == "not reproduced"

@@ -17,10 +17,9 @@ split step on, chunk-end samples after it.
 
 import numpy as np
 import pytest
-import yaml
-from conftest import L_B, L_P, R_B, R_P
+from conftest import L_B, L_P, R_B, R_P, run_spec
 
-from isaflow import cli, runfile
+from isaflow import runfile
 
 WALLS = [{"name": "left", "from": [0, 80], "to": [0, 0]}, {"name": "floor", "from": [0, 0], "to": [80, 0]},
          {"name": "right", "from": [80, 0], "to": [80, 80]}]
@@ -49,18 +48,12 @@ SETTLED = {**SCENE, "walls": [{"name": "left", "from": [0, 60], "to": [0, 0]},
                                                      "bottom_y": 5.0}}}
 
 
-def run(tmp_path, name, rule, *sets, base=SCENE):
+def run(tmp_path, name, rule, *sets, base=SCENE, start=None):
     spec = {**base, "solver": {**base["solver"], **RULES[rule]}}
-    path = tmp_path / "scene.yaml"
-    path.write_text(yaml.safe_dump(spec))
+    spec["solver"].pop("accept", None)
     out = tmp_path / f"{name}.nc"
-    assert cli.run(str(path), str(out), list(sets), quiet=True) == 0
+    assert run_spec(tmp_path, spec, out, sets, start) == 0
     return out
-
-
-def from_run(path):
-    """Override replacing the lattice by a start file."""
-    return f"particles={{weight: 50.0, from_run: '{path}'}}"
 
 
 def assert_continues(whole, leg2, split):
@@ -89,7 +82,7 @@ def split_and_compare(tmp_path, rule, splits, base=SCENE):
     for split in sorted(s for s in splits(total) if 0 < s < total):
         leg1 = run(tmp_path, f"leg1_{split}", rule, f"solver.max_steps={split}", base=base)
         assert int(runfile.read(leg1)["steps"]) == split
-        leg2 = run(tmp_path, f"leg2_{split}", rule, from_run(leg1), base=base)
+        leg2 = run(tmp_path, f"leg2_{split}", rule, base=base, start=leg1)
         assert_continues(whole, runfile.read(leg2), split)
     return whole
 
@@ -112,6 +105,6 @@ def test_a_changed_scene_continues_from_positions_only(tmp_path):
     """Another update rule (or walls, laws, du, ...) is a new problem from a previous state, as in the
     paper's applications 3-4: the run file says so, and the continued run starts FIRE and the list afresh."""
     leg1 = run(tmp_path, "leg1", "paper", "solver.max_steps=150")
-    leg2 = runfile.read(run(tmp_path, "leg2", "capped", from_run(leg1), "solver.max_steps=300"))
+    leg2 = runfile.read(run(tmp_path, "leg2", "capped", "solver.max_steps=300", start=leg1))
     assert leg2.attrs["restart"].startswith("positions only") and "variant" in leg2.attrs["restart"]
     assert leg2.attrs["start_sha256"] == runfile.sha256(leg1) and leg2.attrs["start_file"] == str(leg1)

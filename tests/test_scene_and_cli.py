@@ -1,4 +1,5 @@
-"""Scene validation, CLI exit codes, run-file contents and provenance."""
+"""Tanks, the one settings loader, ISA scenes built from them, `isaflow run` exit codes, run-file
+contents and provenance."""
 
 import subprocess
 import sys
@@ -7,76 +8,115 @@ import numpy as np
 import pytest
 import yaml
 
-from isaflow import cli, runfile, scene
+from isaflow import cli, runfile, settings as S, tank as T
+from isaflow.inputs import InputError
+from isaflow.methods.isa import scene
+from isaflow.methods.isa.settings import VALUES
 
-from conftest import ROOT, SCENES, TINY
+from conftest import ISA_SETTINGS, ROOT, TANKS, TINY, run_spec, write_spec
 
 TINY = {**TINY, "solver": {**TINY["solver"], "history": {"every": 10}}}
 
 
-def write_scene(tmp_path, spec, name="scene.yaml"):
-    path = tmp_path / name
-    path.write_text(yaml.safe_dump(spec))
-    return path
+def test_paper_resolutions_build_the_paper_particle_counts():
+    assert len(scene.initial_positions(scene.of_run("single", "coarse", "paper"))) == 180
+    assert len(scene.initial_positions(scene.of_run("single", "refined", "paper"))) == 684
 
 
-def test_paper_scenes_load_with_the_paper_particle_counts():
-    assert len(scene.initial_positions(scene.load(SCENES / "single_coarse.yaml"))) == 180
-    assert len(scene.initial_positions(scene.load(SCENES / "single_refined.yaml"))) == 684
+def test_every_tank_loads_and_states_its_theory():
+    for path in sorted(TANKS.glob("*.yaml")):
+        t = T.load(path)
+        assert t.rho_g > 0 and t.depth > 0 and len(t.walls) >= 3
+    t = T.load(TANKS / "single.yaml")
+    assert t.rho_g == pytest.approx(9000 / 7250) and t.rho_g * t.depth**2 / 2 == pytest.approx(3262.5)
 
 
-def test_unknown_key_is_rejected_naming_file_and_field(tmp_path):
-    spec = {**TINY, "solver": {**TINY["solver"], "stepsize": 1}}
-    path = write_scene(tmp_path, spec)
-    with pytest.raises(scene.SceneError, match=r"scene\.yaml: field 'solver'.*'stepsize'"):
-        scene.load(path)
+def test_unknown_settings_key_is_rejected_naming_file_and_field(tmp_path):
+    tp, sp = write_spec(tmp_path, TINY)
+    spec = yaml.safe_load(sp.read_text())
+    spec["solver"]["stepsize"] = {"value": 1, "source": "inferred: test"}
+    sp.write_text(yaml.safe_dump(spec))
+    with pytest.raises(InputError, match=r"settings\.yaml: field 'solver'.*'stepsize'"):
+        S.load(sp, VALUES, "paper", "r")
 
 
 def test_wrong_type_names_the_field(tmp_path):
     spec = {**TINY, "forces": {**TINY["forces"], "wall": {**TINY["forces"]["wall"], "l_u": -1}}}
-    with pytest.raises(scene.SceneError, match=r"field 'forces\.wall\.l_u'"):
-        scene.load(write_scene(tmp_path, spec))
+    tp, sp = write_spec(tmp_path, spec)
+    with pytest.raises(InputError, match=r"field 'forces\.wall\.l_u\.value'"):
+        S.load(sp, VALUES, "paper", "r")
 
 
 def test_particles_outside_the_walls_are_an_impossible_geometry(tmp_path):
     spec = {**TINY, "particles": {**TINY["particles"], "lattice": {**TINY["particles"]["lattice"], "center_x": 50.0}}}
-    with pytest.raises(scene.SceneError, match="outside the walls' bounding box"):
-        scene.load(write_scene(tmp_path, spec))
+    tp, sp = write_spec(tmp_path, spec)
+    with pytest.raises(InputError, match="outside the walls' bounding box"):
+        scene.build(T.load(tp), S.load(sp, VALUES, "capped", "r"), "capped")
 
 
 def test_zero_length_wall_and_nan_points_are_rejected(tmp_path):
     spec = {**TINY, "walls": TINY["walls"] + [{"name": "dot", "from": [5, 5], "to": [5, 5]}]}
-    with pytest.raises(scene.SceneError, match=r"field 'walls' \(dot\): segment has zero length"):
-        scene.load(write_scene(tmp_path, spec))
+    tp, _ = write_spec(tmp_path, spec)
+    with pytest.raises(InputError, match=r"field 'walls' \(dot\): segment has zero length"):
+        T.load(tp)
     spec = {**TINY, "particles": {"weight": 1.0, "points": [[1.0, float("nan")]]}}
-    with pytest.raises(scene.SceneError, match="must be finite"):
-        scene.load(write_scene(tmp_path, spec))
+    tp, sp = write_spec(tmp_path, spec)
+    with pytest.raises(InputError, match="must be finite"):
+        S.load(sp, VALUES, "paper", "r")
 
 
-def test_override_of_a_missing_field_is_an_error(tmp_path):
-    with pytest.raises(scene.SceneError, match="override 'solver.bogus.x': no field 'bogus'"):
-        scene.load(write_scene(tmp_path, TINY), ["solver.bogus.x=1"])
+def test_override_of_a_missing_setting_is_an_error():
+    with pytest.raises(InputError, match=r"override field 'solver\.bogus': no such setting"):
+        S.load(ISA_SETTINGS, VALUES, "paper", "coarse", ["solver.bogus=1"])
 
 
-def test_bad_scene_exits_2_and_writes_nothing(tmp_path, capsys):
+def test_resolution_and_variant_must_exist():
+    with pytest.raises(InputError, match="no resolution 'nope'"):
+        S.load(ISA_SETTINGS, VALUES, "paper", "nope")
+    with pytest.raises(InputError, match="no variant 'nope'"):
+        S.load(ISA_SETTINGS, VALUES, "nope", "coarse")
+
+
+def test_a_resolution_then_overrides_set_the_values():
+    s = S.load(ISA_SETTINGS, VALUES, "paper", "refined", ["solver.du=0.005"])
+    assert s["particles.weight"] == 12.5 and s["solver.du"] == 0.005 and s["particles.lattice.a"] == 5.0
+    assert s.sources["particles.weight"].startswith("page text") and "command line" in s.sources["solver.du"]
+
+
+def test_bad_settings_exit_2_and_write_nothing(tmp_path, capsys):
     out = tmp_path / "run.nc"
-    code = cli.run(str(write_scene(tmp_path, {**TINY, "extra": 1})), str(out), quiet=True)
+    tp, sp = write_spec(tmp_path, TINY)
+    spec = yaml.safe_load(sp.read_text())
+    spec["extra"] = 1
+    sp.write_text(yaml.safe_dump(spec))
+    code = cli.main(["run", "--method", "isa", "--tank", str(tp), "--settings", str(sp), "--variant", "capped",
+                     "--resolution", "r", "-o", str(out)])
     assert code == 2 and not out.exists()
-    assert "scene.yaml" in capsys.readouterr().err
+    assert "settings.yaml" in capsys.readouterr().err
 
 
 def test_unaccepted_outcome_exits_1_and_writes_nothing(tmp_path, capsys):
     out = tmp_path / "run.nc"
     spec = {**TINY, "solver": {**TINY["solver"], "max_steps": 50}}
-    code = cli.run(str(write_scene(tmp_path, spec)), str(out), quiet=True)
-    assert code == 1 and not out.exists() and not list(tmp_path.glob(".*tmp*"))
+    tp, sp = write_spec(tmp_path, spec)
+    code = cli.main(["run", "--method", "isa", "--tank", str(tp), "--settings", str(sp), "--variant", "capped",
+                     "--resolution", "r", "-o", str(out)])
+    assert code == 1 and not out.exists() and not list(tmp_path.glob(".*partial*"))
     assert "outcome 'step_limit' is not accepted" in capsys.readouterr().err
+
+
+def test_a_method_that_runs_on_no_tank_is_refused(tmp_path, capsys):
+    code = cli.main(["run", "--method", "sph1d", "--tank", str(TANKS / "single.yaml"), "--variant", "x",
+                     "--resolution", "r", "-o", str(tmp_path / "r.nc")])
+    assert code == 2 and "does not run on tanks" in capsys.readouterr().err
 
 
 def test_tiny_scene_end_to_end_through_the_command_line(tmp_path):
     out = tmp_path / "run.nc"
-    proc = subprocess.run([sys.executable, "-m", "isaflow.cli", "run", str(write_scene(tmp_path, TINY)), "-o",
-                           str(out), "-q"], capture_output=True, text=True, cwd=ROOT)
+    tp, sp = write_spec(tmp_path, TINY)
+    proc = subprocess.run([sys.executable, "-m", "isaflow.cli", "run", "--method", "isa", "--tank", str(tp),
+                           "--settings", str(sp), "--variant", "capped", "--resolution", "r", "-o", str(out)],
+                          capture_output=True, text=True, cwd=ROOT)
     assert proc.returncode == 0, proc.stderr
     ds = runfile.read(out)
     # physics: converged, and the walls carry the weight of the 4 particles
@@ -84,12 +124,21 @@ def test_tiny_scene_end_to_end_through_the_command_line(tmp_path):
     assert ds["wall_resultant"].sel(xy="y").sum() == pytest.approx(200.0, abs=4 * 0.1)
     # every variable has units; provenance is complete
     assert all("units" in ds[v].attrs for v in ds.variables if v not in ds.coords)
-    for key in ("git_commit", "git_dirty", "scene_sha256", "config_sha256", "package_versions", "command",
-                "time_coverage_start", "time_coverage_end", "Conventions", "variant_label"):
+    for key in ("git_commit", "git_dirty", "tank_sha256", "settings_sha256", "package_versions", "command",
+                "time_coverage_start", "time_coverage_end", "Conventions", "variant_label", "settings_resolved",
+                "tank_weight", "tank_rho_g", "layer_pitch", "held_weight", "tank_difference", "threads"):
         assert ds.attrs[key] not in ("", None), key
     assert "ACDD" in ds.attrs["Conventions"] and "numba==" in ds.attrs["package_versions"]
-    assert yaml.safe_load(ds.attrs["scene_yaml"])["name"] == "tiny"
-    assert not list(tmp_path.glob(".*tmp*"))
+    assert "solver.du = 0.01" in ds.attrs["settings_resolved"]
+    assert not list(tmp_path.glob(".*partial*"))
+
+
+def test_a_declared_run_runs_by_its_id(tmp_path):
+    out = tmp_path / "sc.nc"
+    assert cli.main(["run", "--method", "isa", "--run", "single_coarse", "-o", str(out)]) == 0
+    ds = runfile.read(out)
+    assert ds.attrs["run_id"] == "single_coarse" and ds.attrs["resolution"] == "coarse"
+    assert ds.attrs["status"] == "cycle" and ds.sizes["particle"] == 180
 
 
 def test_equilibrium_balances_the_weight(single_runs):
@@ -103,3 +152,7 @@ def test_equilibrium_balances_the_weight(single_runs):
         assert abs(R[0]) <= n * 0.1
         # per-particle residuals are all below f_tol, so the sum is bounded as well
         assert np.abs(ds["force"].values).max() < 0.1
+
+
+def test_run_spec_helper_runs_a_scene(tmp_path):
+    assert run_spec(tmp_path, TINY, tmp_path / "x.nc") == 0

@@ -14,7 +14,7 @@ import pytest
 
 from isaflow.methods.solid import cases as C
 from isaflow.methods.solid import claims, lattice, settings, solve, theory
-from isaflow.scene import SceneError
+from isaflow.inputs import InputError as SceneError
 
 CFG_PATH = Path(__file__).parents[1] / "config/methods/solid.yaml"
 CFG = settings.load(CFG_PATH)

@@ -16,7 +16,8 @@ from isaflow.methods.sph import kernels as K
 from isaflow.methods.sph import particles as P
 from isaflow.methods.sph import settings as S
 from isaflow.methods.sph import solver
-from isaflow.scene import SceneError, load_tank
+from isaflow.inputs import InputError as SceneError
+from isaflow.tank import load as load_tank
 
 ROOT = Path(__file__).resolve().parents[1]
 SINGLE = load_tank(ROOT / "config" / "tanks" / "single.yaml")

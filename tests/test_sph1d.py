@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from isaflow.methods.sph1d import closed_form, column, settings, sweep, system
-from isaflow.scene import SceneError
+from isaflow.inputs import InputError as SceneError
 
 KERNELS = ("cubic_spline", "wendland_c2", "wendland_c4", "wendland_c6")
 FLOORS = ("mirror_hydrostatic", "mirror_equal")

@@ -5,15 +5,15 @@ import copy
 
 import numpy as np
 import pytest
-import yaml
 
-from isaflow import cli, runfile, tables
+from isaflow import runfile
+from isaflow.methods.isa import tables
 
-from conftest import BOX, OUTCOMES as ALL, TINY
+from conftest import BOX, OUTCOMES as ALL, TINY, run_spec
 from isaflow.core import geometry as GEO
 from isaflow.methods.isa import relax as R
 
-TINY = {**TINY, "solver": {**TINY["solver"], "accept": ALL}}
+
 
 
 def scene(**changes):
@@ -26,11 +26,9 @@ def scene(**changes):
 
 
 def run(tmp_path, spec):
-    """Run a scene through the command-line entry point; returns the run file."""
-    path = tmp_path / "scene.yaml"
-    path.write_text(yaml.safe_dump(spec))
+    """Run a scene through isaflow.run (the command line's path), every outcome accepted; the run file."""
     out = tmp_path / "run.nc"
-    assert cli.run(str(path), str(out), quiet=True) == 0
+    assert run_spec(tmp_path, spec, out, accept=ALL) == 0
     return runfile.read(out)
 
 

@@ -12,14 +12,16 @@ import pytest
 import xarray as xr
 import yaml
 
-from isaflow import metrics, scene, tables, theory
-from isaflow import plan as plans
+from isaflow import settings as S, theory
+from isaflow.methods.isa import metrics, scene, tables
+from isaflow.methods.isa import plan as plans
 from isaflow.methods.isa.solver import DETECTED_BY
-from isaflow.methods.isa.settings import fire_dt_max, settings
+from isaflow.methods.isa.settings import VALUES, fire_dt_max, settings
 
-from conftest import ROOT
+from conftest import ISA_SETTINGS, ROOT
 
-STUDY = yaml.safe_load((ROOT / "config" / "study.yaml").read_text())["study"]
+STUDY = yaml.safe_load((ROOT / "config" / "methods" / "isa_study.yaml").read_text())["study"]
+SPEC = S.read(ISA_SETTINGS, VALUES)
 CI_CONFIG = ROOT / "tests" / "data" / "study_ci.yaml"
 
 
@@ -97,7 +99,11 @@ def test_law_usage_by_hand():
 
 @pytest.fixture(scope="module")
 def plan():
-    return plans.plan(STUDY)
+    return {k: {**v["meta"], **v} for k, v in plans.plan(STUDY, SPEC).items()}
+
+
+def planned_scene(m, sets=True):
+    return scene.of_run(m["tank"], m["resolution"], m["variant"], m["set"] if sets else (), ISA_SETTINGS)
 
 
 def test_plan_covers_the_issue(plan):
@@ -106,12 +112,13 @@ def test_plan_covers_the_issue(plan):
     assert {v["variant"] for v in er.values()} == {"paper", "capped", "fire"}
     factors = {v["du_factor"] for v in er.values()}
     assert min(factors) <= 0.1 and max(factors) >= 10
-    spacings = [scene.load(STUDY["lattices"][k]["scene"]).spacing for k in ("coarse", "refined", "fine", "finer")]
+    spacings = [scene.of_run("single", STUDY["lattices"][k]["resolution"], "paper").spacing
+                for k in ("coarse", "refined", "fine", "finer")]
     assert spacings == sorted(spacings, reverse=True) and spacings[-1] < 5.0 / 2 + 1e-12  # two finer than the paper's
     cases = {v["case"] for v in plan.values() if v["group"] == "cases"}
     assert cases >= {"stiff", "du_large", "du_small", "overlap", "coincident", "on_wall", "narrow_opening", "shallow",
                      "tall", "lattice_100k", "float_limit"}
-    big = scene.load(STUDY["cases"]["list"]["lattice_100k"]["scene"])
+    big = scene.of_run("single", STUDY["cases"]["list"]["lattice_100k"]["resolution"], "fire")
     assert len(scene.initial_positions(big)) >= 100_000
     # the map reaches k du far above w and du far above and below the paper's
     sm = [v for v in plan.values() if v["group"] == "stability_map"]
@@ -121,11 +128,11 @@ def test_plan_covers_the_issue(plan):
 
 def test_every_planned_run_is_a_valid_scene_with_its_du(plan):
     for sid, m in plan.items():
-        sc = scene.load(m["scene"], m["set"])  # raises SceneError naming the field otherwise
+        sc = planned_scene(m)  # raises InputError naming the field otherwise
         s = settings(sc)
-        assert s["variant"] == m["variant"] and s["history"] == {} and set(s["accept"]) == set(DETECTED_BY), sid
+        assert s["variant"] == m["variant"] and s["history"] == {} and set(m["accept"]) == set(DETECTED_BY), sid
         if m["group"] != "cases":
-            base = settings(scene.load(m["scene"]))["du"]
+            base = settings(planned_scene(m, sets=False))["du"]
             assert s["du"] == pytest.approx(m["du_factor"] * base, rel=1e-7), sid
         if m["variant"] == "fire":
             k = 2 * sc.stiffness("wall") + 12 * sc.stiffness("pair")
@@ -138,9 +145,9 @@ def test_fire_dt_max_of_the_paper_stiffness():
 
 
 @pytest.mark.parametrize("x", [1e-5, 0.01, 3535.5339, 1e8, 1e308, 2.5e-300])
-def test_override_numbers_read_back_as_floats(x):
-    y = yaml.safe_load(plans._num(x))
-    assert isinstance(y, float) and y == pytest.approx(x, rel=1e-7)
+def test_planned_numbers_keep_eight_digits(x):
+    y = plans._num(x)
+    assert isinstance(y, float) and y == pytest.approx(x, rel=1e-7) and y == float(f"{x:.8g}")
 
 
 def test_outcome_detail_separates_the_two_escapes():
@@ -179,7 +186,7 @@ def test_reduced_study_builds_both_figures_and_the_report_fragment(tmp_path):
         src = ROOT / item
         (shutil.copytree if src.is_dir() else shutil.copy)(src, tmp_path / item)
     (tmp_path / "src").symlink_to(ROOT / "src")  # rules depend on the package sources
-    shutil.copy(CI_CONFIG, tmp_path / "config" / "study.yaml")
+    shutil.copy(CI_CONFIG, tmp_path / "config" / "methods" / "isa_study.yaml")
     env = {**os.environ, "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}"}
     targets = ["figures/error_vs_runtime.png", "figures/stability_map.png", "results/report/30_study.md"]
     proc = subprocess.run([sys.executable, "-m", "snakemake", "-c2", *targets], cwd=tmp_path, env=env,
@@ -187,21 +194,21 @@ def test_reduced_study_builds_both_figures_and_the_report_fragment(tmp_path):
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
     for t in targets:
         assert (tmp_path / t).stat().st_size > 0
-    err = pd.read_csv(tmp_path / "figures" / "error_vs_runtime.csv").set_index("run")
+    err = pd.read_csv(tmp_path / "results" / "isa" / "study" / "error_vs_runtime.csv").set_index("run")
     assert len(err) == 6
     # physics: the capped update reaches f_tol at the paper's level (tolerance a/4 = 2.5 cm);
     # the literal update ends in its period-2 cycle
     cap = err.loc["er_coarse_capped_du1"]
     assert cap["status"] == "converged" and cap["residual"] < 0.1 and abs(cap["level_err_paper_cm"]) <= 2.5
     assert err.loc["er_coarse_paper_du1", "status"] == "cycle" and err.loc["er_coarse_paper_du1", "paper_config"]
-    cases = pd.read_csv(tmp_path / "figures" / "stability_cases.csv").set_index("run")
+    cases = pd.read_csv(tmp_path / "results" / "isa" / "study" / "stability_cases.csv").set_index("run")
     big = cases.loc["sc_du_large_paper"]
     assert big["status"] == "escaped" and "would cross wall 'floor' at step 0" in big["message"]
     assert (cases.loc[["sc_on_wall_paper", "sc_on_wall_fire"], "positions_finite"]).all()
-    smap = pd.read_csv(tmp_path / "results" / "study" / "stability_map.csv")
+    smap = pd.read_csv(tmp_path / "results" / "isa" / "study" / "stability_map.csv")
     assert len(smap) == 8 and set(smap["status"]) <= set(DETECTED_BY)
     # FIRE needs fewer force evaluations than the capped update and than the paper's reported 2000 steps
-    ratio = pd.read_csv(tmp_path / "results" / "study" / "fire_ratio.csv").iloc[0]
+    ratio = pd.read_csv(tmp_path / "results" / "isa" / "study" / "fire_ratio.csv").iloc[0]
     assert ratio["ratio_vs_capped"] > 1 and ratio["ratio_vs_paper_reported"] > 1
     # the Snakemake report of those targets holds both figures with their captions
     rep = subprocess.run([sys.executable, "-m", "snakemake", "--report", "report.html", *targets[:2]], cwd=tmp_path,

@@ -5,11 +5,12 @@ import pytest
 
 from isaflow import theory
 from isaflow.methods.isa import solver
-from isaflow.scene import rhombic_lattice
+from isaflow.methods.isa.scene import rhombic_lattice
 
 from conftest import box_walls
 from isaflow.methods.isa import forces as F
 from isaflow.core import neighbours as NB
+from isaflow.methods.isa import theory as isa_theory
 
 
 def test_wall_totals_are_the_hydrostatic_integrals():
@@ -66,7 +67,7 @@ def test_detect_cycle():
 
 def test_stiffness_matrix_of_one_particle_on_the_floor():
     walls = box_walls()
-    lam, floor = theory.step_floor(np.array([[50.0, 4.0]]), walls, 5.0, 10000.0, 7.07, 3535.5, 0.01)
+    lam, floor = isa_theory.step_floor(np.array([[50.0, 4.0]]), walls, 5.0, 10000.0, 7.07, 3535.5, 0.01)
     assert lam == pytest.approx(2000.0)  # k_b = 10000 / 5 N/cm, vertical only
     assert floor == pytest.approx(10.0)
 
@@ -75,7 +76,7 @@ def test_stiffness_matrix_is_the_force_jacobian():
     pos = rhombic_lattice(10.0, 5, [3, 4], 20.0, 4.0) + np.random.default_rng(1).normal(0, 0.3, (17, 2))
     walls = box_walls(40.0, 40.0)
     args = (walls, 5.0, 10000.0, 7.0710678, 3535.5339)
-    H = theory.stiffness_matrix(pos, *args).toarray()
+    H = isa_theory.stiffness_matrix(pos, *args).toarray()
 
     def force(p):
         

@@ -1,22 +1,25 @@
-"""Command line: ``isaflow run SCENE -o RUN.nc [--set key=value ...]``.
+"""Command line: ``isaflow run --method NAME --tank TANK --variant V --resolution R -o RUN.nc``.
 
-Exit codes: 0 success; 1 the run ended in an outcome the scene does not
-accept (no output written); 2 bad input: scene, override, start file,
-configuration file, output path or a run that cannot fit in memory, refused
+Runs any tank method of the registry on any tank (isaflow.run), or a run
+declared in the method's settings file (``--run ID``: its tank, variant,
+resolution, overrides and start).  Exit codes: 0 success; 1 the run ended in
+an outcome it does not accept (no output written); 2 bad input (tank,
+settings, override, start file, output path, a run that cannot fit), refused
 before any work with one line naming the file and the field; 3 the output
-could not be written after the solve; 130/143 interrupted (SIGINT/SIGTERM;
-the temporary file is removed).  No traceback is printed unless
-ISAFLOW_DEBUG=1.
+could not be written after the solve; 130/143 interrupted (SIGINT/SIGTERM; the
+temporary file is removed); 70 internal error.  No traceback is printed
+unless ISAFLOW_DEBUG=1.
 """
 
 import argparse
 import os
 import signal
 import sys
-from pathlib import Path
 
-from . import inputs, runfile
-from . import scene as scenes
+from . import inputs, methods
+from . import run as runs
+
+OUTCOMES = ("converged", "cycle", "step_limit", "escaped", "nonfinite", "solver_failed")
 
 
 def _interrupted(signum, frame):
@@ -27,99 +30,72 @@ def _error(msg):
     print(f"error: {msg}", file=sys.stderr)
 
 
-def prepare(scene_path, out, overrides=(), config=None):
-    """Every check that can refuse a run, before any work: (scene, start, settings) or SceneError/RunFileError."""
-    from .methods.isa.settings import settings
+def declared(method, run_id, settings_path=None):
+    """(tank path, variant, resolution, overrides, start path, accept) of a run declared in a settings file."""
+    from . import settings as S
+    from . import tank as T
 
-    scene = scenes.load(scene_path, overrides)
-    start = scenes.start_file(scene) if "from_run" in scene.spec["particles"] else None
-    if config is not None:
-        p = Path(config)
-        if not p.is_file():
-            raise scenes.SceneError(f"{config}: --config: not a readable regular file")
-        try:
-            with open(p, "rb"):
-                pass
-        except OSError as err:
-            raise scenes.SceneError(f"{config}: --config: {err.strerror or err}") from None
-    runfile.check_output(out)
-    inputs_read = {"the scene": scene_path, "--config": config, "particles.from_run": start and start["path"]}
-    for what, src in inputs_read.items():
-        if src and _same_file(src, out):
-            raise runfile.RunFileError(f"{out}: the output would overwrite {what} ('{src}'); choose another path")
-    return scene, start, settings(scene)
-
-
-def _same_file(a, b):
-    try:
-        return os.path.samefile(a, b)
-    except OSError:
-        return False
-
-
-def run(scene_path, out, overrides=(), config=None, quiet=False):
-    """Check, solve and write one run; returns the exit code (see the module docstring)."""
-    from .methods.isa import solver
-
-    try:
-        scene, start, s = prepare(scene_path, out, overrides, config)
-        if start is None:
-            pos0, weight, start_step, spacing = scenes.initial_state(scene)
-            state = None
-        else:
-            pos0, weight, start_step, spacing = start["pos"], start["weight"], start["steps"], start["spacing"]
-            state = start["state"]
-        files = {"scene": scene.path, "config": config, "start": start and start["path"]}
-        prov = runfile.provenance(files)
-    except (scenes.SceneError, runfile.RunFileError) as err:
-        _error(err)
-        return 2
-    except OSError as err:
-        _error(f"{getattr(err, 'filename', None) or scene_path}: {err.strerror or err}")
-        return 2
-    prov.update(scene_yaml=scene.text, scene_overrides="; ".join(scene.overrides) or "none",
-                scene_resolved_sha256=scene.digest, restart=start["restart"] if start else "none (fresh start)")
-    if start:
-        prov.update(start_sha256=start["sha256"], start_step=start["steps"])
-    started = runfile.now()
-
-    def progress(step, fmax):
-        if not quiet:
-            print(f"{scene.name}: step {step:>9d}  max|F| = {fmax:.4g} N", file=sys.stderr, flush=True)
-
-    result = solver.solve(scene, pos0, weight, start_step=start_step, progress=progress, state=state)
-    finished = runfile.now()
-    print(f"{scene.name}: {result.status}: {result.message} ({result.wall_time:.3f} s)", file=sys.stderr)
-    if result.status not in s["accept"]:
-        _error(f"{scene.path}: field 'solver.accept': outcome '{result.status}' is not accepted "
-               f"({', '.join(s['accept'])}); no output written")
-        return 1
-    try:
-        runfile.write(runfile.to_dataset(result, scene, prov, started, finished, spacing), out)
-    except (OSError, runfile.RunFileError) as err:
-        _error(f"{out}: the run finished but its file could not be written: {getattr(err, 'strerror', None) or err}")
-        return 3
-    return 0
+    m = methods.get(method)
+    spec = S.read(settings_path or m.settings, m.values_schema(), f"{method} settings")
+    decl = spec.get("runs", {}).get(run_id)
+    if decl is None:
+        raise inputs.InputError(f"{settings_path or m.settings}: field 'runs': no run '{inputs.printable(run_id)}' "
+                                f"(choose from {', '.join(spec.get('runs', {}))})")
+    start = f"results/runs/{method}/{decl['start']}.nc" if decl.get("start") else None
+    return (T.path_of(decl["tank"]), decl["variant"], decl["resolution"], decl.get("set", {}), start,
+            tuple(decl.get("accept", ["converged"])))
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="isaflow", description=__doc__.splitlines()[0])
     sub = ap.add_subparsers(dest="cmd", required=True)
-    r = sub.add_parser("run", help="relax one scene and write its netCDF run file")
-    r.add_argument("scene")
+    r = sub.add_parser("run", help="run one method on one tank and write its netCDF run file")
+    r.add_argument("--method", required=True, help=f"one of {', '.join(methods.PACKAGES)} (tank methods only)")
+    r.add_argument("--run", help="a run declared in the method's settings file (runs: section)")
+    r.add_argument("--tank", help="tank file, e.g. config/tanks/single.yaml")
+    r.add_argument("--variant")
+    r.add_argument("--resolution")
+    r.add_argument("--settings", help="settings file (default: the method's config/methods/<name>.yaml)")
+    r.add_argument("--start", help="run file of the same method to continue")
+    r.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override a setting")
+    r.add_argument("--accept", help=f"comma-separated outcomes that count as success (default converged; "
+                                    f"{', '.join(OUTCOMES)})")
+    r.add_argument("--threads", type=int, help="threads of the compiled loops (default: numba's)")
     r.add_argument("-o", "--out", required=True)
-    r.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override a scene field")
-    r.add_argument("--config", help="workflow config file to hash into the provenance")
-    r.add_argument("-q", "--quiet", action="store_true")
     args = ap.parse_args(argv)
-    for name in ("scene", "out", "config"):
-        bad = getattr(args, name) is not None and inputs.bad_string(getattr(args, name))
+    for name in ("method", "run", "tank", "variant", "resolution", "settings", "start", "out", "accept"):
+        value = getattr(args, name)
+        bad = value is not None and inputs.bad_string(value)
         if bad:
-            _error(f"argument {name} '{inputs.printable(getattr(args, name))}': {bad}")
+            _error(f"argument --{name} '{inputs.printable(value)}': {bad}")
             return 2
     signal.signal(signal.SIGTERM, _interrupted)
     try:
-        return run(args.scene, args.out, args.set, args.config, args.quiet)
+        overrides, accept = list(args.set), ("converged",)
+        if args.run:
+            tank, variant, resolution, decl_set, start, accept = declared(args.method, args.run, args.settings)
+            overrides = {**decl_set, **dict(runs.settings._parse(o, "--set", "override") for o in overrides)}
+            start = args.start or start
+        else:
+            missing = [f"--{n}" for n in ("tank", "variant", "resolution") if getattr(args, n) is None]
+            if missing:
+                _error(f"{', '.join(missing)} required (or --run ID of a declared run)")
+                return 2
+            tank, variant, resolution, start = args.tank, args.variant, args.resolution, args.start
+        if args.accept:
+            accept = tuple(a.strip() for a in args.accept.split(","))
+            bad = [a for a in accept if a not in OUTCOMES]
+            if bad:
+                _error(f"argument --accept: unknown outcome '{inputs.printable(bad[0])}' (choose from {', '.join(OUTCOMES)})")
+                return 2
+        if args.threads is not None and not 1 <= args.threads <= 64:
+            _error("argument --threads: must be between 1 and 64")
+            return 2
+        return runs.run(args.method, tank, variant, resolution, args.out, args.settings, overrides, start, accept,
+                        args.threads, args.run)
+    except inputs.InputError as err:
+        _error(err)
+        return 2
     except KeyboardInterrupt:
         _error("interrupted (SIGINT); no output written")
         return 130
@@ -128,7 +104,7 @@ def main(argv=None):
             _error("terminated (SIGTERM); no output written")
         raise
     except MemoryError:
-        _error("out of memory (the estimate in methods.isa.budget was too low: please report); no output written")
+        _error("out of memory (the method's memory estimate was too low: please report); no output written")
         return 2
     except Exception as err:
         if os.environ.get("ISAFLOW_DEBUG") == "1":

@@ -70,6 +70,7 @@ class Result:
     residual_name: str  # e.g. "max|F|" or "kinetic energy"
     residual_units: str
     sim_time: float = float("nan")  # s of physical time simulated (dynamic methods)
+    spacing: float = float("nan")  # cm, initial particle spacing (free-surface strip width)
     history: dict = field(default_factory=dict)
     fields: dict = field(default_factory=dict)
     params: dict = field(default_factory=dict)  # scalar settings, written as attributes

@@ -78,14 +78,16 @@ def _var(dims, data, units, long_name, **attrs):
     return xr.Variable(dims, data, {"units": units, "long_name": long_name, **attrs})
 
 
-def to_dataset(result, tank, prov, started, finished, spacing, references=""):
+def to_dataset(result, tank, prov, started, finished, spacing=None, references=""):
     """xarray Dataset of a contract.Result with CF/ACDD metadata.
 
-    tank: anything with name, walls (W, 4) cm, wall_names and spec (a
-    scene.Scene or scene.Tank); spacing: initial particle spacing [cm] (the
-    free-surface strip width); references: the papers the method follows.
+    tank: anything with name, walls (W, 4) cm, wall_names and spec (an
+    isaflow.tank.Tank; its liquid's theory attributes are recorded when it has
+    them); spacing: initial particle spacing [cm] (the free-surface strip
+    width), default result.spacing; references: the papers the method follows.
     """
     r = result
+    spacing = r.spacing if spacing is None else spacing
     walls = tank.walls
     vessels = tank.spec.get("vessels", [])
     xy = ("particle", "xy")
@@ -137,6 +139,7 @@ def to_dataset(result, tank, prov, started, finished, spacing, references=""):
         "status_message": r.message,
         "residual_name": r.residual_name,
         "spacing": float(spacing),
+        **(tank.attrs() if hasattr(tank, "attrs") else {}),
         **r.params,
         **prov,
     }

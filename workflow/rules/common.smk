@@ -1,24 +1,42 @@
-# Config validation and input functions shared by all rules.
+# Shared by every rules file: the project's source on the path (the workflow parses with only
+# Snakemake installed), every configuration file read through the project's hardened reader and
+# checked against its schema before any job starts, the method registry, register(), the run
+# declarations of every tank method, and the source files each rule depends on.
 import glob
 import os
+import sys
 
-from snakemake.utils import validate
+sys.path.insert(0, os.path.join(workflow.basedir, "src"))
 
-from isaflow.plan import set_args
-from isaflow.scene import load as load_scene
+from isaflow import deps as _deps  # noqa: E402
+from isaflow import inputs as _inputs  # noqa: E402
+from isaflow import methods as _methods  # noqa: E402
 
-validate(config, "../schemas/config.schema.yaml")
 
-RUNS = config["runs"]
+def refuse(message):
+    """Stop the workflow while it is parsed: one line naming the file and the field, exit status 2."""
+    print(f"error: {message}", file=sys.stderr)
+    raise SystemExit(2)
 
-# What each rules file contributes, read lazily by `rule all` and the report
-# (input functions run after every file is included, so include order does
-# not matter).  register(targets=[...]) adds files to the full target;
-# register(report=[...]) adds report fragments results/report/NN_name.md
-# (assembled in NN order); register(claims=[...]) adds claims-table CSVs
-# (columns: paper, section, claim, measured, verdict, evidence); register(timing=[...])
-# adds timing fragments results/timing/<part>.md, appended to docs/timing.md (everything
-# that changes from run to run goes there, never into docs/replication.md).
+
+def read_config(path, schema):
+    """A configuration file read by the hardened reader and checked against a schema (workflow/schemas/)."""
+    try:
+        _, schema_spec = _inputs.read_yaml(os.path.join(workflow.basedir, "workflow", "schemas", schema), "schema")
+        return _inputs.load(path, schema_spec, "workflow configuration")[1]
+    except _inputs.InputError as err:
+        refuse(err)
+
+
+config.update(read_config("config/config.yaml", "config.schema.yaml"))
+REGISTRY = _methods.registry()
+TANK_METHODS = [name for name, m in REGISTRY.items() if m.tank]
+
+# What each rules file contributes, read lazily by `rule all` and the report (input functions run
+# after every file is included, so include order does not matter): targets; report fragments
+# results/report/NN_name.md (assembled in NN order); claims-table CSVs; timing fragments
+# results/timing/NN_name.md (everything that changes from run to run goes there, never into
+# docs/replication.md).
 TARGETS = {"targets": [], "report": [], "claims": [], "timing": []}
 
 
@@ -29,15 +47,62 @@ def register(targets=(), report=(), claims=(), timing=()):
     TARGETS["timing"].extend(timing)
 
 
-def code(*patterns):
-    """Package source files a rule depends on (globs under src/isaflow, without .py),
-    so editing them reruns the rule."""
-    return sorted({f for p in patterns for f in glob.glob(f"src/isaflow/{p}.py")})
+def code(*modules):
+    """Source files (src/isaflow/...) of the given modules and everything they import (isaflow.deps), so
+    editing any of them reruns the rule.  A module is a dotted name ('isaflow.run', 'methods.isa.tables')
+    or a path glob under src/isaflow without '.py' ('methods/sph/*')."""
+    names = []
+    for m in modules:
+        if os.path.sep in m or "*" in m:
+            names += [os.path.relpath(f, "src")[:-3].replace(os.sep, ".")
+                      for f in sorted(glob.glob(f"src/isaflow/{m}.py"))]
+        else:
+            names.append(m)
+    return _deps.closure(*names)
 
 
-# what an ISA run executes
-SOLVER_CODE = code("core/*", "methods/__init__", "methods/isa/*", "contract", "scene", "runfile", "cli")
-FIGURE_CODE = code("figures/*", "metrics", "theory", "methods/__init__", "methods/isa/__init__")
+def func_code(func):
+    """code() of the module of an isaflow function named as call.py names it ('module.function')."""
+    return code(func.rsplit(".", 1)[0])
+
+
+# Run declarations of every tank method: {method: {run id: {tank, variant, resolution, set, accept,
+# start, threads, compare, label, meta}}} (isaflow.settings.RUN_SCHEMA); each method's rules file
+# declares its runs with declare_runs(); the one rule `run` (runs.smk) makes them.
+RUNS = {name: {} for name in TANK_METHODS}
+
+
+def declare_runs(method, runs):
+    for run_id, decl in runs.items():
+        if run_id in RUNS[method]:
+            refuse(f"{REGISTRY[method].settings}: field 'runs.{run_id}': run declared twice")
+        RUNS[method][run_id] = decl
+
+
+def run_file(method, run):
+    return f"results/runs/{method}/{run}.nc"
+
+
+def run_inputs(wc):
+    """Inputs of every tank run (runs.smk) - tank, settings, start file (a run of the same method), code."""
+    decl = RUNS[wc.method][wc.run]
+    m = REGISTRY[wc.method]
+    out = {"tank": f"config/tanks/{decl['tank']}.yaml", "settings": m.settings,
+           "code": code("isaflow.run", m.entry) + ["workflow/scripts/run.py"]}
+    if decl.get("start"):
+        out["start"] = run_file(wc.method, decl["start"])
+    return out
+
+
+def runtime_runs():
+    """Run files of the single-vessel runs a method adds to the error-against-run-time figure ('runtime: true')."""
+    return [run_file(m, r) for m in TANK_METHODS for r, d in RUNS[m].items() if d.get("runtime")]
+
+
+def compare_runs():
+    """Run files of every run a tank method marks 'compare: true' on the comparison's tanks (config.yaml)."""
+    tanks = set(config["compare"]["tanks"])
+    return [run_file(m, r) for m in TANK_METHODS for r, d in RUNS[m].items() if d.get("compare") and d["tank"] in tanks]
 
 
 def figure(name):
@@ -45,54 +110,16 @@ def figure(name):
     return [f"figures/{name}.png", f"figures/{name}.pdf"]
 
 
-def report_file(path, caption, category):
+def report_file(path, caption, category, subcategory=None):
     """path marked for the Snakemake report with the caption workflow/report/<caption>.rst."""
     # Snakemake resolves a caption against the directory of the rule file that calls this (rules/ or
     # rules/methods/), so give it the path from there
     rst = os.path.join(workflow.basedir, "workflow", "report", f"{caption}.rst")
-    return report(path, caption=os.path.relpath(rst, str(workflow.current_basedir)), category=category)
+    kw = {"subcategory": subcategory} if subcategory else {}
+    return report(path, caption=os.path.relpath(rst, str(workflow.current_basedir)), category=category, **kw)
 
 
-def report_figure(name, caption, category):
+def report_figure(name, caption, category, subcategory=None):
     """figure(name) with the PNG marked for the Snakemake report."""
     png, pdf = figure(name)
-    return [report_file(png, caption, category), pdf]
-
-
-def run_file(run):
-    return f"results/runs/{run}.nc"
-
-
-def run_overrides(wildcards):
-    return set_args(RUNS[wildcards.run].get("set", []))
-
-
-def start_file(run):
-    """The run file a run continues from (particles.from_run, after overrides), if any."""
-    spec = load_scene(RUNS[run]["scene"], RUNS[run].get("set", [])).spec
-    src = spec["particles"].get("from_run")
-    return [src] if src else []
-
-
-# runs whose metrics go into results/metrics.csv
-METRIC_RUNS = list(RUNS)
-
-
-CAL = config["calibration"]
-
-
-def calibration_overrides(wc):
-    """Scene overrides of one calibration point: k_b = kb, k_p = ratio kb."""
-    scene = load_scene(RUNS[wc.run]["scene"])
-    wall_l_u, _ = scene.law("wall")
-    pair_l_u, _ = scene.law("pair")
-    kb, ratio = float(wc.kb), float(wc.ratio)
-    sets = [
-        f"forces.wall.r_u={kb * wall_l_u}",
-        f"forces.pair.r_u={kb * ratio * pair_l_u}",
-        f"solver.variant={CAL['variant']}",
-        f"solver.max_steps={CAL['max_steps']}",
-        "solver.accept=[converged,cycle,step_limit]",
-        "solver.history={}",
-    ]
-    return set_args(sets)
+    return [report_file(png, caption, category, subcategory), pdf]

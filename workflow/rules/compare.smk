@@ -1,61 +1,73 @@
-# Every method on the same tank: one table, one figure, one report section, one claim.
-# The method summaries list each method's run files; all measures come from metrics on those files.
-METHOD_SUMMARIES = ["results/sph/summary.csv", "results/mps/summary.csv"]
+# Every method on every tank: one table (metrics.comparison_row of every compared run), the figures, the
+# report section.  Which runs take part is each method's declaration ('compare: true' on a tank of
+# config.yaml's compare.tanks; 'runtime: true' adds single-vessel points to the run-time figure).
 
 
-rule methods_tables:
+rule compare_table:
     input:
-        isa_errors="figures/error_vs_runtime.csv",
-        isa_metrics="results/metrics.csv",
-        summaries=METHOD_SUMMARIES,
-        code=code("tables", "metrics", "theory"),
+        runs=lambda wc: sorted(set(compare_runs()) | set(runtime_runs())),
+        code=code("tables"),
     output:
-        "figures/methods_error_vs_runtime.csv",
-        "figures/methods_flow.csv",
+        "results/compare/runs.csv",
     params:
-        func="tables.methods_tables",
+        func="tables.compare_table",
+        kw=lambda wc: {"compare": compare_runs()},
+    log:
+        "logs/compare/table.log",
     conda:
         "../envs/isaflow.yaml"
-    log:
-        "logs/compare/tables.log",
     script:
         "../scripts/call.py"
 
 
-rule fig_methods:
+rule compare_figure_tanks:
     input:
-        inputs=["figures/methods_error_vs_runtime.csv"],
-        code=FIGURE_CODE,
+        table="results/compare/runs.csv",
+        code=code("figures.methods"),
     output:
-        report_figure("methods_error_vs_runtime", "methods_figure", "Methods compared"),
+        report_figure("methods_tanks", "methods_figure", "Methods compared", "Every method on every tank"),
     params:
-        func="figures.methods.methods_error_vs_runtime_figure",
+        func="figures.methods.tanks_figure",
+    log:
+        "logs/compare/figure_tanks.log",
     conda:
         "../envs/isaflow.yaml"
-    log:
-        "logs/figures/methods_error_vs_runtime.log",
     script:
         "../scripts/call.py"
 
 
-rule report_methods:
+rule compare_figure_runtime:
     input:
-        single="figures/methods_error_vs_runtime.csv",
-        flow="figures/methods_flow.csv",
-        code=code("report/__init__", "report/methods"),
+        table="results/compare/runs.csv",
+        code=code("figures.methods"),
+    output:
+        report_figure("methods_error_vs_runtime", "methods_figure", "Methods compared", "Error against run time"),
+    params:
+        func="figures.methods.error_vs_runtime_figure",
+    log:
+        "logs/compare/figure_runtime.log",
+    conda:
+        "../envs/isaflow.yaml"
+    script:
+        "../scripts/call.py"
+
+
+rule compare_report:
+    input:
+        table="results/compare/runs.csv",
+        code=code("report.methods"),
     output:
         "results/report/70_methods.md",
-        "results/claims/methods.csv",
+        "docs/tables/methods_compare.csv",
     params:
         func="report.methods.methods_section",
+    log:
+        "logs/compare/report.log",
     conda:
         "../envs/isaflow.yaml"
-    log:
-        "logs/report/methods.log",
     script:
         "../scripts/call.py"
 
 
-register(targets=figure("methods_error_vs_runtime") + ["figures/methods_flow.csv"])
+register(targets=figure("methods_tanks") + figure("methods_error_vs_runtime") + ["docs/tables/methods_compare.csv"])
 register(report=["results/report/70_methods.md"])
-register(claims=["results/claims/methods.csv"])

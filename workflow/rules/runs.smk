@@ -1,23 +1,26 @@
-# One solver run per configured run id.
+# The one rule of every tank run of every method: results/runs/{method}/{run}.nc from the run's
+# declaration (tank, variant, resolution, overrides, start), passed to isaflow.run as data.
 
 
 rule run:
     input:
-        scene=lambda wc: RUNS[wc.run]["scene"],
-        start=lambda wc: start_file(wc.run),
-        code=SOLVER_CODE,
+        unpack(run_inputs),
     output:
-        "results/runs/{run}.nc",
+        "results/runs/{method}/{run}.nc",
     params:
-        overrides=run_overrides,
+        decl=lambda wc: RUNS[wc.method][wc.run],
+    threads: lambda wc: RUNS[wc.method][wc.run].get("threads", 1)
+    resources:
+        mem_mb=lambda wc: RUNS[wc.method][wc.run].get("mem_mb", 1000),
+        runtime=lambda wc: RUNS[wc.method][wc.run].get("runtime", 20),
+    log:
+        "logs/runs/{method}/{run}.log",
+    benchmark:
+        "results/benchmarks/runs/{method}/{run}.tsv"
+    wildcard_constraints:
+        method="|".join(TANK_METHODS),
+        run="[A-Za-z0-9_.]+",
     conda:
         "../envs/isaflow.yaml"
-    priority: 10  # the paper's own outputs first (snakemake -c2 paper)
-    log:
-        "logs/run/{run}.log",
-    benchmark:
-        "results/benchmarks/run/{run}.tsv"
-    wildcard_constraints:
-        run="|".join(RUNS),
-    shell:
-        "isaflow run {input.scene} -o {output} {params.overrides} --config config/config.yaml -q 2> {log}"
+    script:
+        "../scripts/run.py"

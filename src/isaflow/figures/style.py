@@ -21,8 +21,6 @@ OUTCOME_STYLE = {
     "nonfinite": ("k", "*"),
     "solver_failed": ("tab:brown", "P"),
 }
-LATTICE_MARKER = {"coarse": "o", "refined": "s", "fine": "^", "finer": "D"}
-METHOD_MARKER = {"isa": "o", "sph": "s", "mps": "^", "sph1d": "v", "solid": "D"}  # when methods share a figure
 
 
 def variant_style(method, variant):
@@ -31,6 +29,18 @@ def variant_style(method, variant):
 
     v = lookup(method, variant)
     return v.colour, v.label
+
+
+def method_marker(method):
+    """Marker of a method where methods share a figure (the registry's)."""
+    from ..methods import get
+
+    return get(method).marker
+
+
+def case_name(ds):
+    """'<tank>_<resolution>' of a run file (e.g. single_coarse): one name per tank and resolution."""
+    return f"{ds.attrs['tank']}_{ds.attrs['resolution']}"
 
 
 def save(fig, outputs):
@@ -50,9 +60,9 @@ def draw_walls(ax, ds, **kw):
 
 
 def run_caption(ds):
-    """One line naming the scene, the algorithm variant and the outcome."""
+    """One line naming the run, its tank, the algorithm variant and the outcome."""
     a = ds.attrs
-    return f"scene {a['scene']} | {a['variant_label']} | {a['status']}: {a['status_message']}"
+    return f"run {a.get('run_id', '')} on tank {a['tank']} | {a['variant_label']} | {a['status']}: {a['status_message']}"
 
 
 # ---- shared helpers for readable figures -------------------------------------------------

@@ -1,8 +1,18 @@
-"""Registry of methods and their variants: name -> solver, label, colour, in one place.
+"""Registry of methods and their variants: the one list of them, in one place.
 
-Each method lives in its own sub-package ``isaflow.methods.<name>`` that
-defines ``METHOD`` (a :class:`Method`).  Add a new method's package name to
-``PACKAGES``; nothing else branches on method names.
+Each method lives in its own sub-package ``isaflow.methods.<name>`` whose
+``__init__`` defines ``METHOD`` (a :class:`Method`) and imports nothing heavy,
+so the workflow reads the registry while it is parsed.  Add a new method's
+package name to ``PACKAGES``; nothing outside ``methods/`` names a method or
+a variant: labels, colours, markers, papers, settings files, claims files and
+report fragments all come from here.
+
+A *tank method* (``tank=True``) runs on the shared tanks: its ``entry``
+module provides ``check(tank, settings, variant, resolution, start)``,
+``solve(tank, settings, variant, resolution, start=None, progress=None,
+threads=None) -> contract.Result``, ``warm_up(threads)`` and
+``REFERENCES``; its ``values`` (``module:attribute``) is the schema of its
+settings file (isaflow.settings).
 """
 
 import importlib
@@ -17,15 +27,31 @@ class Variant:
     label: str  # says what it is and whether the paper states it
     colour: str
     marker: str = "o"
+    paper: bool = False  # True only for the paper's method as the paper states it
 
 
 @dataclass(frozen=True)
 class Method:
     name: str
     label: str
-    paper: str  # the paper in ../shared/papers the method replicates or completes
+    paper: str  # the paper in ../shared/papers the method replicates or completes (file stem)
+    paper_label: str = ""  # short citation, e.g. "Papadopoulos, Koutitas & Lazaridis (2016)"
+    marker: str = "o"  # where methods share a figure
     variants: dict = field(default_factory=dict)  # name -> Variant
-    solver: str = ""  # "module:function" of its solve()
+    tank: bool = False  # runs on the shared tanks through isaflow.run
+    entry: str = ""  # module with check / solve / warm_up / REFERENCES (tank methods)
+    values: str = ""  # "module:attribute" of the settings values schema (tank methods)
+    settings: str = ""  # default settings file, relative to the project root
+    report: str = ""  # the method's report fragment, results/report/NN_name.md
+    claims: str = ""  # its claims table, results/claims/<name>.csv
+    timing: str = ""  # its timing fragment, results/timing/NN_name.md
+
+    def entry_module(self):
+        return importlib.import_module(self.entry)
+
+    def values_schema(self):
+        module, attr = self.values.split(":")
+        return getattr(importlib.import_module(module), attr)
 
 
 def get(method):
@@ -36,15 +62,13 @@ def get(method):
 
 
 def registry():
-    """{method name: Method} of every registered sub-package that exists."""
-    out = {}
-    for pkg in PACKAGES:
-        try:
-            out[pkg] = get(pkg)
-        except ModuleNotFoundError as err:
-            if err.name != f"isaflow.methods.{pkg}":
-                raise
-    return out
+    """{method name: Method} of every registered sub-package."""
+    return {pkg: get(pkg) for pkg in PACKAGES}
+
+
+def tank_methods():
+    """{name: Method} of the methods that run on the shared tanks."""
+    return {k: m for k, m in registry().items() if m.tank}
 
 
 def variant(method, name):

@@ -1,87 +1,86 @@
-"""Report section and claims: every method on the same tank (single vessel and flow).
+"""Report section: every method on every shared tank, judged by one measure (results/compare/runs.csv).
 
-Deterministic: errors and end states only; solver times are in figures/methods_error_vs_runtime.* (timing files).
+Deterministic: end states and errors only (solver times are in the timing figure and docs/timing.md).
 """
 
 import numpy as np
 import pandas as pd
 
-from ..methods import label
+from ..methods import get
 from . import md_table, write
 
-CLAIM = '"approximates dynamic behavior with strong damping" (the static analysis ends where a damped liquid ends)'
+TIMING = ("wall_time_s",)
 
 
-FAILED = ("escaped", "nonfinite", "solver_failed")  # outcomes whose end state is not a state of the method
+def _pct(v):
+    return "" if not np.isfinite(v) else f"{v:+.1%}"
 
 
-def _judged(g):
-    """Runs whose wall loads are a state of the method: converged (its own stop criterion met, or at rest), or,
-    for dynamic methods (finite sim_time), at their time limit with loads averaged over the final window.  A
-    static method stopped at its step limit or in a detected cycle (an oscillation of size du) is not in
-    equilibrium and is left out."""
-    return g[(g["status"] == "converged") | ((g["status"] == "step_limit") & g["dynamic"].astype(bool))]
+def _cm(v):
+    return "" if not np.isfinite(v) else f"{v:.2f}"
 
 
-def _best(g, col):
-    """Smallest |col| among the judged runs (NaN if none)."""
-    ok = _judged(g)[col].abs()
-    return ok.min() if len(ok) else np.nan
+def _outcome(r):
+    if r["status"] == "converged":
+        return "at rest" if np.isfinite(r["sim_time_s"]) else "converged"
+    return str(r["status"]).replace("_", " ")
 
 
-def methods_section(single, flow, outputs):
-    """results/report/70_methods.md and results/claims/methods.csv."""
-    md, claims = outputs
-    s, f = pd.read_csv(single), pd.read_csv(flow)
+def _vessels(g):
+    names = [c[: -len("tank_surface_cm")] for c in g.columns if c.endswith("tank_surface_cm") and g[c].notna().any()]
+    return names or [""]
+
+
+def tank_table(g):
+    """One row per run of a tank: outcome, surfaces against the tank's level, wall-load errors of the receiving
+    vessel against the tank's theory and the run's own depth, what is left behind, flatness, tank difference."""
+    vess = _vessels(g)
+    recv = vess[-1]
     rows = []
-    for (method, variant), g in s.groupby(["method", "variant"], sort=False):
-        rows.append({"method": method, "variant": variant, "runs": len(g),
-                     "at rest / converged": int((g["status"] == "converged").sum()),
-                     "spacings (cm)": ", ".join(f"{x:.3g}" for x in sorted(g["spacing_cm"].unique(), reverse=True)),
-                     "best side err": _best(g, "side_err"), "best per-panel RMS": _best(g, "contact_rms"),
-                     "best resultant-height err (cm)": _best(g, "side_height_err_cm")})
-    fl = f[["method", "variant", "run", "particles", "status", "left_fraction", "depth", "slope_deg",
-            "surface_range_cm", "side_err"]].copy()
-    fl["left_fraction"] = fl["left_fraction"].map("{:.1%}".format)
-    text = ["## Methods compared on the same tank", "",
-            "Every method's run files are judged by the same functions (`isaflow.metrics`) on the same 10 cm wall "
-            "panels (per-contact loads for the point particles). Single vessel, W = 9 kN: best errors among the runs "
-            "whose loads are a state of the method: converged or at rest, or (dynamic methods) at their time limit "
-            "with loads averaged over the final window; not a static method stopped at its step limit or in a "
-            "detected cycle, nor an escaped, non-finite or failed run (solver times against these errors: "
-            "`figures/methods_error_vs_runtime.png`, a timing file):", "", md_table(pd.DataFrame(rows)), "",
-            "Flow into the second vessel, end states (level: mean top particle per strip above the second floor; a "
-            "liquid at rest has slope and range about 0 and leaves at most a film behind):", "", md_table(fl), ""]
-    judged = _judged(s)
-    floor = judged.assign(err=judged["side_err"].abs()).groupby("method", sort=False)["err"].min()
-    if "isa" in floor and len(floor) > 1:
-        others = "; ".join(f"{m} {e:.2%}" for m, e in floor.items() if m != "isa")
-        text += [f"Smallest side-wall error any judged run reaches, per method: isa {floor['isa']:.2%}; {others}. "
-                 f"Side-wall errors below {floor['isa']:.2%} are beyond every ISA update rule (paper, capped, fire) at any "
-                 "run time; above it, "
-                 "which method gets there sooner is a matter of solver time (`figures/methods_error_vs_runtime.png`, "
-                 "`docs/timing.md`).", ""]
+    for _, r in g.iterrows():
+        row = {"method": r["method"], "variant": r["variant"], "resolution": r["resolution"],
+               "particles": int(r["particles"]), "outcome": _outcome(r),
+               "t (s) / steps": f"{r['sim_time_s']:.3g} s" if np.isfinite(r["sim_time_s"]) else f"{int(r['steps']):,}"}
+        for v in vess:
+            name = v.rstrip("_") or "surface"
+            row[f"{name} (cm)"] = _cm(r.get(f"{v}surface_cm", np.nan))
+        if len(vess) > 1:
+            row["left"] = f"{r['left_fraction']:.1%}"
+        row["side err tank"] = _pct(r.get(f"{recv}side_err_tank", np.nan))
+        row["side err own"] = _pct(r.get(f"{recv}side_err_own", np.nan))
+        row["floor err tank"] = _pct(r.get(f"{recv}floor_err_tank", np.nan))
+        row["floor err own"] = _pct(r.get(f"{recv}floor_err_own", np.nan))
+        row["slope (deg)"] = f"{r.get(f'{recv}slope_deg', np.nan):+.1f}"
+        row["range (cm)"] = f"{r.get(f'{recv}surface_range_cm', np.nan):.1f}"
+        row["tank difference"] = r["tank_difference"] if isinstance(r["tank_difference"], str) else ""
+        rows.append(row)
+    theory = ", ".join(f"{(v.rstrip('_') or 'surface')} {g[f'{v}tank_surface_cm'].iloc[0]:.2f} cm" for v in vess)
+    return pd.DataFrame(rows), theory, recv.rstrip("_")
+
+
+def methods_section(table, outputs):
+    """results/report/70_methods.md and docs/tables/methods_compare.csv (every compared run, no timings)."""
+    md, csv = outputs
+    df = pd.read_csv(table)
+    df = df[df["compare"].astype(bool)].drop(columns=["compare", "file", *TIMING])
+    df.to_csv(csv, index=False, float_format="%.6g")
+    text = ["## Every method on every tank", "",
+            "Every run of every tank method is judged by the same functions (`isaflow.metrics.comparison_row`) "
+            "on the same tank. The free surface of a particle method is its top particle centres (mean over strips "
+            "one spacing wide) plus half its layer pitch (dy, l0 or the rhombic a / 2): where its own discretisation "
+            "puts the liquid's top. Wall-load errors are given twice: against the tank's theory (`tank`: the tank "
+            "file's W and rho g, the liquid at rest in its vessels) and against the run's own liquid (`own`: the "
+            "weight it holds in the vessel and the depth of its own surface). Dynamic methods run until at rest "
+            "(kinetic energy / (W h) below the ratio of `config/rest.yaml` for its window) or their time limit; "
+            "'at rest' is written only when met. Every difference of a run's liquid from the tank is in the last "
+            "column. All columns: [`docs/tables/methods_compare.csv`](tables/methods_compare.csv); solver times "
+            "against errors: `figures/methods_error_vs_runtime.png` (a timing figure), `figures/methods_tanks.png`.",
+            ""]
+    for tank, g in df.groupby("tank", sort=False):
+        t, theory, recv = tank_table(g)
+        where = f" of the {recv} vessel" if recv else ""
+        text += [f"### Tank `{tank}`", "",
+                 f"The tank's liquid at rest: {theory}. Wall-load errors are those{where}.", "", md_table(t), ""]
+    notes = sorted({f"`{m}`: {get(m).label}" for m in df["method"]})
+    text += ["Methods: " + "; ".join(notes) + ".", ""]
     write(text, md)
-    isa = f[(f["method"] == "isa") & (f["run"] == "flow_complete_capped")]
-    liquid = f[(f["method"] == "sph") & ~f["status"].isin(FAILED)].sort_values("particles")
-    if len(isa) and len(liquid):
-        i, q = isa.iloc[0], liquid.iloc[-1]
-        tol = 10 / i["particles"]  # one floor row of the coarse lattice (B / a = 10 particles) as a share
-        # the liquid only drains further: its share left at the time limit bounds its share at rest from above
-        bounded = q["status"] != "converged"
-        same = i["left_fraction"] - q["left_fraction"] <= tol and i["surface_range_cm"] <= i["spacing_cm"] / 2
-        state = "at rest" if not bounded else f"{q['status']}, still draining or sloshing: an upper bound"
-        measured = (f"ISA (capped, converged): {i['left_fraction']:.0%} left, surface slope {i['slope_deg']:+.1f} deg, "
-                    f"range {i['surface_range_cm']:.0f} cm; SPH, finest flow ({q['run']}, {state}): "
-                    f"{q['left_fraction']:.1%} left, slope {q['slope_deg']:+.1f} deg; tolerance one floor row "
-                    f"({tol:.1%}) and a/2")
-        verdict, why = ("reproduced", "") if same else (
-            "not reproduced", "the static analysis stops in a jammed granular state (a heap and stable floor layers) "
-                              f"that the damped liquid of {label('sph', q['variant']).split(':')[0]} does not reach: "
-                              "it drains to a film and its surface levels; a liquid that has not come to rest can only "
-                              "leave less behind, so its share left is an upper bound.")
-    else:
-        measured, verdict, why = "no SPH flow run", "not testable here (no liquid flow to compare)", ""
-    pd.DataFrame([dict(paper="papadopoulos2016", section="1, 7", claim=CLAIM, measured=measured, verdict=verdict,
-                       evidence="figures/methods_error_vs_runtime.png, results/report/70_methods.md",
-                       why=why or None)]).to_csv(claims, index=False)

@@ -1,12 +1,10 @@
 # Issue 11: MPS with three pressure source terms on the shared tank (single vessel, then the flow),
 # stiff and extreme cases.  Package: src/isaflow/methods/mps/.  Runs -> summary -> figures, claims,
 # report fragment 55.  Every rule calls one package function through scripts/call.py.
-import yaml as _mps_yaml
 
 MPS_CFG = "config/methods/mps.yaml"
-with open(MPS_CFG) as _fh:
-    _MPS = _mps_yaml.safe_load(_fh)
-MPS_VARIANTS = ["standard", "hattori", "mixed"]
+_MPS = _inputs.read_yaml(MPS_CFG)[1]
+MPS_VARIANTS = list(REGISTRY["mps"].variants)
 MPS_STIFF = ["large_dt", "small_re", "no_relaxation", "on_wall"]
 MPS_DX = {case: [f"{l0:.3g}" for l0 in _MPS["runs"][f"{case}_spacings"]["value"]] for case in ("single", "flow")}
 MPS_CODE = code("methods/mps/model", "methods/mps/operators", "methods/mps/boundary", "methods/mps/pressure", "methods/mps/solver",

@@ -12,12 +12,10 @@ SOLID_REPORT_FIGURES = [f for name in ("solid_bar", "solid_hertz") for f in repo
 # section 4.4 pressure vessel and the elastic floor of the single tank (one-way: loads from the coarsest
 # rigid-floor run of each method; the sph/mps rules files are read after this one, so their first
 # single-vessel run names are taken from their settings here)
-with open("config/methods/sph.yaml") as _fh:
-    _SOLID_SPH1 = __import__("yaml").safe_load(_fh)["runs"]["single"][0]
-with open("config/methods/mps.yaml") as _fh:
-    _SOLID_MPS1 = __import__("yaml").safe_load(_fh)["runs"]["single_spacings"]["value"][0]
+_SOLID_SPH1 = _inputs.read_yaml("config/methods/sph.yaml")[1]["runs"]["single"][0]
+_SOLID_MPS1 = _inputs.read_yaml("config/methods/mps.yaml")[1]["runs"]["single_spacings"]["value"][0]
 SOLID_FLOOR_LOADS = {
-    "isa": run_file("single_coarse"),
+    "isa": run_file("isa", "single_coarse"),
     "sph": "results/sph/single_wcsph_" + (f"n{_SOLID_SPH1['particles']}" if "particles" in _SOLID_SPH1
                                           else f"dx{_SOLID_SPH1['spacing']:g}") + ".nc",
     "mps": f"results/mps/single_standard_dx{_SOLID_MPS1:.3g}.nc",

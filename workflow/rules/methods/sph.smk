@@ -1,11 +1,9 @@
 # Weakly compressible SPH on the shared tank (single vessel, then the flow), figures, summary, claims,
 # report fragment 50.  Package: src/isaflow/methods/sph/.  Every rule calls one package function
 # through scripts/call.py.
-import yaml as _sph_yaml
 
 SPH_CFG = "config/methods/sph.yaml"
-with open(SPH_CFG) as _fh:
-    _SPH = _sph_yaml.safe_load(_fh)
+_SPH = _inputs.read_yaml(SPH_CFG)[1]
 
 SPH_VARIANTS = list(_SPH["variants"])
 # resolution ids as isaflow.methods.sph.outputs.res_id names them: n<particles> or dx<spacing>

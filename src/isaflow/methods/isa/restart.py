@@ -9,7 +9,8 @@ dynamics, so the continued run repeats the uninterrupted one bit for bit.
 import numpy as np
 
 from ... import runfile
-from ...scene import SceneError, check_positions
+from ...inputs import InputError as SceneError
+from ...tank import check_positions
 from . import budget, solver
 from .settings import settings
 
@@ -30,7 +31,7 @@ def start_file(scene):
     walls, another particle weight, or a step at or past solver.max_steps.
     """
 
-    field = "particles.from_run"
+    field = "start"
     src = scene.spec["particles"]["from_run"]
     where = f"{scene.path}: field '{field}'"
     try:
@@ -40,6 +41,7 @@ def start_file(scene):
     try:
         with ds:
             pos, weight, steps, spacing, state = _read_start(scene, ds, src, where, field)
+            chain = _chain(ds, spacing, weight)
     except SceneError:
         raise
     except (OSError, RuntimeError, ValueError, TypeError, KeyError, IndexError) as err:
@@ -61,7 +63,17 @@ def start_file(scene):
     budget.check_memory(scene, pos)
     state, restart = state
     return dict(pos=pos, weight=weight, steps=steps, spacing=spacing, path=src, sha256=runfile.sha256(src),
-                state=state, restart=restart)
+                state=state, restart=restart, chain=chain)
+
+
+def _chain(ds, spacing, weight):
+    """(layer_pitch cm, held_weight N, initial_depth cm, tank_difference) of the chain a start file belongs to."""
+    a = ds.attrs
+    try:
+        return (float(a.get("layer_pitch", spacing / 2)), float(a.get("held_weight", float(np.sum(weight)))),
+                float(a.get("initial_depth", np.nan)), str(a.get("tank_difference", "continued run")))
+    except (TypeError, ValueError):
+        return spacing / 2, float(np.sum(weight)), float("nan"), "continued run"
 
 
 def _read_start(scene, ds, src, where, field):

@@ -1,14 +1,44 @@
-"""ISA solver settings with every default resolved here, once (cm, N).
+"""ISA settings: the values of config/methods/isa.yaml (:data:`VALUES`, read by isaflow.settings)
+and the solver settings of a scene with every default resolved here, once (cm, N).
 
 A scene's ``solver`` block gives the update rule and its numbers; anything it
-leaves out is filled in by :func:`settings`.
+leaves out is filled in by :func:`settings`.  This module imports no numerics
+(the workflow reads the values while it is parsed).
 """
 
 import math
 
-from . import relax as R
+RULE_IDS = {"paper": 0, "capped": 1, "fire": 2}  # relax.PAPER, CAPPED, FIRE
+RULES = RULE_IDS
 
-RULES = {"paper": R.PAPER, "capped": R.CAPPED, "fire": R.FIRE}
+_POS = {"type": "number", "exclusiveMinimum": 0}
+_OPT_POS = {"type": ["number", "null"], "exclusiveMinimum": 0}
+_COUNT = {"type": "integer", "minimum": 1, "maximum": 2147483647}
+_LAW = {"enum": ["linear"]}
+_HISTORY = {"type": "object", "additionalProperties": False, "properties": {
+    "every": {"type": "integer", "minimum": 1, "maximum": 10**15},
+    "walls": {"type": "boolean"}, "vessels": {"type": "boolean"},
+    "snapshots": {"type": "integer", "minimum": 0, "maximum": 10**6}}}
+# {dotted key: JSON schema of the value} of config/methods/isa.yaml
+VALUES = {
+    "particles.weight": _POS,  # N per particle
+    "particles.points": {"type": ["array", "null"], "minItems": 1, "items": {
+        "type": "array", "items": {"type": "number"}, "minItems": 2, "maxItems": 2}},  # cm; null: the lattice
+    "particles.lattice.a": _POS,  # cm, rhomb diagonal
+    "particles.lattice.rows": _COUNT,
+    "particles.lattice.row_lengths": {"type": "array", "items": _COUNT, "minItems": 1, "maxItems": 2},
+    "particles.lattice.center_x": {"type": "number"},  # cm
+    "particles.lattice.bottom_y": {"type": "number"},  # cm
+    "forces.wall.law": _LAW, "forces.wall.l_u": _POS, "forces.wall.r_u": _POS,  # cm, N
+    "forces.pair.law": _LAW, "forces.pair.l_u": _POS, "forces.pair.r_u": _POS,
+    "solver.du": _POS,  # cm
+    "solver.f_tol": _POS,  # N
+    "solver.max_steps": {"type": "integer", "minimum": 1, "maximum": 10**15},
+    "solver.f_ref": _OPT_POS, "solver.dt_max": _OPT_POS, "solver.skin": _OPT_POS,
+    "solver.chunk": {"type": "integer", "minimum": 100, "maximum": 10**12},
+    "solver.stop_on_cycle": {"type": "boolean"},
+    "solver.history": _HISTORY,
+}
 # Defaults of the optional solver fields.  f_ref and dt_max depend on the
 # stiffness: both come from the Gershgorin bound lambda_max <= 2 k_b + 12 k_p
 # (two walls, six neighbours) of the stiffness matrix.

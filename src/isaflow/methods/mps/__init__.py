@@ -6,7 +6,7 @@ from isaflow.methods import Method, Variant
 METHOD = Method(
     name="mps",
     label="MPS (Koshizuka & Oka 1996), semi-implicit",
-    paper="hattori_mps_pressure_poisson.txt",
+    paper="hattori_mps_pressure_poisson",
     variants={
         "standard": Variant("standard", "MPS, standard source gamma rho0/dt^2 (n0 - n*)/n0, relaxation gamma as MPS-Basic (Koshizuka & Oka 1996; not the paper's method)",
                             "tab:blue", "s"),
@@ -15,5 +15,11 @@ METHOD = Method(
         "mixed": Variant("mixed", "MPS, mixed source rho0/dt div V* + gamma rho0/dt^2 (n0 - n*)/n0 (Tanaka & Masunaga 2010; not the paper's method)",
                          "tab:green", "^"),
     },
-    solver="isaflow.methods.mps.solver:solve",
+    marker="^",
+    paper_label="Hattori et al.",
+    tank=True,
+    settings="config/methods/mps.yaml",
+    report="results/report/55_mps.md",
+    claims="results/claims/mps.csv",
+    timing="results/timing/55_mps.md",
 )

@@ -17,7 +17,7 @@ import numpy as np
 import pandas as pd
 
 from isaflow import metrics, runfile
-from isaflow.scene import load_tank
+from isaflow.tank import load as load_tank
 
 from . import boundary, settings, solver
 

@@ -11,7 +11,7 @@ from importlib import resources
 
 from isaflow import inputs
 from isaflow.inputs import InputError
-from isaflow.scene import SceneError
+from isaflow.inputs import InputError as SceneError
 
 SCHEMA = json.loads(resources.files("isaflow.methods.mps").joinpath("settings.schema.json").read_text())
 DEFAULT_PATH = "config/methods/mps.yaml"

@@ -12,7 +12,7 @@ from isaflow.methods import Method, Variant
 METHOD = Method(
     name="solid",
     label="Hooke's-law solid particles (Marko 2017)",
-    paper="marko2017_lagrangian_solid_sph.txt",
+    paper="marko2017_lagrangian_solid_sph",
     variants={
         "paper": Variant("paper", "paper: eqs. 11-16 as printed (normal Hooke springs, no Poisson or shear term)",
                          "tab:red", "s"),
@@ -27,5 +27,10 @@ METHOD = Method(
         "oneway": Variant("oneway", "oneway: elastic floor, one-way: loads from the rigid-floor run of another method "
                           "(not in either paper)", "tab:green", "v"),
     },
-    solver="isaflow.methods.solid.cases:run_case",
+    marker="D",
+    paper_label="Marko et al. (2017)",
+    settings="config/methods/solid.yaml",
+    report="results/report/65_solid.md",
+    claims="results/claims/solid.csv",
+    timing="results/timing/65_solid.md",
 )

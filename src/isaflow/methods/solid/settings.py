@@ -1,7 +1,7 @@
 """Settings of the solid method (config/methods/solid.yaml): schema, validation, unit conversion.
 
 Every value is ``{value: ..., source: "..."}``; unknown keys are rejected and
-a bad file raises isaflow.scene.SceneError naming the file and field.
+a bad file raises isaflow.inputs.InputError naming the file and field.
 """
 
 

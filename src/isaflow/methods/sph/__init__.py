@@ -20,5 +20,11 @@ METHOD = Method(
         "delta_wc2": Variant("delta_wc2", "delta-SPH, Wendland C2: continuity density + density diffusion "
                                           "(variant, not marko2017)", "tab:red", "v"),
     },
-    solver="isaflow.methods.sph.solver:solve",
+    marker="s",
+    paper_label="Marko et al. (2017)",
+    tank=True,
+    settings="config/methods/sph.yaml",
+    report="results/report/50_sph.md",
+    claims="results/claims/sph.csv",
+    timing="results/timing/50_sph.md",
 )

@@ -15,7 +15,7 @@ import numpy as np
 import pandas as pd
 
 from isaflow import metrics, runfile, theory
-from isaflow.scene import load_tank
+from isaflow.tank import load as load_tank
 
 from . import settings, solver
 

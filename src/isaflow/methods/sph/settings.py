@@ -3,14 +3,14 @@
 Every physical setting is ``{value: ..., source: "page text: ..." | "inferred: ..."
 | "literature: ..."}``.  A variant is a named set of overrides with its own
 label; runs may override further (stability cases).  Bad settings raise
-scene.SceneError naming the file and the field.
+inputs.InputError naming the file and the field.
 """
 
 from pathlib import Path
 
 
 from ... import inputs
-from ...scene import SceneError
+from ...inputs import InputError as SceneError
 
 DEFAULT_PATH = Path(__file__).resolve().parents[4] / "config" / "methods" / "sph.yaml"
 

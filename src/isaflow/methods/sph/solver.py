@@ -106,7 +106,7 @@ def setup(tank, s, resolution, start=None, on_wall=False):
 
 def warm_up():
     """Compile (or load from numba's cache) the kernels so timings exclude it."""
-    from ...scene import Tank
+    from ...tank import Tank
 
     tank = Tank("warm-up", {"name": "box", "walls": [{"name": "l", "from": [0, 4], "to": [0, 0]},
                                                       {"name": "f", "from": [0, 0], "to": [4, 0]},

@@ -13,7 +13,7 @@ from isaflow.methods import Method, Variant
 METHOD = Method(
     name="sph1d",
     label="truncated SPH hydrostatic column (1D, static linear system)",
-    paper="merino_alonso2020_sph_hydrostatic_abstract.txt",
+    paper="merino_alonso2020_sph_hydrostatic_abstract",
     variants={
         "symmetric_hydrostatic": Variant(
             "symmetric_hydrostatic",
@@ -28,5 +28,10 @@ METHOD = Method(
             "symmetric gradient (p_i + p_j), mirror floor ghosts with equal pressure (alternative reading)",
             "tab:purple", "^"),
     },
-    solver="isaflow.methods.sph1d.sweep:run_sweep",
+    marker="v",
+    paper_label="Merino-Alonso et al. (2020)",
+    settings="config/methods/sph1d.yaml",
+    report="results/report/60_sph1d.md",
+    claims="results/claims/sph1d.csv",
+    timing="results/timing/60_sph1d.md",
 )

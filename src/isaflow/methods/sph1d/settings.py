@@ -1,7 +1,7 @@
 """Settings of the 1D truncated-SPH study (config/methods/sph1d.yaml): JSON schema and loader.
 
 Every entry is {value, source}; unknown keys are rejected; a bad file raises
-isaflow.scene.SceneError with one line naming the file and the field.
+isaflow.inputs.InputError with one line naming the file and the field.
 """
 
 from pathlib import Path
@@ -10,7 +10,7 @@ import numpy as np
 
 from isaflow.core.smoothing import NAMES
 from isaflow import inputs
-from isaflow.scene import SceneError
+from isaflow.inputs import InputError as SceneError
 
 from .system import FLOORS, GRADIENT_FORMS
 

@@ -4,9 +4,9 @@ import numpy as np
 from matplotlib.ticker import FuncFormatter
 
 from .. import metrics
-from ..runfile import read
+from ....runfile import read
 from .single import _contact_bars
-from .style import (COMPUTED, LABEL_BOX, PAPER_EXPECTED, PAPER_LEVEL, THEORY, draw_walls, legend_below, nice_value,
+from ....figures.style import (COMPUTED, LABEL_BOX, PAPER_EXPECTED, PAPER_LEVEL, THEORY, draw_walls, legend_below, nice_value,
                     plt, run_caption, save, scale_bar, state_phrase, surface_line)
 
 RESULTANT = "tab:brown"
@@ -101,7 +101,7 @@ def flow_complete_figure(inputs, outputs, paper=None):
     fig, ax = plt.subplots(figsize=(12, 6.6))
     fm = _state_axes(ax, ds)
     second = str(ds["vessel"].values[-1])
-    e, (_, _, mag, th) = metrics.contact_loads(ds, second)
+    e, (_, _, mag, th) = metrics.contact_loads(ds, second, "level")
     v = metrics.vessel_view(ds, second)
     bar_scale = 15.0 / np.nanmax(np.concatenate([mag, th]))
     _contact_bars(ax, ds, th, bar_scale)

@@ -2,9 +2,10 @@
 
 import numpy as np
 
+from ....figures.style import case_name  # noqa: F401
 from .. import metrics, theory
-from ..runfile import read
-from .style import (CALIBRATED, COMPUTED, LABEL_BOX, OURS_LEVEL, PAPER_LEVEL, THEORY, draw_walls,
+from ....runfile import read
+from ....figures.style import (CALIBRATED, COMPUTED, LABEL_BOX, OURS_LEVEL, PAPER_LEVEL, THEORY, draw_walls,
                     legend_below, literal_levels, nice_value, plt, run_caption, save, scale_bar, state_phrase)
 
 
@@ -67,7 +68,7 @@ def inputs_figure(inputs, outputs):
               note=f"\ncalibrated to the paper's levels\n(config/inferred.yaml); the literal\n"
                    f"k_p = k_b/2 would be {float(ds.attrs['wall_r_u']) / wl / 2:.4g} N/cm")
     fig.subplots_adjust(hspace=0.3)
-    fig.suptitle(f"Inputs of scene {ds.attrs['scene']}: du = {ds.attrs['du'] * 10:g} mm, f_tol = {ds.attrs['f_tol']:g} N "
+    fig.suptitle(f"Inputs of scene {case_name(ds)}: du = {ds.attrs['du'] * 10:g} mm, f_tol = {ds.attrs['f_tol']:g} N "
                  f"(solver: {ds.attrs['variant_label']})")
     save(fig, outputs)
 
@@ -109,10 +110,10 @@ def single_vessel_figure(inputs, outputs, paper_level=None, calibration=None):
 
     calibration: results/calibration.csv, for the level of the literal reading k_p = k_b / 2."""
     ds = read(inputs[0])
-    e, (_, _, _, th) = metrics.contact_loads(ds)
+    e, (_, _, _, th) = metrics.contact_loads(ds, None, "level")
     pos = ds["pos"].values
     walls = ds["wall_segment"].values
-    literal = literal_levels(calibration).get(ds.attrs["scene"]) if calibration else None
+    literal = literal_levels(calibration).get(case_name(ds)) if calibration else None
     fig, (ax, axp) = plt.subplots(1, 2, figsize=(12.5, 6.2), gridspec_kw={"width_ratios": [1.1, 1]})
     draw_walls(ax, ds)
     ax.plot(pos[:, 0], pos[:, 1], "o", ms=3 if len(pos) < 300 else 1.6, color="k")
@@ -228,10 +229,10 @@ def calibration_figure(inputs, outputs, paper_levels=None, adopted=None):
 def convergence_figure(inputs, outputs):
     """max|F| against the step: the paper's update and the capped variant."""
     runs = [read(p) for p in inputs]
-    scenes = list(dict.fromkeys(ds.attrs["scene"] for ds in runs))
+    scenes = list(dict.fromkeys(case_name(ds) for ds in runs))
     fig, axes = plt.subplots(1, len(scenes), figsize=(6 * len(scenes), 4.2), squeeze=False)
     for ax, sc in zip(axes[0], scenes):
-        for ds in (d for d in runs if d.attrs["scene"] == sc):
+        for ds in (d for d in runs if case_name(d) == sc):
             a = ds.attrs
             st = ds["hist_step"].values
             line, = ax.plot(st, ds["hist_fmax"].values, lw=0.8, label=f"{a['variant_label']}\n-> {a['status']} at step {int(ds['steps']):,}"

@@ -5,11 +5,12 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from ..contract import OUTCOMES
-from ..methods.isa.solver import DETECTED_BY
+from ....contract import OUTCOMES
+from ..solver import DETECTED_BY
 from ..plan import VARIANTS
 from ..tables import recommend, resolution_table
-from . import md_table, write
+from ....report import md_table, write
+from ....inputs import read_yaml
 
 
 
@@ -34,10 +35,8 @@ def map_boundaries(df):
 def report_section(errors, fire_ratio, fire_grid, stability_map, cases, study_config, outputs, targets=None):
     """results/report/30_study.md (+ docs/tables/study_recommendation.csv, study_cases.csv): error against
     work, FIRE's force evaluations, the stability map and the extreme cases, with no timing in the text."""
-    import yaml
-
     md, rec_csv, cases_csv = outputs
-    study = yaml.safe_load(Path(study_config).read_text())["study"]
+    study = read_yaml(study_config)[1]["study"]
     targets = targets or study["error_runtime"]["targets"]
     err = pd.read_csv(errors)
     fr = pd.read_csv(fire_ratio)

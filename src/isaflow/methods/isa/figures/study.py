@@ -8,7 +8,9 @@ import numpy as np
 import pandas as pd
 
 from ..plan import VARIANTS
-from .style import LATTICE_MARKER, OUTCOME_STYLE, plt, save, variant_style
+from ....figures.style import OUTCOME_STYLE, plt, save, variant_style
+
+LATTICE_MARKER = {"coarse": "o", "refined": "s", "fine": "^", "finer": "D"}
 FLOOR = 1e-4  # smallest |error| drawn on the log axes (exact zeros sit on it)
 
 PANELS = [

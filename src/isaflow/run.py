@@ -1,0 +1,146 @@
+"""Run one method on one tank and write its run file: the one path every tank run takes.
+
+:func:`prepare` does every check that can refuse a run before any work (tank,
+settings of the variant and resolution, overrides, start file, output path,
+the method's own plausibility and budget checks); :func:`run` then warms the
+method's compiled code, solves, and writes the run file atomically with its
+provenance (runfile).  Exit codes (also those of ``isaflow run``): 0 written;
+1 the run ended in an outcome the run does not accept (nothing written);
+2 bad input (one line naming the file and the field; nothing written); 3 the
+output could not be written after the solve.
+"""
+
+import os
+import sys
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from . import methods, runfile, settings, tank as tanks
+from .inputs import InputError, printable
+
+PROGRESS_EVERY = 20.0  # s of wall time between progress lines (a log line at least every 30 s)
+
+
+@dataclass
+class Prepared:
+    """Everything a checked run needs: method entry module, tank, resolved settings."""
+
+    method: str
+    entry: object
+    tank: tanks.Tank
+    settings: settings.Settings
+    variant: str
+    resolution: str
+    start: str | None
+    out: str
+    accept: tuple
+    threads: int | None
+    run_id: str
+
+
+def _same_file(a, b):
+    try:
+        return os.path.samefile(a, b)
+    except OSError:
+        return False
+
+
+def prepare(method, tank, variant, resolution, out, settings_path=None, overrides=(), start=None,
+            accept=("converged",), threads=None, run_id=None):
+    """Check a run before any work; returns Prepared or raises InputError / runfile.RunFileError.
+
+    tank: path of a tank file; overrides: 'key=value' strings or {key: {value, source}};
+    start: path of the run file of the same method to continue, or None.
+    """
+    try:
+        m = methods.get(method)
+    except KeyError as err:
+        raise InputError(f"--method: {err.args[0]}") from None
+    if not m.tank:
+        raise InputError(f"--method: method '{method}' does not run on tanks (choose from "
+                         f"{', '.join(methods.tank_methods())})")
+    if variant not in m.variants:
+        raise InputError(f"--variant: method '{method}' has no variant '{printable(str(variant))}' "
+                         f"(choose from {', '.join(m.variants)})")
+    t = tanks.load(tank)
+    path = settings_path or m.settings
+    s = settings.load(path, m.values_schema(), variant, resolution, overrides, what=f"{method} settings")
+    if start is not None:
+        try:
+            runfile.open_run(start).close()
+        except runfile.RunFileError as err:
+            raise InputError(f"--start: {err}") from None
+    runfile.check_output(out)
+    for what, src in {"the tank": tank, "the settings": path, "the start file": start}.items():
+        if src and _same_file(src, out):
+            raise runfile.RunFileError(f"{out}: the output would overwrite {what} ('{src}'); choose another path")
+    entry = m.entry_module()
+    entry.check(t, s, variant, resolution, start)
+    return Prepared(method, entry, t, s, variant, resolution, start, str(out), tuple(accept), threads,
+                    run_id or Path(out).stem)
+
+
+def _progress(run_id, log):
+    """A progress callback printing at most every PROGRESS_EVERY s: (step, measure name, value, units)."""
+    last = [time.perf_counter()]
+
+    def progress(step, name, value, units, force=False):
+        now = time.perf_counter()
+        if force or now - last[0] >= PROGRESS_EVERY:
+            last[0] = now
+            log(f"{run_id}: step {step:>9d}  {name} = {value:.4g} {units}")
+
+    return progress
+
+
+def solve(p, log=None):
+    """(Result, started, finished) of a prepared run; compiled code is warmed first (not timed)."""
+    log = log or (lambda msg: print(msg, file=sys.stderr, flush=True))
+    p.entry.warm_up(p.threads)
+    started = runfile.now()
+    result = p.entry.solve(p.tank, p.settings, p.variant, p.resolution, p.start,
+                           progress=_progress(p.run_id, log), threads=p.threads)
+    return result, started, runfile.now()
+
+
+def write(p, result, started, finished, command=None):
+    """Write the run file of a solved run (raises OSError / RunFileError)."""
+    files = {"tank": p.tank.path, "settings": p.settings.path, "start": p.start}
+    prov = runfile.provenance(files, command)
+    prov.update(run_id=p.run_id, resolution=p.resolution, settings_resolved=settings_text(p.settings),
+                threads=result.params.get("threads", p.threads or 0))
+    ds = runfile.to_dataset(result, p.tank, prov, started, finished, references=p.entry.REFERENCES)
+    runfile.write(ds, p.out)
+
+
+def settings_text(s):
+    """The resolved settings as 'key = value  # source' lines (a run-file attribute)."""
+    return "\n".join(f"{k} = {v!r}  # {s.sources.get(k, '')}" for k, v in sorted(s.items()))
+
+
+def run(method, tank, variant, resolution, out, settings_path=None, overrides=(), start=None,
+        accept=("converged",), threads=None, run_id=None, log=None, command=None):
+    """Check, solve and write one run; returns the exit code (module docstring); errors as one line on stderr."""
+    log = log or (lambda msg: print(msg, file=sys.stderr, flush=True))
+    try:
+        p = prepare(method, tank, variant, resolution, out, settings_path, overrides, start, accept, threads, run_id)
+    except (InputError, runfile.RunFileError) as err:
+        log(f"error: {err}")
+        return 2
+    except OSError as err:
+        log(f"error: {getattr(err, 'filename', None) or tank}: {err.strerror or err}")
+        return 2
+    result, started, finished = solve(p, log)
+    log(f"{p.run_id}: {result.status}: {result.message} ({result.wall_time:.3f} s solver, "
+        f"{result.params.get('threads', p.threads or 1)} thread(s))")
+    if result.status not in p.accept:
+        log(f"error: {p.run_id}: outcome '{result.status}' is not accepted ({', '.join(p.accept)}); no output written")
+        return 1
+    try:
+        write(p, result, started, finished, command)
+    except (OSError, runfile.RunFileError) as err:
+        log(f"error: {out}: the run finished but its file could not be written: "
+            f"{getattr(err, 'strerror', None) or err}")
+        return 3
+    return 0

@@ -1,0 +1,210 @@
+"""Every method's settings file (config/methods/<name>.yaml), read by this one loader.
+
+The dialect: nested mappings whose leaves are ``{value: ..., source: "..."}``
+(the source says where the value comes from: ``page text: ...``,
+``literature: ...``, ``inferred: why``, ``issue text: ...``, ``calibrated: ...``
+or ``study plan: ...``).  Values are addressed by dotted keys
+(``forces.wall.r_u``).  Three top-level sections are reserved:
+
+- ``variants: {name: {set: {dotted.key: leaf}}}``: the settings a variant
+  changes (its name, label and colour live in the method registry);
+- ``resolutions: {name: {source: str, set: {dotted.key: leaf}}}``: the
+  settings one resolution (a lattice, a spacing, a particle count) changes;
+- ``runs: {run id: {...}}``: the method's workflow runs (:data:`RUN_SCHEMA`).
+
+A method gives the JSON schema of each value by dotted key (its ``VALUES``);
+:func:`file_schema` builds the file's schema from it, so unknown keys are
+refused everywhere.  :func:`load` applies a resolution, then a variant, then
+overrides (``key=value`` strings parsed as hardened YAML, or ``{key: leaf}``
+mappings) and checks every value again.  Every error is one line naming the
+file and the field (inputs.InputError).  Pure Python (yaml, jsonschema): the
+workflow reads settings while it is parsed.
+"""
+
+import copy
+
+from . import inputs
+from .inputs import InputError
+
+RESERVED = ("variants", "resolutions", "runs")
+SOURCE = {"type": "string", "maxLength": 2000,
+          "pattern": "^(page text|literature|inferred|issue text|calibrated|study plan): .+"}
+NAME = {"type": "string", "pattern": "^[A-Za-z0-9_.]+\\Z", "maxLength": 64}
+OUTCOME_NAMES = ["converged", "cycle", "step_limit", "escaped", "nonfinite", "solver_failed"]
+
+
+def leaf(value_schema):
+    """Schema of one ``{value, source}`` entry."""
+    return {"type": "object", "additionalProperties": False, "required": ["value", "source"],
+            "properties": {"value": value_schema, "source": SOURCE}}
+
+
+def _tree(values):
+    """Nested object schema of the dotted keys of ``values`` (every key required)."""
+    root = {}
+    for key, schema in values.items():
+        node = root
+        parts = key.split(".")
+        for p in parts[:-1]:
+            node = node.setdefault(p, {})
+            if not isinstance(node, dict) or "__leaf__" in node:
+                raise ValueError(f"settings key '{key}' nests under a value")
+        node[parts[-1]] = {"__leaf__": schema}
+
+    def build(node):
+        if "__leaf__" in node:
+            return leaf(node["__leaf__"])
+        return {"type": "object", "additionalProperties": False, "required": sorted(node),
+                "properties": {k: build(v) for k, v in node.items()}}
+
+    return build(root)
+
+
+def overrides_schema(values):
+    """Schema of a ``set:`` block: {dotted key: leaf} with the keys of ``values`` only."""
+    return {"type": "object", "additionalProperties": False,
+            "properties": {k: leaf(v) for k, v in values.items()}}
+
+
+RUN_SCHEMA = {
+    "type": "object", "additionalProperties": False, "required": ["tank", "variant", "resolution"],
+    "properties": {
+        "tank": NAME,                 # config/tanks/<tank>.yaml
+        "variant": NAME,
+        "resolution": NAME,
+        "start": NAME,                # run id of the same method this run continues
+        "set": {"type": "object"},    # overrides, checked against the method's values
+        "accept": {"type": "array", "items": {"enum": OUTCOME_NAMES}, "minItems": 1, "uniqueItems": True},
+        "label": {"type": "string", "maxLength": 300},
+        "compare": {"type": "boolean"},  # the run enters the methods' comparison
+        "threads": {"type": "integer", "minimum": 1, "maximum": 64},
+        "note": {"type": "string", "maxLength": 2000},
+    },
+}
+
+
+def file_schema(values, extra=None):
+    """JSON schema of a settings file whose values are ``values`` ({dotted key: value schema}).
+
+    extra: {section: schema} of further top-level sections the method's file holds.
+    """
+    sets = overrides_schema(values)
+    base = _tree(values)
+    props = dict(base["properties"])
+    props["variants"] = {"type": "object", "minProperties": 1, "additionalProperties": {
+        "type": "object", "additionalProperties": False, "required": ["set"], "properties": {"set": sets}}}
+    props["resolutions"] = {"type": "object", "minProperties": 1, "additionalProperties": {
+        "type": "object", "additionalProperties": False, "required": ["source", "set"],
+        "properties": {"source": SOURCE, "set": sets}}}
+    props["runs"] = {"type": "object", "propertyNames": NAME, "additionalProperties": RUN_SCHEMA}
+    props.update(extra or {})
+    return {"type": "object", "additionalProperties": False, "required": [*base["required"], "variants", "resolutions"],
+            "properties": props}
+
+
+class Settings(dict):
+    """{dotted key: value} of one method's settings, resolved for a variant and resolution.
+
+    ``sources`` {dotted key: source}; ``path`` the file; ``variant``,
+    ``resolution`` the names applied; ``spec`` the validated file.
+    """
+
+    def __init__(self, values, sources, path, spec, variant=None, resolution=None, schema=None):
+        super().__init__(values)
+        self.sources, self.path, self.spec = sources, path, spec
+        self.variant, self.resolution, self.schema = variant, resolution, schema
+
+    def tree(self, prefix=""):
+        """Nested {name: value} of the keys under ``prefix`` ('' for all)."""
+        out = {}
+        for key, value in self.items():
+            if prefix and not key.startswith(prefix + "."):
+                continue
+            node = out
+            parts = key[len(prefix) + 1:].split(".") if prefix else key.split(".")
+            for p in parts[:-1]:
+                node = node.setdefault(p, {})
+            node[parts[-1]] = copy.deepcopy(value)
+        return out
+
+    def with_overrides(self, overrides, what="override"):
+        """Copy with ``overrides`` applied (see :func:`apply`)."""
+        new = Settings(copy.deepcopy(dict(self)), dict(self.sources), self.path, self.spec, self.variant,
+                       self.resolution, self.schema)
+        apply(new, overrides, self.schema or {}, self.path, what)
+        return new
+
+    def runs(self):
+        """{run id: declaration} of the file's ``runs`` section."""
+        return copy.deepcopy(self.spec.get("runs", {}))
+
+
+def flatten(node, prefix=""):
+    """{dotted key: leaf} of every ``{value, source}`` leaf under node."""
+    out = {}
+    for k, v in node.items():
+        key = f"{prefix}.{k}" if prefix else k
+        if isinstance(v, dict) and set(v) == {"value", "source"}:
+            out[key] = v
+        elif isinstance(v, dict):
+            out.update(flatten(v, key))
+    return out
+
+
+def _parse(item, path, what):
+    """(key, leaf) of one override: a 'key=value' string (value as hardened YAML)."""
+    if not isinstance(item, str) or "=" not in item:
+        raise InputError(f"{path}: {what} '{inputs.printable(str(item))}' is not of the form key=value")
+    key, value = item.split("=", 1)
+    bad = inputs.bad_string(key) or inputs.bad_string(value)
+    if bad:
+        raise InputError(f"{path}: {what} '{inputs.printable(item)}': {bad}")
+    try:
+        parsed = inputs.parse_yaml(value)
+    except InputError as err:
+        raise InputError(f"{path}: {what} '{inputs.printable(item)}': {err}") from None
+    return key.strip(), {"value": parsed, "source": f"inferred: {what} on the command line"}
+
+
+def apply(settings, overrides, values, path, what="override"):
+    """Set every override in place, checking key and value against ``values``.
+
+    overrides: a list of 'key=value' strings, or a mapping {key: leaf or plain value}.
+    """
+    items = (overrides.items() if isinstance(overrides, dict) else (_parse(o, path, what) for o in overrides))
+    for key, item in items:
+        if key not in values:
+            raise InputError(f"{path}: {what} field '{inputs.printable(key)}': no such setting")
+        entry = item if isinstance(item, dict) and set(item) == {"value", "source"} else \
+            {"value": item, "source": f"inferred: {what}"}
+        inputs.validate({key: entry}, {"type": "object", "properties": {key: leaf(values[key])}}, path)
+        settings[key] = copy.deepcopy(entry["value"])
+        settings.sources[key] = entry["source"]
+
+
+def read(path, values, what="settings", extra=None):
+    """The validated settings file as written (InputError naming the file and the field)."""
+    return inputs.load(path, file_schema(values, extra), what)[1]
+
+
+def load(path, values, variant=None, resolution=None, overrides=(), what="settings", extra=None, spec=None):
+    """Settings of a file for one variant and resolution, then overrides (see module docstring).
+
+    values: {dotted key: JSON schema of the value}.  An unknown variant or
+    resolution is refused naming the choices.
+    """
+    path = str(path)
+    spec = spec if spec is not None else read(path, values, what, extra)
+    leaves = flatten({k: v for k, v in spec.items() if k not in RESERVED and k not in (extra or {})})
+    s = Settings({k: v["value"] for k, v in leaves.items()}, {k: v["source"] for k, v in leaves.items()},
+                 path, spec, variant, resolution, values)
+    for section, name in (("resolutions", resolution), ("variants", variant)):
+        if name is None:
+            continue
+        if name not in spec[section]:
+            raise InputError(f"{path}: field '{section}': no {section[:-1]} '{inputs.printable(str(name))}' "
+                             f"(choose from {', '.join(spec[section])})")
+        apply(s, spec[section][name]["set"], values, path, f"{section[:-1]} '{name}'")
+    if overrides:
+        apply(s, overrides, values, path)
+    return s

@@ -1,0 +1,481 @@
+# ISA, the paper's method (Papadopoulos, Koutitas & Lazaridis 2016): its runs (config/methods/isa.yaml),
+# the free-surface calibration, the error-against-run-time and stability study
+# (config/methods/isa_study.yaml), Figures 5-10, Table 1, its claims, report fragments 10-30 and its
+# timing fragment (config/methods/isa_workflow.yaml).  Package: src/isaflow/methods/isa/.  Runs go
+# through the shared rule `run`; every other rule calls one package function through scripts/call.py.
+from isaflow import settings as _isa_settings  # noqa: E402
+from isaflow.methods.isa import plan as _isa_plan  # noqa: E402
+from isaflow.methods.isa.settings import VALUES as _ISA_VALUES  # noqa: E402
+
+ISA_SETTINGS = REGISTRY["isa"].settings
+ISA_WORKFLOW_CFG = "config/methods/isa_workflow.yaml"
+ISA_STUDY_CFG = "config/methods/isa_study.yaml"
+try:
+    _ISA_SPEC = _isa_settings.read(ISA_SETTINGS, _ISA_VALUES, "isa settings")
+except _inputs.InputError as _err:
+    refuse(_err)
+ISA = read_config(ISA_WORKFLOW_CFG, "isa_workflow.schema.yaml")
+STUDY = read_config(ISA_STUDY_CFG, "isa_study.schema.yaml")["study"]
+for _v in [ISA["calibration"]["variant"],
+           *(v for b in STUDY["error_runtime"]["blocks"] for v in b["variants"]), *STUDY["stability_map"]["variants"]]:
+    if _v not in REGISTRY["isa"].variants:
+        refuse(f"{ISA_STUDY_CFG}: variant '{_v}': not a variant of method isa ({', '.join(REGISTRY['isa'].variants)})")
+try:
+    ISA_RUNS = _ISA_SPEC.get("runs", {})
+    STUDY_RUNS = _isa_plan.plan(STUDY, _ISA_SPEC)
+    CAL_RUNS = _isa_plan.calibration(ISA["calibration"], ISA_RUNS, _ISA_SPEC)
+except (_inputs.InputError, KeyError) as _err:
+    refuse(f"{ISA_STUDY_CFG}: {_err}")
+for _sid in STUDY_RUNS:
+    if STUDY_RUNS[_sid]["meta"]["group"] == "error_runtime":
+        STUDY_RUNS[_sid]["runtime"] = True  # single-vessel points of the methods' error-against-run-time figure
+declare_runs("isa", {**ISA_RUNS, **STUDY_RUNS, **CAL_RUNS})
+STUDY_META = _isa_plan.meta(STUDY_RUNS)
+CAL_FILES = [run_file("isa", r) for r in CAL_RUNS]
+FIGS = ISA["figures"]
+FLOW = ISA["flow"]
+TABLE1_RUNS = sorted({run for row in ISA["table1"] for run in row["chain"]})
+
+
+isa_file = lambda run: run_file("isa", run)  # noqa: E731
+study_files = lambda group, **match: _isa_plan.run_files(STUDY_RUNS, group, **match)  # noqa: E731
+
+
+rule isa_metrics:
+    input:
+        runs=[isa_file(r) for r in ISA_RUNS],
+        code=code("methods.isa.tables"),
+    output:
+        "results/isa/metrics.csv",
+    params:
+        func="methods.isa.tables.metrics_table",
+    log:
+        "logs/isa/metrics.log",
+    conda:
+        "../../envs/isaflow.yaml"
+    script:
+        "../../scripts/call.py"
+
+
+rule isa_calibration_table:
+    input:
+        runs=CAL_FILES,
+        code=code("methods.isa.tables"),
+    output:
+        "results/isa/calibration.csv",
+    params:
+        func="methods.isa.tables.calibration_table",
+    log:
+        "logs/isa/calibration_table.log",
+    conda:
+        "../../envs/isaflow.yaml"
+    script:
+        "../../scripts/call.py"
+
+
+rule isa_fig_inputs:
+    input:
+        inputs=lambda wc: [isa_file(FIGS[wc.name])],
+        code=code("methods.isa.figures.single"),
+    output:
+        report_figure("{name}", "paper_figure", "Paper figures", "Single vessel"),
+    params:
+        func="methods.isa.figures.single.inputs_figure",
+    log:
+        "logs/isa/figures/{name}.log",
+    wildcard_constraints:
+        name="fig05_inputs_coarse|fig07_inputs_refined",
+    conda:
+        "../../envs/isaflow.yaml"
+    script:
+        "../../scripts/call.py"
+
+
+rule isa_fig_single:
+    input:
+        inputs=lambda wc: [isa_file(FIGS[wc.name])],
+        code=code("methods.isa.figures.single"),
+    output:
+        report_figure("{name}", "paper_figure", "Paper figures", "Single vessel"),
+    params:
+        func="methods.isa.figures.single.single_vessel_figure",
+        kw=lambda wc: {"paper_level": ISA["paper"][FIGS[wc.name].removesuffix("_capped")]["level"]},
+    log:
+        "logs/isa/figures/{name}.log",
+    wildcard_constraints:
+        name="fig06_single_coarse|fig08_single_refined",
+    conda:
+        "../../envs/isaflow.yaml"
+    script:
+        "../../scripts/call.py"
+
+
+rule isa_fig_calibration:
+    input:
+        inputs=CAL_FILES,
+        code=code("methods.isa.figures.single"),
+    output:
+        report_figure("calibration_free_surface", "study_figure", "Studies", "ISA calibration"),
+    params:
+        func="methods.isa.figures.single.calibration_figure",
+        kw={"paper_levels": {k: v["level"] for k, v in ISA["paper"].items()}, "adopted": ISA["calibration"]["adopted"]},
+    log:
+        "logs/isa/figures/calibration_free_surface.log",
+    conda:
+        "../../envs/isaflow.yaml"
+    script:
+        "../../scripts/call.py"
+
+
+rule isa_fig_convergence:
+    input:
+        inputs=[isa_file(r) for r in ["single_coarse", "single_coarse_capped", "single_refined", "single_refined_capped"]],
+        code=code("methods.isa.figures.single"),
+    output:
+        report_figure("convergence_single", "study_figure", "Studies", "ISA convergence"),
+    params:
+        func="methods.isa.figures.single.convergence_figure",
+    log:
+        "logs/isa/figures/convergence_single.log",
+    conda:
+        "../../envs/isaflow.yaml"
+    script:
+        "../../scripts/call.py"
+
+
+rule isa_fig_flow:
+    input:
+        inputs=lambda wc: [isa_file(FIGS[wc.name])],
+        code=code("methods.isa.figures.flow"),
+    output:
+        report_figure("{name}", "paper_figure", "Paper figures", "Flow"),
+    params:
+        func=lambda wc: {
+            "fig09_flow_incomplete": "methods.isa.figures.flow.flow_incomplete_figure",
+            "fig10_flow_complete": "methods.isa.figures.flow.flow_complete_figure",
+        }[wc.name],
+        kw={"paper": FLOW["paper"]},
+    log:
+        "logs/isa/figures/{name}.log",
+    wildcard_constraints:
+        name="fig09_flow_incomplete|fig10_flow_complete",
+    conda:
+        "../../envs/isaflow.yaml"
+    script:
+        "../../scripts/call.py"
+
+
+rule isa_fig_flow_history:
+    input:
+        inputs=sorted({isa_file(r) for chain in FLOW["chains"].values() for r in chain}),
+        code=code("methods.isa.figures.flow"),
+    output:
+        report_figure("flow_history", "study_figure", "Studies", "ISA flow"),
+    params:
+        func="methods.isa.figures.flow.flow_history_figure",
+        kw={"chains": FLOW["chains"]},
+    log:
+        "logs/isa/figures/flow_history.log",
+    conda:
+        "../../envs/isaflow.yaml"
+    script:
+        "../../scripts/call.py"
+
+
+rule isa_table1:
+    input:
+        runs=[isa_file(r) for r in TABLE1_RUNS],
+        benchmarks=[f"results/benchmarks/runs/isa/{r}.tsv" for r in TABLE1_RUNS],
+        code=code("methods.isa.tables"),
+    output:
+        "results/isa/table1.csv",
+        "results/isa/table1.md",
+    params:
+        func="methods.isa.tables.write_table1",
+        kw={"rows": ISA["table1"]},
+    log:
+        "logs/isa/table1.log",
+    conda:
+        "../../envs/isaflow.yaml"
+    script:
+        "../../scripts/call.py"
+
+
+rule isa_study_error_table:
+    input:
+        runs=study_files("error_runtime"),
+        code=code("methods.isa.tables"),
+    output:
+        "results/isa/study/error_vs_runtime.csv",
+    params:
+        func="methods.isa.tables.error_table",
+        kw={"meta": STUDY_META, "paper": ISA["paper"]},
+    log:
+        "logs/isa/study/error_table.log",
+    conda:
+        "../../envs/isaflow.yaml"
+    script:
+        "../../scripts/call.py"
+
+
+rule isa_study_fire_tables:
+    input:
+        tuning=study_files("fire_tuning"),
+        references=[f for lat in STUDY["fire_tuning"]["lattices"] for var in ("capped", "paper")
+                    for f in study_files("error_runtime", lattice=lat, variant=var, du_factor=1)],
+        code=code("methods.isa.tables"),
+    output:
+        "results/isa/study/fire_tuning.csv",
+        "results/isa/study/fire_ratio.csv",
+    params:
+        func="methods.isa.tables.fire_tables",
+        kw={"meta": STUDY_META, "paper": ISA["paper"], "required_ratio": STUDY["fire_tuning"]["required_ratio"]},
+    log:
+        "logs/isa/study/fire_tables.log",
+    conda:
+        "../../envs/isaflow.yaml"
+    script:
+        "../../scripts/call.py"
+
+
+rule isa_study_map_table:
+    input:
+        runs=study_files("stability_map"),
+        code=code("methods.isa.tables"),
+    output:
+        "results/isa/study/stability_map.csv",
+    params:
+        func="methods.isa.tables.map_table",
+        kw={"meta": STUDY_META},
+    log:
+        "logs/isa/study/map_table.log",
+    conda:
+        "../../envs/isaflow.yaml"
+    script:
+        "../../scripts/call.py"
+
+
+rule isa_study_cases_table:
+    input:
+        runs=study_files("cases"),
+        code=code("methods.isa.tables"),
+    output:
+        "results/isa/study/stability_cases.csv",
+    params:
+        func="methods.isa.tables.cases_table",
+        kw={"meta": STUDY_META},
+    log:
+        "logs/isa/study/cases_table.log",
+    conda:
+        "../../envs/isaflow.yaml"
+    script:
+        "../../scripts/call.py"
+
+
+rule isa_fig_error_vs_runtime:
+    input:
+        inputs=["results/isa/study/error_vs_runtime.csv"],
+        code=code("methods.isa.figures.study"),
+    output:
+        report_figure("error_vs_runtime", "study_figure", "Studies", "ISA error against run time"),
+    params:
+        func="methods.isa.figures.study.error_vs_runtime_figure",
+    log:
+        "logs/isa/figures/error_vs_runtime.log",
+    conda:
+        "../../envs/isaflow.yaml"
+    script:
+        "../../scripts/call.py"
+
+
+rule isa_fig_stability_map:
+    input:
+        inputs=["results/isa/study/stability_map.csv", "results/isa/study/stability_cases.csv"],
+        code=code("methods.isa.figures.study"),
+    output:
+        report_figure("stability_map", "study_figure", "Studies", "ISA stability"),
+    params:
+        func="methods.isa.figures.study.stability_map_figure",
+    log:
+        "logs/isa/figures/stability_map.log",
+    conda:
+        "../../envs/isaflow.yaml"
+    script:
+        "../../scripts/call.py"
+
+
+rule isa_report_claims:
+    input:
+        metrics="results/isa/metrics.csv",
+        calibration="results/isa/calibration.csv",
+        config=ISA_WORKFLOW_CFG,
+        code=code("methods.isa.report.claims"),
+    output:
+        report_file("results/claims/papadopoulos2016.csv", "claims", "Claims"),
+        "results/report/findings.md",
+    params:
+        func="methods.isa.report.claims.paper_claims",
+    log:
+        "logs/isa/report/claims.log",
+    conda:
+        "../../envs/isaflow.yaml"
+    script:
+        "../../scripts/call.py"
+
+
+rule isa_report_single:
+    input:
+        metrics="results/isa/metrics.csv",
+        calibration="results/isa/calibration.csv",
+        config=ISA_WORKFLOW_CFG,
+        code=code("methods.isa.report.single"),
+    output:
+        "results/report/10_single.md",
+        "docs/tables/single_tolerances.csv",
+        "docs/tables/calibration.csv",
+    params:
+        func="methods.isa.report.single.single_section",
+    log:
+        "logs/isa/report/single.log",
+    conda:
+        "../../envs/isaflow.yaml"
+    script:
+        "../../scripts/call.py"
+
+
+rule isa_report_flow:
+    input:
+        metrics="results/isa/metrics.csv",
+        config=ISA_WORKFLOW_CFG,
+        code=code("methods.isa.report.flow"),
+    output:
+        "results/report/20_flow.md",
+    params:
+        func="methods.isa.report.flow.flow_section",
+    log:
+        "logs/isa/report/flow.log",
+    conda:
+        "../../envs/isaflow.yaml"
+    script:
+        "../../scripts/call.py"
+
+
+rule isa_report_study:
+    input:
+        errors="results/isa/study/error_vs_runtime.csv",
+        fire_ratio="results/isa/study/fire_ratio.csv",
+        fire_grid="results/isa/study/fire_tuning.csv",
+        stability_map="results/isa/study/stability_map.csv",
+        cases="results/isa/study/stability_cases.csv",
+        study_config=ISA_STUDY_CFG,
+        code=code("methods.isa.report.study"),
+    output:
+        "results/report/30_study.md",
+        "docs/tables/study_recommendation.csv",
+        "docs/tables/study_cases.csv",
+    params:
+        func="methods.isa.report.study.report_section",
+    log:
+        "logs/isa/report/study.log",
+    conda:
+        "../../envs/isaflow.yaml"
+    script:
+        "../../scripts/call.py"
+
+
+rule isa_bench_step:
+    input:
+        script="benchmarks/bench_step.py",
+        reference="benchmarks/numpy_reference.py",
+        code=code("methods.isa.method"),
+    output:
+        "benchmarks/results/step_cost.csv",
+        "benchmarks/results/compile.csv",
+        "benchmarks/results/memory.csv",
+        "benchmarks/results/summary.txt",
+        "benchmarks/results/machine.txt",
+        "benchmarks/results/step_cost.png",
+    threads: 2  # the benchmark takes the whole 2-core machine so other jobs do not perturb it
+    log:
+        "logs/isa/bench_step.log",
+    conda:
+        "../../envs/isaflow.yaml"
+    shell:
+        "python {input.script} > {log} 2>&1"
+
+
+rule isa_bench_output:
+    input:
+        script="benchmarks/bench_output.py",
+        code=code("methods.isa.method"),
+    output:
+        "benchmarks/results/output_cost.csv",
+    threads: 2  # the benchmark takes the whole 2-core machine so other jobs do not perturb it
+    log:
+        "logs/isa/bench_output.log",
+    conda:
+        "../../envs/isaflow.yaml"
+    shell:
+        "python {input.script} > {log} 2>&1"
+
+
+rule isa_timing:
+    input:
+        step_cost="benchmarks/results/step_cost.csv",
+        compile="benchmarks/results/compile.csv",
+        memory="benchmarks/results/memory.csv",
+        machine="benchmarks/results/machine.txt",
+        output_cost="benchmarks/results/output_cost.csv",
+        table1="results/isa/table1.csv",
+        table1_md="results/isa/table1.md",
+        code=code("methods.isa.report.speed"),
+    output:
+        "results/timing/10_isa.md",
+    params:
+        func="methods.isa.report.speed.timing_fragment",
+    log:
+        "logs/isa/report/timing.log",
+    conda:
+        "../../envs/isaflow.yaml"
+    script:
+        "../../scripts/call.py"
+
+
+# the paper's own outputs: Figures 5-10, Table 1, the report's single-vessel and flow sections and the
+# paper's claims (quick start: snakemake -c2 paper)
+PAPER_TARGETS = [f for name in ("fig05_inputs_coarse", "fig06_single_coarse", "fig07_inputs_refined",
+                                "fig08_single_refined", "fig09_flow_incomplete", "fig10_flow_complete")
+                 for f in figure(name)] + ["results/isa/table1.csv", "results/isa/table1.md",
+                                           "results/report/10_single.md", "results/report/20_flow.md",
+                                           "results/claims/papadopoulos2016.csv"]
+
+
+rule paper:
+    input:
+        PAPER_TARGETS,
+
+
+register(targets=PAPER_TARGETS + figure("calibration_free_surface") + figure("convergence_single")
+         + figure("flow_history") + figure("error_vs_runtime") + figure("stability_map")
+         + ["results/isa/study/fire_ratio.csv", "results/isa/metrics.csv"])
+register(report=["results/report/10_single.md", "results/report/20_flow.md", "results/report/30_study.md"])
+register(claims=["results/claims/papadopoulos2016.csv"], timing=["results/timing/10_isa.md"])
+
+
+rule isa_claims_methods:
+    input:
+        table="results/compare/runs.csv",
+        code=code("methods.isa.report.claims"),
+    output:
+        "results/claims/papadopoulos2016_methods.csv",
+    params:
+        func="methods.isa.report.claims.damping_claim",
+    log:
+        "logs/isa/report/claims_methods.log",
+    conda:
+        "../../envs/isaflow.yaml"
+    script:
+        "../../scripts/call.py"
+
+
+register(claims=["results/claims/papadopoulos2016_methods.csv"])
