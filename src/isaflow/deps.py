@@ -3,9 +3,10 @@
 The workflow gives every rule the files of :func:`closure` of the module it
 calls as inputs, so editing any module an output depends on (directly or
 through another module) reruns the rule.  Imports are read from the source
-(ast), anywhere in a module (also inside functions); a method package's
-``METHOD.entry`` is followed too (the registry imports it by name).  The JSON
-schemas beside a module count as its source.  Pure Python.
+(ast), anywhere in a module (also inside functions); the registry's method
+packages (its ``PACKAGES``) and literal ``import_module("isaflow...")`` calls
+count as imports.  A method's entry module is what the run rule adds itself.
+The JSON schemas beside a module count as its source.  Pure Python.
 """
 
 import ast
@@ -15,7 +16,6 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent  # src/isaflow
 PACKAGE = ROOT.name
-_ENTRY = re.compile(r"""entry\s*=\s*["']([\w.]+)["']""")
 
 
 def module_file(name):
@@ -39,8 +39,9 @@ def _name_of(path):
 
 
 @lru_cache(maxsize=None)
-def imports(path):
-    """Package modules imported by the file at ``path`` (absolute and relative imports, at any depth)."""
+def imports(path, by_name=True):
+    """Package modules imported by the file at ``path`` (absolute and relative imports, at any depth);
+    by_name: also the modules it imports by name (a registry entry ``entry="..."``, import_module("..."))."""
     path = Path(path)
     tree = ast.parse(path.read_text(), str(path))
     here = _name_of(path).split(".")
@@ -56,10 +57,13 @@ def imports(path):
             mod = ".".join(p for p in base if p)
             found.add(mod)
             found.update(f"{mod}.{a.name}" for a in node.names)  # 'from . import x' imports module x
-    text = path.read_text()
-    found.update(_ENTRY.findall(text))  # the registry's METHOD.entry
-    for m in re.findall(r"""import_module\(\s*f?["'](isaflow\.[\w.]+)["']""", text):
-        found.add(m)
+    if by_name:
+        for node in ast.walk(tree):  # a registry's PACKAGES = ("a", "b"): it imports isaflow.methods.a, ...
+            if isinstance(node, ast.Assign) and any(getattr(t, "id", "") == "PACKAGES" for t in node.targets):
+                found.update(f"{'.'.join(here)}.{c.value}" for c in getattr(node.value, "elts", [])
+                             if isinstance(c, ast.Constant))
+        text = path.read_text()
+        found.update(re.findall(r"""import_module\(\s*["'](isaflow\.[\w.]+)["']""", text))
     return frozenset(m for m in found if m.split(".")[0] == PACKAGE and module_file(m))
 
 
@@ -83,3 +87,35 @@ def closure(*modules):
         files.update(path.parent.glob("*.json"))
         todo.extend(imports(path))
     return sorted(str(p.relative_to(ROOT.parents[1])) for p in files)
+
+
+def graph():
+    """{module: modules it imports statically} of every module of the package (imports by name left out)."""
+    out = {}
+    for path in sorted(ROOT.rglob("*.py")):
+        name = _name_of(path)
+        out[name] = sorted(m for m in imports(path, by_name=False) if m != name)
+    return out
+
+
+def cycles(g=None):
+    """Import cycles of the package graph: a list of module lists (empty if acyclic).  An edge to a package
+    whose __init__ only re-exports (e.g. 'from . import x') counts as an edge to that package."""
+    g = graph() if g is None else g
+    colour, stack, found = {}, [], []
+
+    def visit(u):
+        colour[u] = 1
+        stack.append(u)
+        for v in g.get(u, ()):
+            if colour.get(v) == 1:
+                found.append(stack[stack.index(v):] + [v])
+            elif v in g and not colour.get(v):
+                visit(v)
+        stack.pop()
+        colour[u] = 2
+
+    for u in sorted(g):
+        if not colour.get(u):
+            visit(u)
+    return found

@@ -79,12 +79,13 @@ def surface_of(ds, vessel=None):
 
 
 def tank_levels(ds):
-    """{vessel name (None for a single vessel): level [cm] at rest of the tank's liquid} (theory.rest_levels)."""
+    """{vessel name (None for a single vessel): free surface [cm] at rest of the tank's liquid}
+    (theory.rest_levels; a vessel whose floor lies above the common level is empty: its floor)."""
     names = vessels(ds)
     views = [vessel_view(ds, v) for v in names]
     H = theory.rest_levels([v["floor_y"] for v in views], [v["width"] for v in views],
                            float(ds.attrs["tank_weight"]), float(ds.attrs["tank_rho_g"]))
-    return {n: H for n in names}
+    return {n: max(H, float(v["floor_y"])) for n, v in zip(names, views)}
 
 
 def _theory(ds, vessel, reference):

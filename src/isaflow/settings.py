@@ -28,7 +28,7 @@ from .inputs import InputError
 
 RESERVED = ("variants", "resolutions", "runs")
 SOURCE = {"type": "string", "maxLength": 2000,
-          "pattern": "^(page text|literature|inferred|issue text|calibrated|study plan): .+"}
+          "pattern": "^(page text|literature|inferred|issue text|calibrated|study plan)( \\([^)]*\\))?[:;] .+"}
 NAME = {"type": "string", "pattern": "^[A-Za-z0-9_.]+\\Z", "maxLength": 64}
 OUTCOME_NAMES = ["converged", "cycle", "step_limit", "escaped", "nonfinite", "solver_failed"]
 
@@ -98,8 +98,7 @@ def file_schema(values, extra=None):
         "properties": {"source": SOURCE, "set": sets}}}
     props["runs"] = {"type": "object", "propertyNames": NAME, "additionalProperties": RUN_SCHEMA}
     props.update(extra or {})
-    return {"type": "object", "additionalProperties": False, "required": [*base["required"], "variants", "resolutions"],
-            "properties": props}
+    return {"type": "object", "additionalProperties": False, "required": base["required"], "properties": props}
 
 
 class Settings(dict):
@@ -201,7 +200,7 @@ def load(path, values, variant=None, resolution=None, overrides=(), what="settin
     for section, name in (("resolutions", resolution), ("variants", variant)):
         if name is None:
             continue
-        if name not in spec[section]:
+        if name not in spec.get(section, {}):
             raise InputError(f"{path}: field '{section}': no {section[:-1]} '{inputs.printable(str(name))}' "
                              f"(choose from {', '.join(spec[section])})")
         apply(s, spec[section][name]["set"], values, path, f"{section[:-1]} '{name}'")

@@ -28,6 +28,7 @@ rule compare_figure_tanks:
         report_figure("methods_tanks", "methods_figure", "Methods compared", "Every method on every tank"),
     params:
         func="figures.methods.tanks_figure",
+        kw={"tanks": config["compare"]["tanks"]},
     log:
         "logs/compare/figure_tanks.log",
     conda:
@@ -61,6 +62,7 @@ rule compare_report:
         "docs/tables/methods_compare.csv",
     params:
         func="report.methods.methods_section",
+        kw={"tanks": config["compare"]["tanks"]},
     log:
         "logs/compare/report.log",
     conda:

@@ -23,12 +23,13 @@ def _vessels(g):
     return names or [""]
 
 
-def tanks_figure(table, outputs):
-    """Columns = tanks; rows: free-surface error against the tank's level at rest [cm], side-wall and floor
-    errors of the receiving vessel against the tank's theory (filled) and the run's own depth (hollow)."""
+def tanks_figure(table, outputs, tanks=()):
+    """Columns = tanks (in the order given, then any other); rows: free-surface error against the tank's
+    level at rest [cm], side-wall and floor errors of the receiving vessel against the tank's theory (the
+    method's marker) and the run's own depth ('+').  Filled: the run met its stop criterion."""
     df = pd.read_csv(table)
     df = df[df["compare"].astype(bool)]
-    tanks = list(dict.fromkeys(df["tank"]))
+    tanks = [t for t in tanks if t in set(df["tank"])] + [t for t in dict.fromkeys(df["tank"]) if t not in tanks]
     fig, axes = plt.subplots(3, len(tanks), figsize=(6.2 * len(tanks), 12.5), squeeze=False,
                              gridspec_kw={"hspace": 0.08})
     handles = {}
@@ -48,10 +49,10 @@ def tanks_figure(table, outputs):
                 axes[0, col].plot(k + shift, y, marker="x" if first else mk, color=colour, ls="", ms=7,
                                   mfc=colour if done else "none")
             for row, key in ((1, "side_err"), (2, "floor_err")):
-                for ref, fill in (("tank", True), ("own", False)):
-                    y = r.get(f"{recv}{key}_{ref}", np.nan)
-                    axes[row, col].plot(k + (-0.15 if fill else 0.15), y, marker=mk, ls="", ms=7, color=colour,
-                                        mfc=colour if fill and done else "none", mew=1.2 if fill else 0.8)
+                axes[row, col].plot(k - 0.12, r.get(f"{recv}{key}_tank", np.nan), marker=mk, ls="", ms=7,
+                                    color=colour, mfc=colour if done else "none")
+                axes[row, col].plot(k + 0.12, r.get(f"{recv}{key}_own", np.nan), marker="+", ls="", ms=9, mew=1.6,
+                                    color=colour)
         for row in range(3):
             ax = axes[row, col]
             ax.axhline(0, color="k", lw=0.6)
@@ -62,17 +63,19 @@ def tanks_figure(table, outputs):
         axes[0, col].set_title(f"tank {tank}")
         axes[0, col].set_ylabel("free surface - tank's level at rest (cm)" + (
             "\n(x: first vessel, marker: receiving vessel)" if len(vess) > 1 else ""))
-        axes[1, col].set_ylabel(f"side-wall load error{where}\nfilled: vs tank theory; hollow: vs own depth")
-        axes[2, col].set_ylabel(f"floor load error{where}\nfilled: vs tank theory; hollow: vs own depth")
+        axes[1, col].set_ylabel(f"side-wall load error{where}\nmarker: vs tank theory; +: vs own depth")
+        axes[2, col].set_ylabel(f"floor load error{where}\nmarker: vs tank theory; +: vs own depth")
         for row in (1, 2):
             axes[row, col].yaxis.set_major_formatter(plt.FuncFormatter(lambda v, _: f"{v:+.0%}"))
-    handles["* / hollow markers: the run did not meet its stop criterion (" + ", ".join(
+    handles["hollow marker, * after the label: the run did not meet its stop criterion (" + ", ".join(
         k for k in OUTCOME_STYLE if k != "converged") + ")"] = plt.Line2D([], [], ls="", marker="o", mfc="none", color="k")
+    handles["+: the same load against the run's own weight and depth; x: the first vessel's surface"] = \
+        plt.Line2D([], [], ls="", marker="+", color="k", ms=9, mew=1.6)
     fig.legend(handles.values(), handles.keys(), loc="upper center", bbox_to_anchor=(0.5, 0.0), ncol=2, fontsize=8,
                frameon=False)
     fig.suptitle("Every method on every tank, judged by the same measures: free surface = top particle centres + "
-                 "half a layer pitch; theory = the tank's liquid (W, rho g) at rest, or the run's own weight and depth",
-                 y=0.995)
+                 "half a layer pitch;\ntheory = the tank's liquid (W, rho g) at rest in its vessels, or the run's own "
+                 "weight and depth", y=0.93)
     save(fig, outputs)
 
 

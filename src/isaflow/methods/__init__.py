@@ -34,8 +34,8 @@ class Variant:
 class Method:
     name: str
     label: str
-    paper: str  # the paper in ../shared/papers the method replicates or completes (file stem)
-    paper_label: str = ""  # short citation, e.g. "Papadopoulos, Koutitas & Lazaridis (2016)"
+    paper: str  # id of the paper the method replicates or completes (claims name it; ../shared/papers/<id>_*.txt)
+    paper_label: str = ""  # citation and role, e.g. "Papadopoulos, Koutitas & Lazaridis (2016), the paper replicated"
     marker: str = "o"  # where methods share a figure
     variants: dict = field(default_factory=dict)  # name -> Variant
     tank: bool = False  # runs on the shared tanks through isaflow.run
@@ -64,6 +64,14 @@ def get(method):
 def registry():
     """{method name: Method} of every registered sub-package."""
     return {pkg: get(pkg) for pkg in PACKAGES}
+
+
+def papers():
+    """{paper id: label} of every method's paper, the paper replicated first (registry order)."""
+    out = {}
+    for m in registry().values():
+        out.setdefault(m.paper, m.paper_label)
+    return out
 
 
 def tank_methods():

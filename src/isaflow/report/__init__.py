@@ -10,6 +10,8 @@ from pathlib import Path
 
 import numpy as np
 
+from ..methods import papers
+
 
 def md_table(df, floatfmt="{:.4g}"):
     """Markdown table of a DataFrame (no index); NaN as an empty cell."""
@@ -46,12 +48,7 @@ def comparison(quantity, paper, ours, diff, tol=None, note=""):
 
 
 VERDICT_ORDER = ("not reproduced", "reproduced only after calibrating", "reproduced", "not testable here")
-PAPERS = {
-    "papadopoulos2016": "Papadopoulos, Koutitas & Lazaridis (2016), the paper replicated",
-    "marko2017": "Marko et al. (2017), SPH liquid and Hooke's-law solid particles",
-    "hattori": "Hattori et al., MPS pressure Poisson source term",
-    "merino_alonso2020": "Merino-Alonso et al. (2020), truncated SPH hydrostatics (abstract only)",
-}
+PAPERS = papers()  # {paper id: label}, from the method registry
 
 
 def claims_frame(claims):

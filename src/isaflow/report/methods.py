@@ -54,15 +54,22 @@ def tank_table(g):
         row["range (cm)"] = f"{r.get(f'{recv}surface_range_cm', np.nan):.1f}"
         row["tank difference"] = r["tank_difference"] if isinstance(r["tank_difference"], str) else ""
         rows.append(row)
-    theory = ", ".join(f"{(v.rstrip('_') or 'surface')} {g[f'{v}tank_surface_cm'].iloc[0]:.2f} cm" for v in vess)
-    return pd.DataFrame(rows), theory, recv.rstrip("_")
+    parts = []
+    for v in vess:
+        level, floor = g[f"{v}tank_surface_cm"].iloc[0], g[f"{v}floor_y_cm"].iloc[0]
+        name = v.rstrip("_") or "surface"
+        parts.append(f"{name} vessel empty (floor {floor:g} cm)" if level <= floor else f"{name} {level:.2f} cm")
+    return pd.DataFrame(rows), ", ".join(parts), recv.rstrip("_")
 
 
-def methods_section(table, outputs):
-    """results/report/70_methods.md and docs/tables/methods_compare.csv (every compared run, no timings)."""
+def methods_section(table, outputs, tanks=()):
+    """results/report/70_methods.md and docs/tables/methods_compare.csv (every compared run, no timings);
+    tanks: the order of the tank sections."""
     md, csv = outputs
     df = pd.read_csv(table)
     df = df[df["compare"].astype(bool)].drop(columns=["compare", "file", *TIMING])
+    order = {t: i for i, t in enumerate(tanks)}
+    df = df.sort_values("tank", key=lambda c: c.map(lambda t: order.get(t, len(order))), kind="stable")
     df.to_csv(csv, index=False, float_format="%.6g")
     text = ["## Every method on every tank", "",
             "Every run of every tank method is judged by the same functions (`isaflow.metrics.comparison_row`) "
@@ -78,9 +85,9 @@ def methods_section(table, outputs):
             ""]
     for tank, g in df.groupby("tank", sort=False):
         t, theory, recv = tank_table(g)
-        where = f" of the {recv} vessel" if recv else ""
+        where = f"those of the {recv} vessel" if recv else "those of the whole vessel"
         text += [f"### Tank `{tank}`", "",
-                 f"The tank's liquid at rest: {theory}. Wall-load errors are those{where}.", "", md_table(t), ""]
+                 f"The tank's liquid at rest: {theory}. Wall-load errors are {where}.", "", md_table(t), ""]
     notes = sorted({f"`{m}`: {get(m).label}" for m in df["method"]})
     text += ["Methods: " + "; ".join(notes) + ".", ""]
     write(text, md)

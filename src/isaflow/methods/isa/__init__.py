@@ -11,14 +11,14 @@ from .. import Method, Variant
 METHOD = Method(
     name="isa",
     label="incremental static analysis of point particles",
-    paper="papadopoulos2016_isa_point_particles",
+    paper="papadopoulos2016",
     variants={
         "paper": Variant("paper", "paper: x += du F / max|F| (section 3.3, literal)", "tab:blue", "o", paper=True),
         "capped": Variant("capped", "capped: x += du F / max(max|F|, f_ref) (variant, not in paper)", "tab:green", "s"),
         "fire": Variant("fire", "fire: FIRE relaxation, Bitzek et al. 2006 (variant, not in paper)", "tab:purple", "^"),
     },
     marker="o",
-    paper_label="Papadopoulos, Koutitas & Lazaridis (2016)",
+    paper_label="Papadopoulos, Koutitas & Lazaridis (2016), the paper replicated",
     tank=True,
     entry="isaflow.methods.isa.method",
     values="isaflow.methods.isa.settings:VALUES",

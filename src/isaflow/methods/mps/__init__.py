@@ -6,7 +6,7 @@ from isaflow.methods import Method, Variant
 METHOD = Method(
     name="mps",
     label="MPS (Koshizuka & Oka 1996), semi-implicit",
-    paper="hattori_mps_pressure_poisson",
+    paper="hattori",
     variants={
         "standard": Variant("standard", "MPS, standard source gamma rho0/dt^2 (n0 - n*)/n0, relaxation gamma as MPS-Basic (Koshizuka & Oka 1996; not the paper's method)",
                             "tab:blue", "s"),
@@ -16,7 +16,7 @@ METHOD = Method(
                          "tab:green", "^"),
     },
     marker="^",
-    paper_label="Hattori et al.",
+    paper_label="Hattori et al., MPS pressure Poisson source term",
     tank=True,
     settings="config/methods/mps.yaml",
     report="results/report/55_mps.md",

@@ -12,7 +12,7 @@ from isaflow.methods import Method, Variant
 METHOD = Method(
     name="solid",
     label="Hooke's-law solid particles (Marko 2017)",
-    paper="marko2017_lagrangian_solid_sph",
+    paper="marko2017",
     variants={
         "paper": Variant("paper", "paper: eqs. 11-16 as printed (normal Hooke springs, no Poisson or shear term)",
                          "tab:red", "s"),
@@ -28,7 +28,7 @@ METHOD = Method(
                           "(not in either paper)", "tab:green", "v"),
     },
     marker="D",
-    paper_label="Marko et al. (2017)",
+    paper_label="Marko et al. (2017), SPH liquid and Hooke's-law solid particles",
     settings="config/methods/solid.yaml",
     report="results/report/65_solid.md",
     claims="results/claims/solid.csv",

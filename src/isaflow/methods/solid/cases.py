@@ -7,7 +7,6 @@ history holds the case's measured numbers (SI-free: cm, N, s; stresses N/cm^2).
 
 import numpy as np
 
-from isaflow.contract import Result
 from isaflow.core.units import PA
 
 from . import lattice as L
@@ -24,28 +23,6 @@ def _material(cfg):
 def _budget(cfg, variant):
     s = cfg["solver"]
     return s["max_steps"] if variant == "hooke" else s["max_steps_mechanism"]
-
-
-def _result(st, case, status, msg, resid, history, params, start=None):
-    """contract.Result of a solid state: (x, y) in pos, z and stresses in fields, no wall contacts."""
-    b = st.block
-    fields = {
-        "pos_z0": (("particle",), b.ref[:, 2], "cm", "initial particle z"),
-        "pos_z": (("particle",), st.pos[:, 2], "cm", "final particle z"),
-        "stress": (("particle", "stress_component"), st.sig, "N cm-2",
-                   "particle virial stress xx, yy, zz, yx, zy, zx (dim 2: per unit thickness, zz plane strain)"),
-        "lattice_index": (("particle", "axis"), b.index.astype(np.int32), "1", "lattice index i, j, k"),
-    }
-    return Result(
-        method="solid", variant=st.variant, pos0=b.ref[:, :2].copy(), pos=st.pos[:, :2].copy(),
-        weight=st.mass * 981.0, contact_wall=np.zeros(0, int), contact_point=np.zeros((0, 2)),
-        contact_force=np.zeros((0, 2)), status=status, message=msg, steps=st.steps, start_step=0,
-        wall_time=st.wall_time, force_evals=st.steps, residual=resid,
-        residual_name="max|F_free| / max|f_link|", residual_units="1", sim_time=float(st.clock[1]),
-        history=history, fields=fields,
-        params={"case": case, "dim": b.dim, "dx_cm": b.dx, "E_N_cm2": st.mat.E, "nu": st.mat.nu,
-                "rho_N_s2_cm4": st.mat.rho, "dt_min_s": float(st.clock[2]), "dt_max_s": float(st.clock[3]),
-                "dt_rule_s": st.dt_max, **params})
 
 
 def run_bar(cfg, variant, sign=+1):
@@ -85,7 +62,7 @@ def run_bar(cfg, variant, sign=+1):
         "reaction": (("record",), [st.frc[j == ny - 1, 1].sum()], "N", "y force on the moved end layer"),
     }
     case = "tension" if sign > 0 else "compression"
-    return _result(st, f"bar_{case}", status, msg, resid, hist, {"pull_cm": sign * c["pull_um"] * UM,
+    return S.result(st, f"bar_{case}", status, msg, resid, hist, {"pull_cm": sign * c["pull_um"] * UM,
                                                                   "grips": c["grips"]})
 
 
@@ -115,7 +92,7 @@ def run_shear(cfg, variant):
         "tau_peak": (("record",), [st.sig[free, 3].max()], "N cm-2", "largest tau_yx of the free layers"),
         "height": (("record",), [(ny + 2 * g - 1) * dx], "cm", "distance between held and moved layers"),
     }
-    return _result(st, "shear", status, msg, resid, hist, {"deflection_cm": c["deflection_um"] * UM,
+    return S.result(st, "shear", status, msg, resid, hist, {"deflection_cm": c["deflection_um"] * UM,
                                                            "grip_layers": g})
 
 
@@ -168,7 +145,7 @@ def run_hertz(cfg, variant):
     }
     if status == "converged" and len(rows["depth"]) < len(c["depths_um"]):
         status = "step_limit"
-    return _result(st, "hertz", status, msg, resid, hist, {"radius_cm": R})
+    return S.result(st, "hertz", status, msg, resid, hist, {"radius_cm": R})
 
 
 def run_hertz_dt(cfg, variant, dt_ns):
@@ -183,7 +160,7 @@ def run_hertz_dt(cfg, variant, dt_ns):
     status, msg, resid, g = S.relax(st, cfg["solver"]["tol"], c["dt_check_steps"], dt=dt_ns * 1e-9,
                                     label=f"hertz dt {dt_ns} ns")
     hist = {"load": (("record",), [g[1]], "N cm-1", "force of the plate on the disk per unit thickness")}
-    return _result(st, f"hertz_dt{dt_ns:g}ns", status, msg, resid, hist,
+    return S.result(st, f"hertz_dt{dt_ns:g}ns", status, msg, resid, hist,
                    {"dt_fixed_s": dt_ns * 1e-9, "dt_over_rule": dt_ns * 1e-9 / st.dt_max})
 
 
@@ -199,6 +176,10 @@ CASES = {"bar_tension": lambda cfg, v: run_bar(cfg, v, +1), "bar_compression": l
 def run_case(cfg, case, variant, loads=None):
     """Dispatch: case is a key of CASES, 'hertz_dt<ns>' (the paper's fixed step), 'vessel' (4.4) or
     'floor_<source>' (elastic floor; loads: the rigid-floor run file of variant 'oneway')."""
+    if case == "vessel" and variant == "water_particles":
+        from .water import run_water_vessel
+
+        return run_water_vessel(cfg)
     if case == "vessel":
         from .vessel import run_vessel
 

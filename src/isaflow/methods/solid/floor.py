@@ -74,7 +74,6 @@ def nodal(x, load, dx, nx):
 def run_floor(cfg, variant, loads=None, case=None):
     """Settle the plate under its nodal loads; deflection of the middle row against beam theory under
     (a) the uniform W / span and (b) the same nodal loads.  loads: a rigid-floor run file ('oneway')."""
-    from .cases import _result
 
     f = cfg["floor"]
     st, top, mid = plate(cfg)
@@ -126,7 +125,7 @@ def run_floor(cfg, variant, loads=None, case=None):
         "liquid_weight": (("record",), [W], "N", "liquid weight W of the load case"),
     }
     case = case or ("floor_uniform" if variant == "uniform_load" else f"floor_{src['load_method']}")
-    r = _result(st, case, status, msg, resid, hist,
+    r = S.result(st, case, status, msg, resid, hist,
                 {"span_cm": span, "thickness_cm": f["layers"] * dx, "supports": f["supports"],
                  "solid_model": f["solid_model"], "EI_N_cm2": EI, **src})
     r.variant = variant

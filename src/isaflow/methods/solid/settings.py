@@ -1,64 +1,48 @@
-"""Settings of the solid method (config/methods/solid.yaml): schema, validation, unit conversion.
+"""Settings of the solid method (config/methods/solid.yaml), read by the one loader (isaflow.settings).
 
 Every value is ``{value: ..., source: "..."}``; unknown keys are rejected and
 a bad file raises isaflow.inputs.InputError naming the file and field.
 """
 
-
-
+from isaflow import settings as S
 from isaflow.core.units import KG, PA
-from isaflow import inputs
-
-
-def _item(value_schema):
-    return {"type": "object", "additionalProperties": False, "required": ["value", "source"],
-            "properties": {"value": value_schema,
-                           "source": {"type": "string", "pattern": "^(page text|inferred|literature)"}}}
 
 
 POS = {"type": "number", "exclusiveMinimum": 0}
 COUNT = {"type": "integer", "minimum": 1}
 
 
-def _section(**fields):
-    return {"type": "object", "additionalProperties": False, "required": list(fields),
-            "properties": {k: _item(v) for k, v in fields.items()}}
-
-
-SCHEMA = {
-    "type": "object", "additionalProperties": False,
-    "required": ["material", "solver", "bar", "shear", "hertz", "vessel", "floor"],
-    "properties": {
-        "material": _section(E_GPa=POS, nu={"type": "number", "minimum": 0, "exclusiveMaximum": 0.5}, rho_kg_m3=POS),
-        "solver": _section(tol=POS, max_steps=COUNT, max_steps_mechanism=COUNT),
-        "bar": _section(particles={"type": "array", "items": COUNT, "minItems": 3, "maxItems": 3}, dx_mm=POS,
+SECTIONS = {
+    "material": dict(E_GPa=POS, nu={"type": "number", "minimum": 0, "exclusiveMaximum": 0.5}, rho_kg_m3=POS),
+    "solver": dict(tol=POS, max_steps=COUNT, max_steps_mechanism=COUNT),
+    "bar": dict(particles={"type": "array", "items": COUNT, "minItems": 3, "maxItems": 3}, dx_mm=POS,
                         pull_um=POS, grips={"enum": ["clamped", "sliding"]}, exaggeration=POS),
-        "shear": _section(particles={"type": "array", "items": COUNT, "minItems": 3, "maxItems": 3},
+    "shear": dict(particles={"type": "array", "items": COUNT, "minItems": 3, "maxItems": 3},
                           grip_layers={"type": "integer", "minimum": 0}, deflection_um=POS, height_cm=POS),
-        "hertz": _section(plate={"type": "array", "items": COUNT, "minItems": 2, "maxItems": 2}, dx_um=POS,
+    "hertz": dict(plate={"type": "array", "items": COUNT, "minItems": 2, "maxItems": 2}, dx_um=POS,
                           radius_mm=POS, depths_um={"type": "array", "items": POS, "minItems": 1},
                           plane={"enum": ["strain"]}, paper_dt_ns={"type": "array", "items": POS},
                           dt_check_steps=COUNT),
-        "vessel": _section(dx_mm=POS, ring_particles=COUNT, water_radius_particles=COUNT, pressure_Pa=POS,
+    "vessel": dict(dx_mm=POS, ring_particles=COUNT, water_radius_particles=COUNT, pressure_Pa=POS,
                            K_GPa=POS, rho_water_kg_m3=POS, steps=COUNT, dt_ns=POS,
                            solid_model={"enum": ["paper", "hooke", "objective"]}, history_us=POS, record_every=COUNT,
                            water_kernel={"enum": ["cubic_spline", "wendland_c2", "wendland_c4", "wendland_c6"]},
                            water_h_over_dx=POS, water_alpha={"type": "number", "minimum": 0}),
-        "floor": _section(span_cm=POS, dx_cm=POS, layers=COUNT, supports={"enum": ["simply_supported"]},
+    "floor": dict(span_cm=POS, dx_cm=POS, layers=COUNT, supports={"enum": ["simply_supported"]},
                           solid_model={"enum": ["paper", "hooke", "objective"]}, weight_N=POS, max_steps=COUNT),
-    },
 }
+# {dotted key: JSON schema of the value} of config/methods/solid.yaml
+VALUES = {f"{sec}.{k}": v for sec, fields in SECTIONS.items() for k, v in fields.items()}
 
 
 def load(path):
     """{section: {key: value}} of a settings file, values as written (sources dropped)."""
-    spec = load_with_sources(path)
-    return {sec: {k: v["value"] for k, v in items.items()} for sec, items in spec.items()}
+    return S.load(path, VALUES, what="solid settings").tree()
 
 
 def load_with_sources(path):
     """The validated file as written: {section: {key: {value, source}}}."""
-    return inputs.load(path, SCHEMA, "solid settings")[1]
+    return S.read(path, VALUES, "solid settings")
 
 
 def material_units(mat):

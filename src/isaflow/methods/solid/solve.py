@@ -9,6 +9,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from isaflow.contract import Result
+
 from . import kernels as K
 
 log = logging.getLogger("isaflow.solid")
@@ -130,3 +132,25 @@ def warmup():
     b = block(2, 1, 1, 1.0)
     st = State(b, Material(1.0, 0.3, 1.0), "hooke", np.ones((2, 3)), push=1)
     relax(st, 1e-3, 2)
+
+
+def result(st, case, status, msg, resid, history, params, start=None):
+    """contract.Result of a solid state: (x, y) in pos, z and stresses in fields, no wall contacts."""
+    b = st.block
+    fields = {
+        "pos_z0": (("particle",), b.ref[:, 2], "cm", "initial particle z"),
+        "pos_z": (("particle",), st.pos[:, 2], "cm", "final particle z"),
+        "stress": (("particle", "stress_component"), st.sig, "N cm-2",
+                   "particle virial stress xx, yy, zz, yx, zy, zx (dim 2: per unit thickness, zz plane strain)"),
+        "lattice_index": (("particle", "axis"), b.index.astype(np.int32), "1", "lattice index i, j, k"),
+    }
+    return Result(
+        method="solid", variant=st.variant, pos0=b.ref[:, :2].copy(), pos=st.pos[:, :2].copy(),
+        weight=st.mass * 981.0, contact_wall=np.zeros(0, int), contact_point=np.zeros((0, 2)),
+        contact_force=np.zeros((0, 2)), status=status, message=msg, steps=st.steps, start_step=0,
+        wall_time=st.wall_time, force_evals=st.steps, residual=resid,
+        residual_name="max|F_free| / max|f_link|", residual_units="1", sim_time=float(st.clock[1]),
+        history=history, fields=fields,
+        params={"case": case, "dim": b.dim, "dx_cm": b.dx, "E_N_cm2": st.mat.E, "nu": st.mat.nu,
+                "rho_N_s2_cm4": st.mat.rho, "dt_min_s": float(st.clock[2]), "dt_max_s": float(st.clock[3]),
+                "dt_rule_s": st.dt_max, **params})

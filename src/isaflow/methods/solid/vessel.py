@@ -109,13 +109,8 @@ def history(cfg, dt):
 def run_vessel(cfg, variant):
     """The 'pressure_load' vessel: settled state (kinetic damping) and the undamped time history at the
     paper's step; the Lame field at the inner particles' radii; the times that say whether 58.7 us settles."""
-    if variant == "water_particles":
-        from .water import run_water_vessel
-
-        return run_water_vessel(cfg)
     if variant != "pressure_load":
         raise KeyError(f"vessel variant '{variant}' is not implemented (choose from pressure_load, water_particles)")
-    from .cases import _result
 
     v = cfg["vessel"]
     dx, a, b = geometry(v)
@@ -160,7 +155,7 @@ def run_vessel(cfg, variant):
         "history_dt": (("record",), [dt], "s", "fixed step of the undamped run"),
         "history_wall_time": (("record",), [hst.wall_time], "s", "solver time of the undamped run"),
     }
-    r = _result(st, "vessel", status, msg, resid, hist,
+    r = S.result(st, "vessel", status, msg, resid, hist,
                 {"a_cm": a, "b_cm": b, "pressure_N_cm2": v["pressure_Pa"] * 1e-4, "solid_model": v["solid_model"],
                  "ring_lattice": "square lattice, centre radius in [a, b)", "n_inner": int(inner.sum())})
     r.variant = variant

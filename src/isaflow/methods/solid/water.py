@@ -130,7 +130,7 @@ def coupled_history(cfg, dt, steps, every):
 def run_water_vessel(cfg):
     """Variant 'water_particles': the undamped coupled history at the paper's step; the mean over whole
     breathing cycles against Lame at the pressure the water keeps, p0 / (1 + 2 K u_L / (a p0))."""
-    from .cases import _result
+    from .solve import result as _result
     from .vessel import NS, US, geometry, lame
 
     v = cfg["vessel"]

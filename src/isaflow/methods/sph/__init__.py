@@ -13,7 +13,7 @@ from .. import Method, Variant
 METHOD = Method(
     name="sph",
     label="weakly compressible SPH",
-    paper="marko2017_lagrangian_solid_sph",
+    paper="marko2017",
     variants={
         "wcsph": Variant("wcsph", "WCSPH: marko2017 eqs. 4, 6, 9 + Tait EOS, artificial viscosity, Adami walls "
                                   "(completions from literature)", "tab:orange", "D"),
@@ -21,7 +21,7 @@ METHOD = Method(
                                           "(variant, not marko2017)", "tab:red", "v"),
     },
     marker="s",
-    paper_label="Marko et al. (2017)",
+    paper_label="Marko et al. (2017), SPH liquid and Hooke's-law solid particles",
     tank=True,
     settings="config/methods/sph.yaml",
     report="results/report/50_sph.md",

@@ -13,7 +13,7 @@ from isaflow.methods import Method, Variant
 METHOD = Method(
     name="sph1d",
     label="truncated SPH hydrostatic column (1D, static linear system)",
-    paper="merino_alonso2020_sph_hydrostatic_abstract",
+    paper="merino_alonso2020",
     variants={
         "symmetric_hydrostatic": Variant(
             "symmetric_hydrostatic",
@@ -29,7 +29,7 @@ METHOD = Method(
             "tab:purple", "^"),
     },
     marker="v",
-    paper_label="Merino-Alonso et al. (2020)",
+    paper_label="Merino-Alonso et al. (2020), truncated SPH hydrostatics (abstract only)",
     settings="config/methods/sph1d.yaml",
     report="results/report/60_sph1d.md",
     claims="results/claims/sph1d.csv",

@@ -1,0 +1,156 @@
+"""The architecture the issue asks for, checked on the source: no module outside methods/ names a method
+or a variant, imports only point down the layers, no import cycle, and every rule's code inputs hold
+every module its output depends on."""
+
+import ast
+import re
+import subprocess
+import sys
+
+import pytest
+
+from isaflow import deps, methods
+
+from conftest import ROOT
+
+SRC = ROOT / "src" / "isaflow"
+# 'paper' is a variant name and also the claims tables' column naming a claim's paper, so it is left out
+NAMES = ({m for m in methods.PACKAGES} | {v for m in methods.registry().values() for v in m.variants}) - {"paper"}
+LAYERS = [  # a module may import its own layer and the ones above it in this list, never one below
+    ("core",),
+    ("inputs", "settings", "tank", "contract", "rest", "deps", "theory", "methods"),  # 'methods': the registry
+    ("metrics", "runfile", "tables", "run", "cli", "figures", "report"),
+    ("methods.",),  # a method package
+]
+
+
+def _layer(module):
+    rel = module.removeprefix("isaflow.").removeprefix("isaflow")
+    for k in range(len(LAYERS) - 1, -1, -1):
+        for prefix in LAYERS[k]:
+            if prefix.endswith(".") and rel.startswith(prefix) or rel == prefix or rel.startswith(prefix + "."):
+                return k
+    return 0 if rel in ("", "__init__") else None
+
+
+def shared_sources():
+    """Python sources outside methods/ and the workflow's shared rule files and scripts."""
+    py = [p for p in SRC.rglob("*.py") if "methods" not in p.relative_to(SRC).parts[:1]]
+    smk = [ROOT / "Snakefile", *sorted((ROOT / "workflow" / "rules").glob("*.smk"))]
+    return py, smk + sorted((ROOT / "workflow" / "scripts").glob("*.py"))
+
+
+def test_no_module_outside_methods_names_a_method_or_variant():
+    py, other = shared_sources()
+    found = []
+    for p in py:
+        for node in ast.walk(ast.parse(p.read_text())):
+            if isinstance(node, ast.Constant) and isinstance(node.value, str) and node.value in NAMES:
+                found.append(f"{p.relative_to(ROOT)}:{node.lineno}: {node.value!r}")
+    for p in other:
+        for k, line in enumerate(p.read_text().splitlines(), 1):
+            for lit in re.findall(r"""["']([A-Za-z0-9_]+)["']""", line):
+                if lit in NAMES:
+                    found.append(f"{p.relative_to(ROOT)}:{k}: {lit!r}")
+    assert not found, "\n".join(found)
+
+
+def test_imports_point_down_the_layers_and_form_no_cycle():
+    g = deps.graph()
+    up = [f"{a} -> {b}" for a, targets in g.items() for b in targets
+          if _layer(a) is not None and _layer(b) is not None and _layer(b) > _layer(a)]
+    assert not up, "\n".join(up)
+    assert deps.cycles(g) == []
+
+
+def test_rule_code_inputs_hold_every_module_the_function_loads():
+    """For every script rule calling an isaflow function: the modules Python loads when that function's
+    module is imported, and everything it imports later (the static closure), are all code inputs."""
+    from snakemake.api import SnakemakeApi
+    from snakemake.settings.types import ConfigSettings, ResourceSettings, WorkflowSettings  # noqa: F401
+
+    src = ROOT / "src"
+    out = subprocess.run([sys.executable, "-c", """
+import json, sys
+sys.path.insert(0, 'src')
+from snakemake.api import SnakemakeApi
+from snakemake.settings.types import ResourceSettings
+with SnakemakeApi() as api:
+    wf = api.workflow(resource_settings=ResourceSettings(cores=1), snakefile='Snakefile')
+    rules = {}
+    for r in wf._workflow.rules:
+        func = getattr(r.params, 'func', None) if hasattr(r, 'params') else None
+        code = [str(f) for f in r.input.get('code', [])] if 'code' in r.input.keys() else None
+        if isinstance(func, str) and code is not None:
+            rules[r.name] = dict(func=func, code=code)
+    print(json.dumps(rules))
+"""], cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert out.returncode == 0, out.stderr[-3000:]
+    import json
+
+    rules = json.loads(out.stdout.strip().splitlines()[-1])
+    assert len(rules) >= 20
+    missing = {}
+    for name, r in rules.items():
+        module = "isaflow." + r["func"].rsplit(".", 1)[0]
+        loaded = subprocess.run([sys.executable, "-c", f"import sys, importlib; importlib.import_module({module!r}); "
+                                 "print('\\n'.join(m.__file__ for n, m in sys.modules.items() "
+                                 "if n.startswith('isaflow') and getattr(m, '__file__', None)))"],
+                                cwd=ROOT, capture_output=True, text=True, timeout=120)
+        files = {str(__import__('pathlib').Path(f).resolve().relative_to(ROOT)) for f in loaded.stdout.split()}
+        files |= set(deps.closure(module))
+        lacking = sorted(files - set(r["code"]))
+        if lacking:
+            missing[name] = lacking
+    assert not missing, missing
+
+
+def test_changing_a_shared_module_reruns_every_dependent_figure(tmp_path):
+    """In a scratch copy whose every output exists and is newer than every input, a dry run has nothing
+    to do; after a shared module changes (figures/style.py, then metrics.py) it reruns exactly the
+    jobs whose code depends on it: every figure, never a solver run."""
+    import os
+    import shutil
+
+    for item in ("Snakefile", "workflow", "config", "src"):
+        src = ROOT / item
+        (shutil.copytree if src.is_dir() else shutil.copy)(src, tmp_path / item,
+                                                          **({"ignore": shutil.ignore_patterns("__pycache__")}
+                                                             if src.is_dir() else {}))
+    targets = ["figures/fig06_single_coarse.png", "figures/fig10_flow_complete.png", "figures/convergence_single.png",
+               "figures/methods_tanks.png"]
+
+    def dry(*extra):
+        p = subprocess.run([sys.executable, "-m", "snakemake", "-n", "--workflow-profile", "none", *extra, "--",
+                            *targets], cwd=tmp_path, capture_output=True, text=True, timeout=300)
+        assert p.returncode == 0, p.stderr[-2000:]
+        return p.stdout + p.stderr
+
+    def jobs(out):
+        if "Nothing to be done" in out:
+            return {}
+        table = out.split("Job stats:")[1].split("total")[0]
+        return {r.split()[0]: int(r.split()[1]) for r in table.splitlines()[3:] if r.strip()}
+
+    outputs = set()
+    for line in dry("--forceall").splitlines():
+        for key in ("output:", "log:", "benchmark:"):
+            if line.strip().startswith(key):
+                outputs.update(f.strip() for f in line.strip()[len(key):].split(","))
+    old, new = 1.6e9, 1.7e9
+    for p in tmp_path.rglob("*"):
+        if p.is_file():
+            os.utime(p, (old, old))
+    for f in outputs:
+        path = tmp_path / f
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.touch()
+        os.utime(path, (new, new))
+    assert jobs(dry()) == {}
+    os.utime(tmp_path / "src" / "isaflow" / "figures" / "style.py", (new + 10, new + 10))
+    figures = jobs(dry())
+    assert figures and "run" not in figures
+    assert {"isa_fig_single", "isa_fig_flow", "isa_fig_convergence", "compare_figure_tanks"} <= set(figures)
+    os.utime(tmp_path / "src" / "isaflow" / "metrics.py", (new + 20, new + 20))
+    after = jobs(dry())
+    assert "run" not in after and {"compare_table", "isa_fig_single"} <= set(after)
