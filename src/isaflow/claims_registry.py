@@ -1,0 +1,172 @@
+"""The claims registry: every testable statement of the four papers, one YAML file per paper.
+
+``config/claims/<paper>.yaml`` lists the paper's statements (id, section, verbatim quote, kind,
+quantity, measure, tolerance with its derivation and source, runs, inferred inputs, the replaced
+row of the old claims table) and the inputs its verdicts rest on (with the range a sensitivity
+sweep covers).  Each file is read through :func:`isaflow.inputs.load` (no aliases, tags,
+duplicate keys, NaN) against ``claims.schema.json``; :func:`load` then checks what a schema
+cannot: file name = paper, ids unique across files, every reference (inferred inputs,
+``depends_on``, ``calibrated_against``) resolves, id prefix = paper, testable entries carry a
+tolerance that can fail, untestable ones say why.
+
+Kinds: ``method result`` (a number or property the method produces), ``paper arithmetic`` (the
+paper's own formula or number re-evaluated), ``holds by construction`` (true because of how the
+method or an inferred input was built; not evidence), ``input rule`` (how the paper chose an
+input, checked against the inputs the runs use), ``paper inconsistency`` (two statements of the
+paper that cannot both hold), and ``project check`` (a check of ours, quoted from no paper, never
+counted in a paper's tally).
+
+No verdict is computed here: this module is the data.  Units: cm, N, s unless a field says
+otherwise.
+"""
+
+import json
+import re
+from collections import Counter
+from importlib import resources
+from pathlib import Path
+
+from .inputs import InputError, load as load_yaml
+
+SCHEMA = json.loads(resources.files("isaflow").joinpath("claims.schema.json").read_text())
+PAPERS = ("papadopoulos2016", "marko2017", "hattori", "merino_alonso2020")
+PREFIX = {"papadopoulos2016": "pap", "marko2017": "mar", "hattori": "hat", "merino_alonso2020": "mer"}
+KINDS = ("method result", "paper arithmetic", "holds by construction", "input rule", "paper inconsistency",
+         "project check")
+PAPER_KINDS = KINDS[:-1]  # the kinds counted in a paper's tally
+DEFAULT_DIRECTORY = "config/claims"
+_ROOT = Path(__file__).resolve().parents[2]
+
+
+def _directory(directory):
+    """The registry folder: as given, or (relative and absent) under the repository root."""
+    d = Path(directory)
+    if not d.is_absolute() and not d.is_dir() and (_ROOT / d).is_dir():
+        d = _ROOT / d
+    return d
+
+
+def load_files(directory=DEFAULT_DIRECTORY):
+    """{paper: validated file mapping} of every registry file in directory (InputError otherwise)."""
+    d = _directory(directory)
+    if not d.is_dir():
+        raise InputError(f"{d}: claims registry folder not found")
+    files = sorted(p for p in d.iterdir() if p.suffix in (".yaml", ".yml"))
+    out = {}
+    for path in files:
+        _, spec = load_yaml(path, SCHEMA, "claims registry file")
+        if spec["paper"] != path.stem:
+            raise InputError(f"{path}: field 'paper': '{spec['paper']}' does not match the file name "
+                             f"'{path.stem}' (one file per paper, named after it)")
+        out[spec["paper"]] = spec | {"_path": str(path)}
+    missing = [p for p in PAPERS if p not in out]
+    if missing:
+        raise InputError(f"{d}: no registry file for {', '.join(missing)}")
+    return out
+
+
+def _check_file(paper, spec, ids):
+    """Per-file rules a schema cannot state; ids: every claim id of every file."""
+    path = spec["_path"]
+    inputs = [i["id"] for i in spec.get("inputs", [])]
+    dup = [k for k, n in Counter(inputs).items() if n > 1]
+    if dup:
+        raise InputError(f"{path}: input id '{dup[0]}' is defined twice")
+    for i in spec.get("inputs", []):
+        for c in i.get("calibrated_against", []):
+            if c not in ids:
+                raise InputError(f"{path}: input '{i['id']}': calibrated_against names no claim '{c}'")
+    for k, c in enumerate(spec["claims"]):
+        where = f"{path}: claims.{k} ('{c['id']}')"
+        if c["paper"] != paper:
+            raise InputError(f"{where}: paper '{c['paper']}' in the file of '{paper}'")
+        if c["kind"] != "project check" and not c["id"].startswith(PREFIX[paper] + "-"):
+            raise InputError(f"{where}: id must start with '{PREFIX[paper]}-' (the paper's prefix)")
+        for name in c["inferred_inputs"]:
+            if name not in inputs:
+                raise InputError(f"{where}: inferred input '{name}' is not defined under 'inputs' of this file")
+        for d in c.get("depends_on", []):
+            if d not in ids or d == c["id"]:
+                raise InputError(f"{where}: depends_on names no other claim '{d}'")
+        if c["testable"]:
+            t = c["tolerance"]
+            for field in ("derivation", "source", "test"):
+                if not t.get(field, "").strip():
+                    raise InputError(f"{where}: a testable claim needs tolerance.{field}")
+            if c["kind"] == "method result" and not c["runs"]:
+                raise InputError(f"{where}: a testable method result needs the runs it is judged on")
+        elif not c.get("why_not", "").strip():
+            raise InputError(f"{where}: an untestable claim needs why_not")
+        if "quote" in c and "..." in c["quote"] and any(not f.strip() for f in c["quote"].split("...")):
+            raise InputError(f"{where}: quote has an empty fragment around '...'")
+
+
+def load(directory=DEFAULT_DIRECTORY):
+    """Every registry entry of every paper, in file then file order: a list of dicts (InputError
+    naming the file and entry on any violation)."""
+    files = load_files(directory)
+    claims = [c for p in PAPERS for c in files[p]["claims"]]
+    seen = Counter(c["id"] for c in claims)
+    dup = [k for k, n in seen.items() if n > 1]
+    if dup:
+        raise InputError(f"claim id '{dup[0]}' occurs {seen[dup[0]]} times across the registry files")
+    ids = set(seen)
+    for p in PAPERS:
+        _check_file(p, files[p], ids)
+    return claims
+
+
+def inputs(directory=DEFAULT_DIRECTORY):
+    """{paper: [input dicts]}: the inferred inputs of each file, with their sweep ranges."""
+    return {p: spec.get("inputs", []) for p, spec in load_files(directory).items()}
+
+
+def fragments(quote):
+    """The verbatim fragments of a quote ('...' separates them), whitespace-normalised."""
+    return [normalise(f) for f in quote.split("...") if f.strip()]
+
+
+def normalise(text):
+    """Whitespace runs to one space, ends stripped (how quotes are matched against a paper's text)."""
+    return re.sub(r"\s+", " ", text).strip()
+
+
+def quote_found(quote, text):
+    """True when every fragment of quote occurs in text, in order (both whitespace-normalised)."""
+    body, at = normalise(text), 0
+    for frag in fragments(quote):
+        k = body.find(frag, at)
+        if k < 0:
+            return False
+        at = k + len(frag)
+    return True
+
+
+def counts(claims=None, directory=DEFAULT_DIRECTORY):
+    """{paper: {kind: n}} over the registry (project checks under their own kind, never in a paper's
+    tally); 'testable' and 'independent' (testable, no depends_on) are added per paper."""
+    claims = load(directory) if claims is None else claims
+    out = {}
+    for c in claims:
+        row = out.setdefault(c["paper"], {k: 0 for k in KINDS} | {"testable": 0, "independent": 0})
+        row[c["kind"]] += 1
+        if c["kind"] != "project check" and c["testable"]:
+            row["testable"] += 1
+            row["independent"] += not c.get("depends_on")
+    return out
+
+
+def format_counts(table=None):
+    """The counts as a Markdown table (papers x kinds, with the paper tally = all kinds but project checks)."""
+    table = counts() if table is None else table
+    heads = ["paper", *KINDS, "paper tally", "testable", "independent"]
+    lines = ["| " + " | ".join(heads) + " |", "|" + "---|" * len(heads)]
+    total = Counter()
+    for p in PAPERS:
+        r = table.get(p, {})
+        tally = sum(r.get(k, 0) for k in PAPER_KINDS)
+        vals = [r.get(k, 0) for k in KINDS] + [tally, r.get("testable", 0), r.get("independent", 0)]
+        total.update(dict(zip(heads[1:], vals)))
+        lines.append("| " + " | ".join([p, *map(str, vals)]) + " |")
+    lines.append("| all | " + " | ".join(str(total[h]) for h in heads[1:]) + " |")
+    return "\n".join(lines)

@@ -1,0 +1,303 @@
+"""The claims registry (config/claims/<paper>.yaml): valid files, unique ids, verbatim quotes, kinds from
+the list, a tolerance that can fail on every testable entry, every row of the old 42-row claims table
+mapped, run ids that exist (or are flagged new), and the loader's refusals."""
+
+import os
+import re
+import shutil
+from pathlib import Path
+
+import pytest
+import yaml
+
+from isaflow import claims_registry as reg
+from isaflow.inputs import InputError, load as load_yaml
+
+ROOT = Path(__file__).resolve().parents[1]
+CLAIMS_DIR = ROOT / "config" / "claims"
+CLAIMS = reg.load(CLAIMS_DIR)
+FILES = sorted(CLAIMS_DIR.glob("*.yaml"))
+
+
+def papers_dir():
+    """The shared papers folder: $ISAFLOW_PAPERS, else shared/papers beside any parent of the checkout."""
+    env = os.environ.get("ISAFLOW_PAPERS")
+    if env:
+        return Path(env)
+    for parent in ROOT.parents:
+        if (parent / "shared" / "papers").is_dir():
+            return parent / "shared" / "papers"
+    return None
+
+
+PAPERS = papers_dir()
+TEXT = {p: spec["text"] for p, spec in reg.load_files(CLAIMS_DIR).items()}
+
+
+def test_counts_per_paper_and_kind():
+    """The tally printed for the report and the audit note (pytest -s shows it)."""
+    table = reg.counts(CLAIMS)
+    print("\n" + reg.format_counts(table))
+    assert set(table) == set(reg.PAPERS)
+    assert sum(sum(r[k] for k in reg.KINDS) for r in table.values()) == len(CLAIMS)
+    for p, r in table.items():
+        tally = sum(r[k] for k in reg.PAPER_KINDS)
+        assert tally == sum(1 for c in CLAIMS if c["paper"] == p and c["kind"] != "project check")
+        assert r["independent"] <= r["testable"] <= tally
+
+
+@pytest.mark.parametrize("path", FILES, ids=lambda p: p.name)
+def test_each_file_is_valid(path):
+    _, spec = load_yaml(path, reg.SCHEMA, "claims registry file")
+    assert spec["paper"] == path.stem
+    assert all(c["paper"] == path.stem for c in spec["claims"])
+
+
+def test_one_file_per_paper_and_unique_ids():
+    assert sorted(p.stem for p in FILES) == sorted(reg.PAPERS)
+    ids = [c["id"] for c in CLAIMS]
+    assert len(ids) == len(set(ids))
+
+
+def test_kinds_from_the_list():
+    assert {c["kind"] for c in CLAIMS} <= set(reg.KINDS)
+    assert all(c["id"].startswith("prj-") == (c["kind"] == "project check") for c in CLAIMS)
+
+
+@pytest.mark.skipif(PAPERS is None, reason="shared papers folder not found (set ISAFLOW_PAPERS)")
+@pytest.mark.parametrize("claim", [c for c in CLAIMS if "quote" in c], ids=lambda c: c["id"])
+def test_quote_is_verbatim(claim):
+    """Every fragment of the quote ('...' separates them) occurs in the paper's text, in order, after
+    whitespace normalisation."""
+    text = (PAPERS / TEXT[claim["paper"]]).read_text(encoding="utf-8")
+    body, at = reg.normalise(text), 0
+    for frag in reg.fragments(claim["quote"]):
+        k = body.find(frag, at)
+        assert k >= 0, f"fragment not found (in order): {frag!r}"
+        at = k + len(frag)
+
+
+def test_every_paper_claim_has_a_quote():
+    assert all(c.get("quote") for c in CLAIMS if c["kind"] != "project check")
+
+
+@pytest.mark.parametrize("claim", [c for c in CLAIMS if c["testable"]], ids=lambda c: c["id"])
+def test_testable_entries_have_a_tolerance_that_can_fail(claim):
+    t = claim["tolerance"]
+    assert t["derivation"].strip() and t["source"].strip() and t["test"].strip()
+    assert re.match(r"^(page text|paper wording|printed precision|discretisation|physics|statistics|round-off)",
+                    t["source"])
+    if t["kind"] in ("absolute", "relative", "ratio", "range", "order"):
+        assert "value" in t
+    if t["kind"] == "range":
+        lo, hi = t["value"]
+        assert lo < hi
+    # a test that cannot fail is no test: it names a comparison or a condition
+    assert re.search(r"[<>=]|\b(inconsistent|every|all|each|no|without|more than|monotone|strictly|smaller|"
+                     r"exceed|passes|reaches|stays|computes)\b", t["test"]), t["test"]
+    if claim["kind"] == "method result":
+        assert claim["runs"], "a method result is judged on runs"
+
+
+def test_untestable_entries_say_why():
+    for c in CLAIMS:
+        if not c["testable"]:
+            assert c["why_not"].strip() and "tolerance" not in c, c["id"]
+
+
+def test_references_resolve():
+    inputs = reg.inputs(CLAIMS_DIR)
+    ids = {c["id"] for c in CLAIMS}
+    for c in CLAIMS:
+        names = {i["id"] for i in inputs[c["paper"]]}
+        assert set(c["inferred_inputs"]) <= names, c["id"]
+        assert set(c.get("depends_on", [])) <= ids - {c["id"]}, c["id"]
+    for p, lst in inputs.items():
+        for i in lst:
+            assert set(i.get("calibrated_against", [])) <= ids
+
+
+def test_every_inferred_input_is_used_by_a_verdict():
+    used = {(c["paper"], name) for c in CLAIMS for name in c["inferred_inputs"]}
+    for p, lst in reg.inputs(CLAIMS_DIR).items():
+        for i in lst:
+            assert (p, i["id"]) in used, f"{p}: input {i['id']} rests no verdict"
+
+
+def test_the_calibrated_level_rows_name_their_calibration():
+    k_pair = next(i for i in reg.inputs(CLAIMS_DIR)["papadopoulos2016"] if i["id"] == "k_pair")
+    assert set(k_pair["calibrated_against"]) == {"pap-6.1-level-coarse", "pap-6.2-level-refined"}
+
+
+def test_two_sided_sentences_are_split():
+    """Sentences with an ISA half and an SPH or MPS half are two rows (issue 23)."""
+    halves = {(c["section"], c["half"]) for c in CLAIMS if "half" in c}
+    assert {h for _, h in halves} >= {"isa", "sph", "mps"}
+    by_id = {c["id"]: c for c in CLAIMS}
+    assert by_id["pap-7-isa-oscillations"]["half"] == "isa" and by_id["pap-7-sph-needs-technique"]["half"] == "sph"
+    assert by_id["mar-abs-tensile-solid"]["half"] == "solid" and by_id["mar-1-spam-tensile"]["half"] == "sph"
+
+
+# --- the 42 rows of docs/replication.md before issue 23: each maps to an entry ('was.row') -------------
+OLD_ROWS = [
+    "papadopoulos2016 1, 7 | \"approximates dynamic behavior with strong damping\"",
+    "papadopoulos2016 1 (introduction) | in the MPS method",
+    "papadopoulos2016 6.1, 6.2 | \"in about 2.000 steps",
+    "papadopoulos2016 6.4, 7 | \"In about 300,000 steps",
+    "papadopoulos2016 6.1 | \"free surface level ... y_eq ~ 72.5 cm\"",
+    "papadopoulos2016 6.2 | \"free surface level ... y_eq ~ 75 cm\"",
+    "papadopoulos2016 6.1 | \"The approximation between computational and theoretical results",
+    "papadopoulos2016 6.2 | \"A slightly improved approximation",
+    "papadopoulos2016 5 | \"For small deformations u < 0.293a",
+    "papadopoulos2016 5 | \"the area of elementary rhomb has been reduced by only 8.6%\"",
+    "papadopoulos2016 6.1 | \"approximate maximum external repulsive reaction",
+    "papadopoulos2016 6.1 | \"distance, from boundary to adjacent particle",
+    "papadopoulos2016 6.3 | \"In 100,000 steps",
+    "papadopoulos2016 6.4 | \"except of few, fourteen",
+    "papadopoulos2016 6.4 | \"y_eq ~ 32.0 cm ~ 33.4 cm",
+    "papadopoulos2016 Table 1 | \"Steps number ... Computing Time\"",
+    "papadopoulos2016 7 | artificial high frequency oscillations are suppressed",
+    "marko2017 4.1 | The peak tensile stress of 1.4758 MPa",
+    "marko2017 4.1 | the width in the X and Z direction decreased",
+    "marko2017 4.1 | yielding an equivalent Poisson's ratio of 0.34125",
+    "marko2017 4.1 | the magnitude of the stress was identical to the tension case",
+    "marko2017 4.1 | the width in the X and Z direction increased",
+    "marko2017 4.2 | shear modulus of G_Y = 79.6154 GPa",
+    "marko2017 4.2 | gamma = 18.3429e-6 / 9.3619e-2 = 1.9593e-4",
+    "marko2017 4.2 | tau = (79.6154e9) x (1.9593e-4) = 15.5992e6",
+    "marko2017 4.2 | The numerical maximum shear stress was observed to be 15.8993 MPa",
+    "marko2017 4.3 | E'_Y = 207 / (1 - 0.3^2) = 227.4725",
+    "marko2017 4.3 | the peak stress ranging from 7.3 to 10 GPa",
+    "marko2017 4.3 | the analytical load to accomplish this would be 2.66 to 5.98 kN",
+    "marko2017 4.3 | the error percentages for the peak stress were even lower",
+    "marko2017 4.3 | The error percentages for the load varied from 2% to 10.4%",
+    "marko2017 4.3 | the simulation under discussion uses time steps ranging from 15 to 56 nanoseconds",
+    "marko2017 4.4 | The simulation was ran for 400 time steps",
+    "marko2017 4.4 | It was observed that the steel particles are all pushed outwards",
+    "marko2017 4.4 | as the liquid pressure stabilizes within the pressure vessel",
+    "marko2017 floor | (not in the papers) an elastic floor",
+    "hattori eqs. (1)-(5) | By adding the equation (3) and the equation (5)",
+    "hattori eq. (6) | Considering the temporal compressibility",
+    "merino_alonso2020 abstract | the problem in which each particle has one single neighbor",
+    "merino_alonso2020 abstract | When two and three neighbors are involved",
+    "merino_alonso2020 abstract | divergent solutions are also found",
+    "merino_alonso2020 abstract | In general, the Wendland Kernel C 2 turns out to be the worst choice",
+]
+
+
+def test_every_old_row_maps_to_an_entry():
+    assert len(OLD_ROWS) == 42
+    was = [c["was"]["row"] for c in CLAIMS if "was" in c]
+    for row in OLD_ROWS:
+        assert any(w.startswith(row) for w in was), f"old row not mapped: {row}"
+    for w in was:  # and every 'was' names one of them
+        assert any(w.startswith(row) for row in OLD_ROWS), f"'was' names no old row: {w}"
+
+
+# --- run ids: the workflow's names, or flagged new_run ------------------------------------------------
+def _smk_list(path, name):
+    m = re.search(rf"^{name} = \[(.*?)\]", (ROOT / path).read_text(), re.M)
+    return re.findall(r'"([^"]+)"', m.group(1))
+
+
+def existing_runs():
+    """Every run id the workflow defines today, as <method>:<id> (from the config and rule files)."""
+    cfg = yaml.safe_load((ROOT / "config/config.yaml").read_text())
+    runs = {f"isa:{r}" for r in cfg["runs"]} | {"isa:calibration", "isa:error_vs_runtime", "isa:stability_map"}
+    sph = yaml.safe_load((ROOT / "config/methods/sph.yaml").read_text())
+    res = {case: [f"n{r['particles']}" if "particles" in r else f"dx{r['spacing']:g}" for r in sph["runs"][case]]
+           for case in ("single", "flow")}
+    runs |= {f"sph:single_wcsph_{r}" for r in res["single"]} | {f"sph:flow_wcsph_{r}" for r in res["flow"]}
+    runs |= {f"sph:single_{v}_{r}" for v in sph["variants"] if v != "wcsph" for r in res["single"][:-1]}
+    runs |= {f"sph:stab_{c}" for c in sph["runs"]["stability"]}
+    mps = yaml.safe_load((ROOT / "config/methods/mps.yaml").read_text())
+    variants = _smk_list("workflow/rules/methods/mps.smk", "MPS_VARIANTS")
+    for case in ("single", "flow"):
+        runs |= {f"mps:{case}_{v}_dx{l0:.3g}" for v in variants for l0 in mps["runs"][f"{case}_spacings"]["value"]}
+    runs |= {f"mps:stiff_{c}" for c in _smk_list("workflow/rules/methods/mps.smk", "MPS_STIFF")}
+    runs |= {f"mps:dt_standard_c{c:g}" for c in mps["dt_study"]["courants"]["value"]}
+    cases = _smk_list("workflow/rules/methods/solid.smk", "SOLID_CASES")
+    runs |= {f"solid:{c}_{v}" for c in cases for v in ("paper", "hooke")}
+    runs |= {"solid:vessel_pressure_load", "solid:vessel_water_particles", "solid:floor_uniform_uniform_load"}
+    runs |= {f"solid:floor_{m}_oneway" for m in ("isa", "sph", "mps")}
+    return runs | {"sph1d:sweep"}
+
+
+def test_runs_exist_or_are_flagged_new():
+    known = existing_runs()
+    listed = [r for c in CLAIMS for r in c["runs"]]
+    listed += [r for lst in reg.inputs(CLAIMS_DIR).values() for i in lst for r in i.get("runs", [])]
+    for r in listed:
+        if r.get("new_run"):
+            assert r["id"] not in known, f"{r['id']} exists already: drop new_run"
+            assert r["what"].strip()
+        else:
+            assert r["id"] in known, f"{r['id']} is no run of the workflow: flag it new_run with 'what'"
+
+
+# --- the loader refuses -------------------------------------------------------------------------------
+@pytest.fixture
+def registry_copy(tmp_path):
+    d = tmp_path / "claims"
+    shutil.copytree(CLAIMS_DIR, d)
+    return d
+
+
+def _edit(path, old, new):
+    text = path.read_text()
+    assert old in text
+    path.write_text(text.replace(old, new, 1))
+
+
+def test_copy_loads(registry_copy):
+    assert len(reg.load(registry_copy)) == len(CLAIMS)
+
+
+@pytest.mark.parametrize("case, file, old, new, message", [
+    ("duplicate key", "hattori.yaml", "    kind: paper arithmetic\n", "    kind: paper arithmetic\n    kind: input rule\n",
+     "duplicate key"),
+    ("alias", "hattori.yaml", "    inferred_inputs: []\n", "    inferred_inputs: &x []\n    note: *x\n", "aliases"),
+    ("unknown field", "hattori.yaml", "    kind: paper arithmetic\n", "    kind: paper arithmetic\n    verdict: reproduced\n",
+     "Additional properties"),
+    ("unknown kind", "hattori.yaml", "    kind: paper arithmetic\n", "    kind: result\n", "kind"),
+    ("testable without tolerance", "merino_alonso2020.yaml", "    testable: true\n", "    testable: false\n",
+     "claims"),
+    ("unknown input", "hattori.yaml", "inferred_inputs: [reference_configuration]", "inferred_inputs: [nowhere]",
+     "inferred input 'nowhere'"),
+    ("unknown dependency", "papadopoulos2016.yaml", "depends_on: [pap-6.1-steps-coarse, pap-6.2-steps-refined]",
+     "depends_on: [pap-9-nothing]", "depends_on"),
+    ("wrong prefix", "hattori.yaml", "id: hat-eq1-5-algebra", "id: mer-eq1-5-algebra", "prefix"),
+    ("NaN", "hattori.yaml", "value: 1.5\n", "value: .nan\n", "finite"),
+])
+def test_loader_refuses(registry_copy, case, file, old, new, message):
+    _edit(registry_copy / file, old, new)
+    with pytest.raises(InputError, match=re.escape(message) if case != "unknown field" else message):
+        reg.load(registry_copy)
+
+
+def test_loader_refuses_duplicate_ids_across_files(registry_copy):
+    text = (registry_copy / "merino_alonso2020.yaml").read_text()
+    (registry_copy / "merino_alonso2020.yaml").write_text(text.replace("id: mer-abs-setup", "id: prj-hat-mps-step", 1)
+                                                          .replace("    kind: input rule\n    quantity: the sweep's design",
+                                                                   "    kind: project check\n    quantity: the sweep's design", 1))
+    with pytest.raises(InputError, match="occurs 2 times"):
+        reg.load(registry_copy)
+
+
+def test_loader_refuses_a_file_named_after_another_paper(registry_copy):
+    (registry_copy / "hattori.yaml").rename(registry_copy / "hattori2.yaml")
+    with pytest.raises(InputError, match="does not match the file name"):
+        reg.load(registry_copy)
+
+
+def test_loader_refuses_a_missing_paper(registry_copy):
+    (registry_copy / "hattori.yaml").unlink()
+    with pytest.raises(InputError, match="no registry file for hattori"):
+        reg.load(registry_copy)
+
+
+def test_quote_matching_is_ordered_and_whitespace_blind():
+    text = "Alpha  beta\n gamma. Delta epsilon."
+    assert reg.quote_found("Alpha beta gamma ... Delta", text)
+    assert not reg.quote_found("Delta ... Alpha", text)
+    assert not reg.quote_found("beta gamma delta", text)
