@@ -106,6 +106,94 @@ def check_walls(path, spec):
     return walls
 
 
+def _chain(walls, tol=1e-9):
+    """Walls (indices) of the outline: the chain of walls joined end to start, head to tail, that runs through
+    the lowest horizontal wall; returned in traversal order (None if the walls do not join into one chain)."""
+    floors = [k for k, w in enumerate(walls) if abs(w[1] - w[3]) <= tol]
+    if not floors:
+        return None
+    start = min(floors, key=lambda k: walls[k, 1])
+    order = [start]
+    while True:  # walk back: a wall whose end is this one's start
+        prev = [k for k, w in enumerate(walls) if k not in order and np.allclose(w[2:], walls[order[0], :2], atol=tol)]
+        if len(prev) != 1:
+            break
+        order.insert(0, prev[0])
+    while True:  # and forward
+        nxt = [k for k, w in enumerate(walls) if k not in order and np.allclose(w[:2], walls[order[-1], 2:], atol=tol)]
+        if len(nxt) != 1:
+            break
+        order.append(nxt[0])
+    return order
+
+
+def _cross(a, b, tol=1e-9):
+    """True if segments a, b (x0, y0, x1, y1) intersect other than at a shared end point."""
+    p, r = a[:2], a[2:] - a[:2]
+    q, t = b[:2], b[2:] - b[:2]
+    den = r[0] * t[1] - r[1] * t[0]
+    if abs(den) <= tol * np.hypot(*r) * np.hypot(*t):  # parallel: overlapping collinear segments cross
+        if abs((q - p)[0] * r[1] - (q - p)[1] * r[0]) > tol * np.hypot(*r) ** 2:
+            return False
+        s0, s1 = sorted(((q - p) @ r / (r @ r), (q + t - p) @ r / (r @ r)))
+        return min(s1, 1.0) - max(s0, 0.0) > tol
+    u = ((q - p)[0] * t[1] - (q - p)[1] * t[0]) / den
+    v = ((q - p)[0] * r[1] - (q - p)[1] * r[0]) / den
+    inside = -tol <= u <= 1 + tol and -tol <= v <= 1 + tol
+    ends = (abs(u) <= tol or abs(u - 1) <= tol) and (abs(v) <= tol or abs(v - 1) <= tol)
+    return inside and not ends
+
+
+def check_geometry(path, spec, walls):
+    """A tank that can hold its liquid: one outline of joined walls (down the left side, along the floors, up
+    the right side: the liquid on every wall's left), no crossing walls, every vessel inside the outline on a
+    floor, the liquid's top below the outline's wall tops.  InputError naming the file and field otherwise."""
+    names = [w["name"] for w in spec["walls"]]
+    order = _chain(walls)
+    where = f"{path}: field 'walls'"
+    if order is None:
+        raise InputError(f"{where}: no horizontal wall: a tank needs a floor")
+    outline = walls[order]
+    if not (outline[0, 1] > outline[0, 3] and outline[-1, 3] > outline[-1, 1]):
+        raise InputError(f"{where}: the walls joined to the floor do not run down one side and up the other "
+                         f"({names[order[0]]} ... {names[order[-1]]}): the tank is not closed below its top, or a "
+                         f"wall is reversed (walls are oriented with the liquid on their left)")
+    for k in order:
+        w = walls[k]
+        if abs(w[1] - w[3]) <= 1e-9 and w[2] < w[0]:
+            raise InputError(f"{where} ({names[k]}): a floor must run left to right (the liquid on its left)")
+    for i in range(len(walls)):
+        for j in range(i + 1, len(walls)):
+            if _cross(walls[i], walls[j]):
+                raise InputError(f"{where}: walls '{names[i]}' and '{names[j]}' cross")
+    x_lo, x_hi = outline[0, 0], outline[-1, 2]
+    top = min(outline[0, 1], outline[-1, 3])
+    others = [k for k in range(len(walls)) if k not in order]
+    for k in others:
+        w = walls[k]
+        if min(w[0], w[2]) < x_lo - 1e-9 or max(w[0], w[2]) > x_hi + 1e-9:
+            raise InputError(f"{where} ({names[k]}): a wall outside the tank's outline [{x_lo:g}, {x_hi:g}] cm")
+    vessels = spec.get("vessels") or [{"name": "(whole tank)", "x": [x_lo, x_hi]}]
+    floor_y = None
+    for n, v in enumerate(vessels):
+        x0, x1 = v["x"]
+        if x0 < x_lo - 1e-9 or x1 > x_hi + 1e-9:
+            raise InputError(f"{path}: field 'vessels' ({v['name']}): [{x0:g}, {x1:g}] cm lies outside the walls "
+                             f"[{x_lo:g}, {x_hi:g}] cm")
+        under = [w for w in outline if abs(w[1] - w[3]) <= 1e-9 and min(w[0], w[2]) <= x1 and max(w[0], w[2]) >= x0]
+        if not under:
+            raise InputError(f"{path}: field 'vessels' ({v['name']}): no floor under [{x0:g}, {x1:g}] cm")
+        if n == 0:
+            floor_y = min(w[1] for w in under)
+    for a, b in zip(vessels, vessels[1:]):
+        if b["x"][0] < a["x"][1] - 1e-9:
+            raise InputError(f"{path}: field 'vessels' ({b['name']}): overlaps '{a['name']}'")
+    depth = float(spec["liquid"]["depth"])
+    if floor_y + depth > top + 1e-9:
+        raise InputError(f"{path}: field 'liquid.depth': {depth:g} cm above the first floor (y = {floor_y:g} cm) "
+                         f"reaches over the wall tops (y = {top:g} cm)")
+
+
 def check_positions(path, field, pos, walls):
     """Refuse positions that are non-finite or outside the walls' bounding box (NaN counts as outside)."""
     if not np.isfinite(pos).all():
@@ -129,5 +217,6 @@ def load(path):
     """Read and validate a tank file; InputError naming the file and the field."""
     path = str(path)
     text, spec = inputs.load(path, SCHEMA, "tank")
-    check_walls(path, spec)
+    walls = check_walls(path, spec)
+    check_geometry(path, spec, walls)
     return Tank(path, spec, text)

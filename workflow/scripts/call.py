@@ -1,10 +1,10 @@
 """Snakemake script: call one isaflow function; the one calling convention of every script rule.
 
-params.func names 'module.function' under isaflow (e.g. 'tables.error_table',
-'figures.single.single_vessel_figure', 'report.flow.flow_section').  It is
-called as func(**named inputs except 'code', outputs=[output files],
-**params.kw); single-file inputs are passed as a path, others as a list.
-stderr (warnings, tracebacks) goes to the rule's log.  BLAS and OpenMP run on the rule's threads.
+params.func names 'module.function' under isaflow (e.g. 'methods.isa.tables.error_table',
+'figures.methods.tanks_figure').  It is called as func(**named inputs except 'code', outputs=[output
+files], **params.kw); single-file inputs are passed as a path, others as a list.  stderr goes to the
+rule's log.  BLAS and OpenMP run on the rule's threads.  An input error (isaflow.inputs.InputError, or a
+file that is no run file) ends the job with one line in the log and exit status 2, no traceback.
 """
 import importlib
 import os
@@ -13,15 +13,22 @@ import sys
 # BLAS/OpenMP threads = the rule's threads (1 unless it asks for more), set before numpy loads: a threaded
 # OpenBLAS sums in an order that varies from run to run, and two runs of the same commit must give
 # byte-identical physics outputs.
-for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
     os.environ[_var] = str(snakemake.threads)  # noqa: F821
 
-sys.stderr = open(snakemake.log[0], "w")  # noqa: F821
+sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 # the command run files record: the rule and function, not Snakemake's temporary copy of this script
 sys.argv = ["snakemake", f"rule {snakemake.rule}:", f"isaflow.{snakemake.params.func}", "->", *snakemake.output]  # noqa: F821
+
+from isaflow.inputs import InputError  # noqa: E402
+from isaflow.runfile import RunFileError  # noqa: E402
 
 mod, name = snakemake.params.func.rsplit(".", 1)  # noqa: F821
 func = getattr(importlib.import_module(f"isaflow.{mod}"), name)
 inputs = {k: (v if isinstance(v, str) else list(v)) for k, v in snakemake.input.items() if k != "code"}  # noqa: F821
-func(**inputs, outputs=list(snakemake.output), **dict(snakemake.params.get("kw", {}) or {}))  # noqa: F821
+try:
+    func(**inputs, outputs=list(snakemake.output), **dict(snakemake.params.get("kw", {}) or {}))  # noqa: F821
+except (InputError, RunFileError) as err:
+    print(f"error: {err}", file=sys.stderr)
+    sys.exit(2)
 print(f"{snakemake.params.func}: wrote {', '.join(snakemake.output)}", file=sys.stderr)  # noqa: F821
