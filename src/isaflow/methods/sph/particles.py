@@ -148,9 +148,9 @@ def wall_particles(walls, dx, dy, support, origin=(0.0, 0.0), two_faced=None):
         n_ext = int(np.ceil(support / d_t))
         tips = [e for e, free in ((0.0, (w, 0) not in jt), (L, (w, 1) not in jt)) if free]
         for face in ((0, 1) if two_faced[w] else (0,)):
-            # face 0, past a joint: fill the corner; at a free end (and on face 1): cover the wall to its tip
-            lo = -n_ext * d_t if (w, 0) in jt and face == 0 else -0.5 * d_t
-            hi = L + n_ext * d_t if (w, 1) in jt and face == 0 else L + 0.5 * d_t
+            # face 0, past a joint: fill the corner; at a free end (and on face 1): up to the tip column
+            lo = -n_ext * d_t if (w, 0) in jt and face == 0 else 0.0
+            hi = L + n_ext * d_t if (w, 1) in jt and face == 0 else L
             j = np.arange(np.floor((lo - s_org) / d_t) - 1, np.ceil((hi - s_org) / d_t) + 1)
             s = s_org + (j + 0.5) * d_t
             s = s[(s >= lo) & (s <= hi)]

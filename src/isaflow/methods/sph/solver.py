@@ -86,11 +86,11 @@ def _start_value(start, name, default):
 
 def setup(tank, s, resolution, start=None, on_wall=False):
     """Initial state: dict of arrays and scalars (see _run).  start: a run Dataset to continue
-    (its pos, velocity, density, list_pos, weight, lattice cell, clock and step count)."""
+    (its pos, velocity, density, list_pos, acceleration, weight, lattice cell, clock and step count)."""
     x0, x1, floor_y = first_vessel(tank)
     kind = smoothing.kernel_id(s["kernel"])
     c0 = s["sound_speed_factor"] * math.sqrt(2 * G * s["max_drop"])
-    t0, step0 = 0.0, 0
+    t0, step0, acc = 0.0, 0, None
     if start is not None:
         dx, dy = float(start.attrs["cell_dx"]), float(start.attrs["cell_dy"])
         pos = start["pos"].values.copy()
@@ -99,6 +99,7 @@ def setup(tank, s, resolution, start=None, on_wall=False):
         t0 = float(_start_value(start, "sim_time", 0.0))
         step0 = int(_start_value(start, "steps", 0))
         xref = start["list_pos"].values.copy() if "list_pos" in start else pos.copy()
+        acc = start["acceleration"].values.copy() if "acceleration" in start else None
         depth0 = float(start.attrs.get("initial_depth", tank.depth))
     else:
         nx, ny = P.lattice_shape(x1 - x0, tank.depth, resolution.get("particles"), resolution.get("spacing"))
@@ -122,7 +123,7 @@ def setup(tank, s, resolution, start=None, on_wall=False):
     wpos, owner, face = P.wall_particles(tank.walls, dx, dy, 2 * h, origin=(x0, floor_y), two_faced=two)
     dt = min(s["cfl"] * h / c0, 0.25 * math.sqrt(h / G))
     return dict(pos=pos, vel=vel, rho=rho, xref=xref, wpos=wpos, owner=owner, face=face, dx=dx, dy=dy, h=h, c0=c0,
-                dt=dt, mass=mass, rho_ref=rho_ref, kind=kind, t0=t0, step0=step0, depth0=depth0,
+                dt=dt, mass=mass, rho_ref=rho_ref, kind=kind, t0=t0, step0=step0, depth0=depth0, acc=acc,
                 par=pack(s, h, mass, rho_ref, c0, dt, kind, math.sqrt(dx * dy)))
 
 
@@ -170,6 +171,20 @@ def solve(tank, variant="wcsph", resolution=None, overrides=None, start=None, on
     return res
 
 
+def start_dataset(res):
+    """The part of a run file a continuation reads (setup), from a Result: pos, velocity, density,
+    list_pos, acceleration, weight, sim_time, steps and the lattice cell (xarray Dataset)."""
+    import xarray as xr
+
+    f = res.fields
+    return xr.Dataset({"pos": (("particle", "xy"), res.pos), "velocity": f["velocity"][:2],
+                       "density": f["density"][:2], "list_pos": f["list_pos"][:2],
+                       "acceleration": f["acceleration"][:2],
+                       "weight": (("particle",), res.weight), "sim_time": ((), res.sim_time),
+                       "steps": ((), res.steps)},
+                      attrs={k: res.params[k] for k in ("cell_dx", "cell_dy", "initial_depth")})
+
+
 def _panels(walls, length, owner, face, wpos, force, dx, dy):
     """Contacts of the wall-particle forces: per face, spread over the panels (face 1: the back of a
     thin wall).  Returns (wall, point, force, side) with side 0 front (liquid side), 1 back."""
@@ -211,6 +226,8 @@ def _run(tank, s, resolution, start, on_wall, t_max, log, threads=1):
     panel0 = np.concatenate([[0], np.cumsum(npanel)[:-1]]).astype(np.int64)
     panel_sum = np.zeros((len(pw), 2))
     K.evaluate(x, v, rho, p, nf, walls, par, lst, wk, fk, acc, wall_force, panel0, npanel, panel_sum, threads)
+    if st["acc"] is not None:  # the viscosity took the half-step velocities: the run's own accelerations
+        acc[:] = st["acc"]
     diag = np.zeros(4)
     flow = len(tank.spec.get("vessels", [])) > 1
     t_max = t_max or (s["t_max_flow"] if flow else s["t_max_single"])
@@ -307,6 +324,9 @@ def _run(tank, s, resolution, start, on_wall, t_max, log, threads=1):
         "velocity": (("particle", "xy"), v.copy(), VELOCITY, "particle velocity"),
         "list_pos": (("particle", "xy"), xref.copy(), "cm",
                      "positions at the last pair-list build (a continuation rebuilds the list there)"),
+        "acceleration": (("particle", "xy"), acc.copy(), "cm s-2",
+                         "acceleration at the end (its viscosity took the half-step velocities; a continuation "
+                         "starts from it)"),
     }
     params = {f"sph_{k}": (str(v_) if isinstance(v_, (bool, list)) else v_) for k, v_ in s.items()}
     initial_depth = st["depth0"]
