@@ -87,7 +87,7 @@ def test_pair_list_is_the_brute_force_list_with_visibility():
     liquid = np.concatenate([rng.uniform([1, 1], [99, 99], (300, 2)), rng.uniform([101, -49], [299, 99], (300, 2))])
     x = np.concatenate([liquid, wpos])
     nf, rc = len(liquid), 2 * 1.3 * dx
-    pi, pj, m, col, wrow, wpair, near = K.list_pairs(x, nf, np.array([-20.0, -70, 320, 120]), rc, FLOW.walls)
+    pi, pj, m, col, wrow, wpair, close, dwall = K.list_pairs(x, nf, np.array([-20.0, -70, 320, 120]), rc, FLOW.walls)
     got = {(min(int(a), int(b)), max(int(a), int(b))) for a, b in zip(pi[:m], pj[:m])}
     assert len(got) == m and (pi[:m] < nf).all()
     want = set()

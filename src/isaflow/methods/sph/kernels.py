@@ -4,8 +4,8 @@ Arrays (units cm, N, s; masses N s^2/cm, densities N s^2/cm^4, pressures N/cm^2)
 - x (n, 2): positions, rows 0..nf-1 liquid particles, rows nf..n-1 wall
   (boundary) particles, which never move;
 - v (nf, 2) velocities; rho (n,) densities; p (n,) pressures;
-- lst: the pair list of :func:`pairs.build`, a tuple (pi, pj, m, col, wrow, wpair, near):
-  half list, pi liquid, pj liquid or wall (pj >= nf), grouped by cell columns so that
+- lst: the pair list of :func:`pairs.build`, a tuple (pi, pj, m, col, wrow, wpair, close,
+  dwall): half list, pi liquid, pj liquid or wall (pj >= nf), grouped by cell columns so that
   the pair passes run the even columns, then the odd ones, each column in list order
   (in parallel with ``threads`` > 1, bit-identical to the serial passes: see pairs);
 - par (NPAR,) float64 settings, indices below (see solver.pack).
@@ -40,9 +40,17 @@ CHUNK = 1024  # particles per chunk of the per-particle loops (fixed: results do
 OK, CROSSED, LEFT_BOX, NONFINITE = range(4)
 
 
-def list_pairs(x, nf, box, rc, walls):
-    """The pair list tuple (pi, pj, m, col, wrow, wpair, near) of all particles x within rc (pairs.build)."""
-    return build(x, nf, box, rc, walls, np.empty(16, np.int32), np.empty(16, np.int32))
+def list_pairs(x, nf, box, rc, walls, reach=0.0):
+    """The pair list tuple (pi, pj, m, col, wrow, wpair, close, dwall) of all particles x within rc
+    (pairs.build; close: the liquid particles within ``reach`` of a wall at the build)."""
+    return build(x, nf, box, rc, walls, np.empty(16, np.int32), np.empty(16, np.int32), reach)
+
+
+@njit(inline="always", **JIT)
+def reach_of(par):
+    """Distance [cm] from a wall within which, at a list build, a particle can feel the Lennard-Jones net
+    before the next build: r0 + skin / 2 (a particle moves less than skin / 2 between builds)."""
+    return par[LJ_R0] + 0.5 * par[SKIN]
 
 
 @njit(inline="always", **JIT)
@@ -278,7 +286,7 @@ def state_forces(x, v, rho, p, nf, walls, par, lst, wk, fk, acc, wall_force, pan
     (repulsion.wall_repulsion on the particles near a wall; its force on the panels is added to
     panel_sum (P, 2) N).  wall_force (nw, 2) N: force of each wall particle on the liquid.
     """
-    pi, pj, m, col, wrow, wpair, near = lst
+    pi, pj, m, col, wrow, wpair, close, dwall = lst
     nw = x.shape[0] - nf
     summation = par[SUMMATION] > 0
     if summation:
@@ -300,7 +308,7 @@ def state_forces(x, v, rho, p, nf, walls, par, lst, wk, fk, acc, wall_force, pan
         liquid_range(0, nf, rho, rate, p, p_rho2, acc, par, update and not summation)
         wall_range(0, nw, x, rho, p, p_rho2, nf, pi, wrow, wpair, wk, par, wall_force)
         _force_ser(col, x, v, rho, p_rho2, nf, pi, pj, par, fk, acc, wall_force)
-    wall_repulsion(x, near, walls, panel0, npanel, par[LJ_D], par[LJ_R0], par[MASS], acc, panel_sum)
+    wall_repulsion(x, close, walls, panel0, npanel, par[LJ_D], par[LJ_R0], par[MASS], acc, panel_sum)
 
 
 @njit(**PJIT)
@@ -326,14 +334,35 @@ def _kick_ser(nf, v, acc, half, part):
 
 
 @njit(**JIT)
-def _drift_range(lo, hi, x, v, xref, dt, box):
-    """Drift particles lo..hi-1; returns (largest squared move since xref, first particle that left box
-    or became non-finite, or -1)."""
+def _move_range(lo, hi, x, v, acc, xref, half, dt, box, walls, dwall, slack, finish):
+    """Particles lo..hi-1: if finish, the second kick of the last step (v += dt/2 acc) and its |v|^2
+    sum; then the first kick of this step and the drift.  A particle whose move could reach a wall
+    (dt |v| >= its distance to the walls at the last build minus slack = skin / 2, the most it has
+    moved since) is tested (core.geometry.crossed_wall) and, if it would cross, left where it is.
+    Returns (sum |v|^2 after the finishing kick, largest squared move since xref, first particle that
+    would cross a wall or -1, first particle that left box or became non-finite or -1)."""
+    v2 = 0.0
     moved2 = 0.0
+    cross = -1
     bad = -1
     for a in range(lo, hi):
-        x1 = x[a, 0] + dt * v[a, 0]
-        y1 = x[a, 1] + dt * v[a, 1]
+        if finish:
+            v[a, 0] += half * acc[a, 0]
+            v[a, 1] += half * acc[a, 1]
+            v2 += v[a, 0] * v[a, 0] + v[a, 1] * v[a, 1]
+        v[a, 0] += half * acc[a, 0]
+        v[a, 1] += half * acc[a, 1]
+        x0 = x[a, 0]
+        y0 = x[a, 1]
+        x1 = x0 + dt * v[a, 0]
+        y1 = y0 + dt * v[a, 1]
+        step2 = (x1 - x0) * (x1 - x0) + (y1 - y0) * (y1 - y0)
+        reach = dwall[a] - slack
+        if not (step2 < reach * reach and reach > 0.0):
+            if crossed_wall(x0, y0, x1, y1, walls) >= 0:
+                if cross < 0:
+                    cross = a
+                continue
         if bad < 0 and not (np.isfinite(x1) and np.isfinite(y1) and box[0] <= x1 <= box[2] and box[1] <= y1 <= box[3]):
             bad = a
         x[a, 0] = x1
@@ -341,13 +370,14 @@ def _drift_range(lo, hi, x, v, xref, dt, box):
         ddx = x1 - xref[a, 0]
         ddy = y1 - xref[a, 1]
         moved2 = max(moved2, ddx * ddx + ddy * ddy)
-    return moved2, bad
+    return v2, moved2, cross, bad
 
 
 @njit(**PJIT)
-def _drift_par(nf, x, v, xref, dt, box, moved, bad):
+def _move_par(nf, x, v, acc, xref, half, dt, box, walls, dwall, slack, finish, part, moved, cross, bad):
     for ch in prange((nf + CHUNK - 1) // CHUNK):
-        moved[ch], bad[ch] = _drift_range(ch * CHUNK, min(nf, (ch + 1) * CHUNK), x, v, xref, dt, box)
+        part[ch], moved[ch], cross[ch], bad[ch] = _move_range(ch * CHUNK, min(nf, (ch + 1) * CHUNK), x, v, acc, xref,
+                                                              half, dt, box, walls, dwall, slack, finish)
 
 
 @njit(**JIT)
@@ -357,56 +387,70 @@ def advance(x, v, rho, p, nf, walls, box, grid_box, par, n_steps, xref, lst, wk,
 
     Continuity density is a position-like variable: rho_{n+1} = rho_n + dt D(x_{n+1}, v_{n+1/2}),
     its rate taken in the same pass as the kernels at the drifted positions (for fixed
-    positions this is the Stormer-Verlet step of the acoustic system (rho, v)).  The pair
-    list is rebuilt (cells over grid_box, from the positions, so from xref) when a particle
-    has moved more than skin / 2 since the last build.  Stops before a step in which a
-    particle would cross a wall, and after one in which a particle left box (the walls'
-    bounding box) or became non-finite.  force_sum (nw, 2) += wall_force every step;
-    panel_sum (P, 2) += the Lennard-Jones forces on the panels.  diag (4,) out: max over the
-    steps of the rms speed [cm/s], final kinetic energy [N cm], list builds, offending
-    particle (or -1).  threads > 1: the parallel passes (bit-identical to the serial ones).
-    Returns (code, steps done, lst, wk, fk).
+    positions this is the Stormer-Verlet step of the acoustic system (rho, v)).  A step's
+    second kick is done with the next step's first kick and drift, in one pass over the
+    particles (the same two additions).  The pair list is rebuilt (cells over grid_box, from
+    the positions, so from xref) when a particle has moved more than skin / 2 since the last
+    build.  Stops in a step in which a particle would cross a wall (core.geometry.crossed_wall,
+    tested for the particles whose move could reach a wall), and after one in which a particle
+    left box (the walls' bounding box) or became non-finite.  force_sum (nw, 2) += wall_force
+    every step; panel_sum (P, 2) += the Lennard-Jones forces on the panels.  diag (4,) out: max
+    over the steps of the rms speed [cm/s], final kinetic energy [N cm], list builds,
+    offending particle (or -1).  threads > 1: the parallel passes (bit-identical to the serial
+    ones).  Returns (code, steps done, lst, wk, fk).
     """
     dt = par[DT]
     half = 0.5 * dt
     lim2 = (0.5 * par[SKIN]) ** 2
     rc = 2.0 * par[H] + par[SKIN]
+    slack = 0.5 * par[SKIN]
     mass = par[MASS]
     n = x.shape[0]
     nch = (nf + CHUNK - 1) // CHUNK
     part = np.zeros(nch)
     moved = np.zeros(nch)
+    cross = np.full(nch, -1, np.int64)
     bad = np.full(nch, -1, np.int64)
     rate = np.zeros(nf)
     p_rho2 = np.empty(n)
     diag[0] = 0.0
     diag[2] = 0.0
     diag[3] = -1.0
-    for step in range(n_steps):
-        if threads > 1:
-            _kick_par(nf, v, acc, half, part)
-        else:
-            _kick_ser(nf, v, acc, half, part)
-        near = lst[6]
-        for e in range(near.shape[0]):  # a move across a wall stops the run before it happens
-            a = near[e]
-            if crossed_wall(x[a, 0], x[a, 1], x[a, 0] + dt * v[a, 0], x[a, 1] + dt * v[a, 1], walls) >= 0:
-                diag[3] = a
-                return CROSSED, step, lst, wk, fk
-        if threads > 1:
-            _drift_par(nf, x, v, xref, dt, box, moved, bad)
+    for step in range(n_steps + 1):
+        finish = step > 0
+        if step == n_steps:  # the last step's second kick
+            if threads > 1:
+                _kick_par(nf, v, acc, half, part)
+            else:
+                _kick_ser(nf, v, acc, half, part)
+        elif threads > 1:
+            _move_par(nf, x, v, acc, xref, half, dt, box, walls, lst[7], slack, finish, part, moved, cross, bad)
         else:
             for ch in range(nch):
-                moved[ch], bad[ch] = _drift_range(ch * CHUNK, min(nf, (ch + 1) * CHUNK), x, v, xref, dt, box)
+                part[ch], moved[ch], cross[ch], bad[ch] = _move_range(
+                    ch * CHUNK, min(nf, (ch + 1) * CHUNK), x, v, acc, xref, half, dt, box, walls, lst[7], slack, finish)
+        if finish:  # diagnostics of the finished step
+            v2 = 0.0
+            for ch in range(nch):
+                v2 += part[ch]
+            if not np.isfinite(v2):
+                return NONFINITE, step, lst, wk, fk
+            diag[0] = max(diag[0], np.sqrt(v2 / nf))
+            diag[1] = 0.5 * mass * v2
+        if step == n_steps:
+            break
         moved2 = 0.0
         for ch in range(nch):
             moved2 = max(moved2, moved[ch])
+            if cross[ch] >= 0:  # a move across a wall stops the run (that particle not moved)
+                diag[3] = cross[ch]
+                return CROSSED, step, lst, wk, fk
             if bad[ch] >= 0:
                 a = bad[ch]
                 diag[3] = a
                 return (LEFT_BOX if np.isfinite(x[a, 0]) and np.isfinite(x[a, 1]) else NONFINITE), step + 1, lst, wk, fk
         if moved2 > lim2:
-            lst = build(x, nf, grid_box, rc, walls, lst[0], lst[1])
+            lst = build(x, nf, grid_box, rc, walls, lst[0], lst[1], reach_of(par))
             if wk.shape[0] < lst[2]:
                 wk = np.empty(lst[0].shape[0])
                 fk = np.empty(lst[0].shape[0])
@@ -414,17 +458,6 @@ def advance(x, v, rho, p, nf, walls, box, grid_box, par, n_steps, xref, lst, wk,
             diag[2] += 1.0
         state_forces(x, v, rho, p, nf, walls, par, lst, wk, fk, acc, wall_force, panel0, npanel, panel_sum,
                      rate, p_rho2, True, threads)
-        if threads > 1:
-            _kick_par(nf, v, acc, half, part)
-        else:
-            _kick_ser(nf, v, acc, half, part)
-        v2 = 0.0
-        for ch in range(nch):
-            v2 += part[ch]
-        if not np.isfinite(v2):
-            return NONFINITE, step + 1, lst, wk, fk
-        diag[0] = max(diag[0], np.sqrt(v2 / nf))
-        diag[1] = 0.5 * mass * v2
         for q in range(force_sum.shape[0]):
             force_sum[q, 0] += wall_force[q, 0]
             force_sum[q, 1] += wall_force[q, 1]

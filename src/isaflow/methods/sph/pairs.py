@@ -75,16 +75,15 @@ def wall_distance2(px, py, walls):
 
 
 @njit(**JIT)
-def build(x, nf, box, rc, walls, pi, pj):
+def build(x, nf, box, rc, walls, pi, pj, reach):
     """Half pair list within rc by cell columns, filtered for visibility (module docstring).
 
     box (4,) cm: the cell grid (particles outside are clamped into edge cells); pi, pj int32
-    arrays reused as storage (grown when full).  Returns (pi, pj, m, col, wrow, wpair, near):
-    the first m entries of pi (liquid), pj (liquid or wall); col (ncx + 1,) the pair range of each
-    cell column; wrow (n - nf + 1,), wpair: the pairs of wall particle q are
-    wpair[wrow[q]:wrow[q + 1]] (ascending); near: the liquid particles closer than rc to a wall
-    (the only ones that can reach a wall before the next rebuild, which comes before any particle
-    has moved skin / 2 < rc).
+    arrays reused as storage (grown when full).  Returns (pi, pj, m, col, wrow, wpair, close,
+    dwall): the first m entries of pi (liquid), pj (liquid or wall); col (ncx + 1,) the pair
+    range of each cell column; wrow (n - nf + 1,), wpair: the pairs of wall particle q are
+    wpair[wrow[q]:wrow[q + 1]] (ascending); dwall (nf,) cm: each liquid particle's distance to
+    the nearest wall; close: the liquid particles with dwall < reach (ascending).
     """
     n = x.shape[0]
     ncx, ncy, csx, csy = cell_grid(box, rc)
@@ -174,13 +173,15 @@ def build(x, nf, box, rc, walls, pi, pj):
             q = pj[k] - nf
             wpair[wfill[q]] = k
             wfill[q] += 1
+    dwall = np.empty(nf)
     count = 0
     for i in range(nf):
-        count += near[i]
-    near_idx = np.empty(count, np.int64)
+        dwall[i] = np.sqrt(wall_distance2(x[i, 0], x[i, 1], walls))
+        count += dwall[i] < reach
+    close = np.empty(count, np.int64)
     count = 0
     for i in range(nf):
-        if near[i]:
-            near_idx[count] = i
+        if dwall[i] < reach:
+            close[count] = i
             count += 1
-    return pi, pj, m, col, wrow, wpair, near_idx
+    return pi, pj, m, col, wrow, wpair, close, dwall
