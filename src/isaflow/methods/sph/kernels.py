@@ -101,7 +101,7 @@ def kernel_range(lo, hi, x, v, rho, nf, pi, pj, par, wk, fk, out):
     ih = 1.0 / h
     summation = par[SUMMATION] > 0
     run = -1
-    sa = xa = ya = vxa = vya = ra = 0.0
+    sa = xa = ya = vxa = vya = ra = ira = 0.0
     for k in range(lo, hi):
         a = np.uint32(pi[k])
         b = np.uint32(pj[k])
@@ -111,6 +111,7 @@ def kernel_range(lo, hi, x, v, rho, nf, pi, pj, par, wk, fk, out):
             run = a
             sa = out[a]
             xa, ya, vxa, vya, ra = x[a, 0], x[a, 1], v[a, 0], v[a, 1], rho[a]
+            ira = 1.0 / ra
         dx = xa - x[b, 0]
         dy = ya - x[b, 1]
         w, f = kernel_wf(dx * dx + dy * dy, ih, kind, c)
@@ -128,7 +129,7 @@ def kernel_range(lo, hi, x, v, rho, nf, pi, pj, par, wk, fk, out):
                 rb = rho[b]
                 t = -2.0 * delta * h * c0 * mass * f * ((rb - ra) - rho0 * g * dy / (c0 * c0))
                 sa += dd + t / rb
-                out[b] += dd - t / ra
+                out[b] += dd - t * ira
             else:
                 sa += dd
                 out[b] += dd
