@@ -2,7 +2,8 @@
 
 Outcomes: ``converged`` (the liquid is at rest by isaflow.rest, the one criterion of every
 dynamic method: e = KE / (W h) below its ratio for its window), ``step_limit`` (the run's
-time limit), ``escaped`` (a particle would cross a wall, or left the walls' bounding box),
+time limit), ``escaped`` (a particle would cross a wall, or left the walls' bounding box,
+which is open max_drop above the walls' top: a splash may rise over the walls and fall back),
 ``nonfinite``.  Wall loads are the wall particles' forces on the liquid averaged over the
 last rest window, spread over the tank's wall panels (core.panels), one set of panels per
 wetted face.  A run continued from a run file (``start``) keeps the chain's clock and step
@@ -218,10 +219,13 @@ def _run(tank, s, resolution, start, on_wall, t_max, log, threads=1):
     rho = np.concatenate([st["rho"], np.full(nw, st["rho_ref"])])
     p = np.zeros(nf + nw)
     walls = tank.walls
-    box = bounding_box(walls)
+    # the vessels are open at the top: a splash may rise above the walls and fall back in, by at most the
+    # largest free fall max_drop (a particle faster than sqrt(2 g max_drop) breaks the Mach 0.1 design)
+    wall_box = bounding_box(walls)
+    box = wall_box + [0.0, 0.0, 0.0, s["max_drop"]]
     rc = 2 * st["h"] + par[K.SKIN]
     # the cell grid depends on the tank and the lattice only, so a continuation builds the same lists
-    lo, hi = np.minimum(box[:2], st["wpos"].min(0)) - rc, np.maximum(box[2:], st["wpos"].max(0)) + rc
+    lo, hi = np.minimum(wall_box[:2], st["wpos"].min(0)) - rc, np.maximum(wall_box[2:], st["wpos"].max(0)) + rc
     grid_box = np.array([lo[0], lo[1], hi[0], hi[1]])
     xref = st["xref"]
     lst = K.list_pairs(np.concatenate([xref, st["wpos"]]), nf, grid_box, rc, walls, K.reach_of(par))
@@ -284,7 +288,7 @@ def _run(tank, s, resolution, start, on_wall, t_max, log, threads=1):
         rms = math.sqrt(2 * ke / (st["mass"] * nf))
         if code != K.OK:
             status = CODES[code]
-            what = {K.CROSSED: "would cross a wall", K.LEFT_BOX: "left the walls' bounding box",
+            what = {K.CROSSED: "would cross a wall", K.LEFT_BOX: "left the walls' bounding box (open max_drop above)",
                     K.NONFINITE: "became non-finite"}[code]
             k = int(diag[3])
             message = f"particle {k}, at ({x[k, 0]:.4g}, {x[k, 1]:.4g}) cm, {what} at step {steps} (t = {t:.4g} s)"
