@@ -6,15 +6,21 @@ variant's settings); after one untimed chunk (compilation, first list), chunks o
 the median is kept.  ns per particle-step counts liquid particles (the wall particles are
 the boundary's overhead; their count is in the table).  The two thread counts give
 bit-identical states (kernels docstring), so both advance one state.  Parallel efficiency
-= t(1 thread) / (2 t(2 threads)).  Writes benchmarks/results/sph_step_cost.csv with the
-machine's load average at the start and end (the machine is shared: read the figures with it).
+= t(1 thread) / (2 t(2 threads)).  Each OpenMP wait policy runs in its own process (the policy
+is read once, when numba starts its pool): PASSIVE (solver.set_threads' default: robust on a
+loaded machine) and ACTIVE (spinning: faster when both cores are free, much slower when they are
+not).  Writes benchmarks/results/sph_step_cost.csv with the machine's load average at the start
+and end of each (the machine is shared: read the figures with it).
 
-    python benchmarks/bench_sph.py            # N = 5,000, 20,000, 50,000; about a minute
+    python benchmarks/bench_sph.py            # N = 5,000, 20,000, 50,000, wcsph; about a minute
     python benchmarks/bench_sph.py --quick    # N <= 5,000 (results/quick)
 """
 
 import argparse
+import json
 import os
+import subprocess
+import sys
 import time
 from pathlib import Path
 
@@ -22,7 +28,7 @@ import numpy as np
 import pandas as pd
 
 os.environ.setdefault("NUMBA_NUM_THREADS", "2")
-os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")  # as solver.set_threads
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")  # as solver.set_threads; the parent sets it per child
 
 from isaflow.core.geometry import bounding_box  # noqa: E402
 from isaflow.methods.sph import kernels as K  # noqa: E402
@@ -64,16 +70,12 @@ def advance(a, steps, threads):
     assert code == K.OK and done == steps
 
 
-def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--quick", action="store_true")
-    ap.add_argument("--reps", type=int, default=5)
-    args = ap.parse_args()
+def measure(sizes, variants, reps):
+    """Rows of one process (one OpenMP wait policy)."""
     tank = load_tank(ROOT / "config" / "tanks" / "single.yaml")
-    sizes = [5000, 20000, 50000] if not args.quick else [684, 5000]
-    load0 = os.getloadavg()
+    load0 = os.getloadavg()[0]
     rows = []
-    for variant in ("wcsph", "delta_wc2"):
+    for variant in variants:
         s = S.resolve(S.load(), variant)
         for n in sizes:
             a, nw = state(tank, s, n)
@@ -82,31 +84,52 @@ def main():
                 solver.set_threads(threads)
                 advance(a, 2, threads)  # compile / warm caches
             times = {1: [], 2: []}
-            for _ in range(args.reps):
+            for _ in range(reps):
                 for threads in (1, 2):
                     solver.set_threads(threads)
                     t0 = time.perf_counter()
                     advance(a, steps, threads)
                     times[threads].append(time.perf_counter() - t0)
             t1, t2 = (float(np.median(times[k])) / steps / a["nf"] * 1e9 for k in (1, 2))
-            rows.append(dict(variant=variant, N=a["nf"], wall_particles=nw, steps=steps, reps=args.reps,
-                             ns_per_particle_step_1thread=t1, ns_per_particle_step_2threads=t2,
-                             parallel_efficiency=t1 / (2 * t2),
-                             pairs_per_particle=a["lst"][2] / a["nf"], list_builds=a["diag"][2]))
-            print(rows[-1], flush=True)
-    load1 = os.getloadavg()
+            rows.append(dict(variant=variant, omp_wait_policy=os.environ["OMP_WAIT_POLICY"], N=a["nf"],
+                             wall_particles=nw, steps=steps, reps=reps, ns_per_particle_step_1thread=t1,
+                             ns_per_particle_step_2threads=t2, parallel_efficiency=t1 / (2 * t2),
+                             pairs_per_particle=a["lst"][2] / a["nf"], list_builds=float(a["diag"][2])))
+            print(rows[-1], file=sys.stderr, flush=True)
+    for r in rows:
+        r.update(load_avg_1min_start=load0, load_avg_1min_end=os.getloadavg()[0])
+    return rows
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--reps", type=int, default=5)
+    ap.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
+    args = ap.parse_args()
+    sizes = [5000, 20000, 50000] if not args.quick else [684, 5000]
+    if args.child:
+        json.dump(measure(sizes, ["wcsph", "delta_wc2"] if os.environ["OMP_WAIT_POLICY"] == "PASSIVE" else ["wcsph"],
+                          args.reps), sys.stdout)
+        return
+    rows = []
+    for policy in ("PASSIVE", "ACTIVE"):
+        cmd = [sys.executable, __file__, "--child", "--reps", str(args.reps)] + (["--quick"] if args.quick else [])
+        out = subprocess.run(cmd, env={**os.environ, "OMP_WAIT_POLICY": policy}, check=True, capture_output=True,
+                             text=True)
+        rows += json.loads(out.stdout)
     df = pd.DataFrame(rows)
-    df["load_avg_1min_start"], df["load_avg_1min_end"] = load0[0], load1[0]
     out = ROOT / "benchmarks" / "results" / ("quick" if args.quick else "")
     out.mkdir(parents=True, exist_ok=True)
     df.to_csv(out / "sph_step_cost.csv", index=False, float_format="%.4g")
-    for variant, g in df.groupby("variant"):
+    for (variant, policy), g in df.groupby(["variant", "omp_wait_policy"]):
         big = g[g.N >= 19000]  # the 20,000 requested (19,920 on the lattice) and up
-        print(f"{variant}: N >= 20,000: {big.ns_per_particle_step_1thread.min():.0f}-"
+        print(f"{variant}, {policy}: N >= 20,000: {big.ns_per_particle_step_1thread.min():.0f}-"
               f"{big.ns_per_particle_step_1thread.max():.0f} ns/particle-step on 1 thread, "
               f"{big.ns_per_particle_step_2threads.min():.0f}-{big.ns_per_particle_step_2threads.max():.0f} on 2 "
               f"(target 100), efficiency {big.parallel_efficiency.min():.2f}-{big.parallel_efficiency.max():.2f}; "
-              f"load average {load0[0]:.1f} -> {load1[0]:.1f} on {os.cpu_count()} cores")
+              f"load average {g.load_avg_1min_start.iloc[0]:.1f} -> {g.load_avg_1min_end.iloc[0]:.1f} on "
+              f"{os.cpu_count()} cores")
 
 
 if __name__ == "__main__":

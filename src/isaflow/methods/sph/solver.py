@@ -195,7 +195,8 @@ def start_dataset(res):
 
 def _panels(walls, length, owner, face, wpos, force, dx, dy):
     """Contacts of the wall-particle forces: per face, spread over the panels (face 1: the back of a
-    thin wall).  Returns (wall, point, force, side) with side 0 front (liquid side), 1 back."""
+    thin wall, its loaded panels only).  Returns (wall, point, force, side) with side 0 front (liquid
+    side), 1 back."""
     out = [], [], [], []
     for f in (0, 1):
         on = face == f
@@ -203,8 +204,8 @@ def _panels(walls, length, owner, face, wpos, force, dx, dy):
             continue
         cw, cpt, cf = P.wall_contacts(walls, wpos[on], owner[on], force[on])
         pw, pc, pf = P.spread_to_panels(walls, length, cw, cpt, cf, dx, dy)
-        if f == 1:
-            keep = np.isin(pw, np.unique(owner[on]))
+        if f == 1:  # only the loaded back-face panels (a dry back face adds no contacts)
+            keep = np.isin(pw, np.unique(owner[on])) & (np.abs(pf).sum(1) > 0)
             pw, pc, pf = pw[keep], pc[keep], pf[keep]
         for lst, arr in zip(out, (pw, pc, pf, np.full(len(pw), f))):
             lst.append(arr)
