@@ -11,7 +11,7 @@ Arrays (units cm, N, s; masses N s^2/cm, densities N s^2/cm^4, pressures N/cm^2)
 - par (NPAR,) float64 settings, indices below (see solver.pack).
 
 Equations: marko2017 eq. 6 (density summation) or the continuity equation
-drho_a/dt = sum_b m_b v_ab . grad_a W_ab (Monaghan 1992, 1994), eq. 9 in its symmetric
+drho_a/dt = sum_b m_b v_ab . grad_a W_ab (Monaghan 1992), eq. 9 in its symmetric
 form -sum_b m_b (P_a/rho_a^2 + P_b/rho_b^2 + Pi_ab) grad_a W_ab, Tait or linear equation
 of state, Monaghan (1992) artificial viscosity Pi_ab, Adami, Hu & Adams (2012) wall
 pressure, optional density diffusion (Molteni & Colagrossi 2009, hydrostatic part removed
