@@ -1,26 +1,34 @@
-"""Cost per particle-step of the SPH step loop against N (one core), beside the paper's method.
+"""Cost per particle-step of the SPH step loop against N, on 1 and 2 threads side by side.
 
-The single vessel filled to its depth with N liquid particles (hydrostatic
-start, wcsph settings); after one untimed chunk (compilation, first list),
-``steps`` leapfrog steps are timed (best of ``reps``).  ns per particle-step
-counts liquid particles (the wall particles are the boundary's overhead; their
-count is in the table).  Writes benchmarks/results/sph_step_cost.csv and prints
-the fitted exponent of time per step against N and the ISA cost from
-benchmarks/results/step_cost.csv.
+The single vessel filled to its depth with N liquid particles (hydrostatic start, the
+variant's settings); after one untimed chunk (compilation, first list), chunks of
+``steps`` steps are timed, 1-thread and 2-thread chunks interleaved, ``reps`` of each;
+the median is kept.  ns per particle-step counts liquid particles (the wall particles are
+the boundary's overhead; their count is in the table).  The two thread counts give
+bit-identical states (kernels docstring), so both advance one state.  Parallel efficiency
+= t(1 thread) / (2 t(2 threads)).  Each OpenMP wait policy runs in its own process (the policy
+is read once, when numba starts its pool): PASSIVE (solver.set_threads' default: robust on a
+loaded machine) and ACTIVE (spinning: faster when both cores are free, much slower when they are
+not).  Writes benchmarks/results/sph_step_cost.csv with the machine's load average at the start
+and end of each (the machine is shared: read the figures with it).
 
-    python benchmarks/bench_sph.py            # N = 180 ... 102,400
+    python benchmarks/bench_sph.py            # N = 5,000, 20,000, 50,000, wcsph; about a minute
     python benchmarks/bench_sph.py --quick    # N <= 5,000 (results/quick)
 """
 
 import argparse
+import json
 import os
+import subprocess
+import sys
 import time
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-os.environ.setdefault("NUMBA_NUM_THREADS", "1")
+os.environ.setdefault("NUMBA_NUM_THREADS", "2")
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")  # as solver.set_threads; the parent sets it per child
 
 from isaflow.core.geometry import bounding_box  # noqa: E402
 from isaflow.methods.sph import kernels as K  # noqa: E402
@@ -32,73 +40,96 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def state(tank, s, n):
-    """Arrays of a hydrostatic single vessel with about n liquid particles."""
+    """Arrays of a hydrostatic single vessel with about n liquid particles (as solver._run sets them up)."""
     st = solver.setup(tank, s, {"particles": n})
     nf, nw = len(st["pos"]), len(st["wpos"])
     x = np.concatenate([st["pos"], st["wpos"]])
     rho = np.concatenate([st["rho"], np.full(nw, st["rho_ref"])])
     walls = tank.walls
     box = bounding_box(walls)
-    grid = np.array([x[:, 0].min() - 1, x[:, 1].min() - 1, x[:, 0].max() + 1, x[:, 1].max() + 1])
     par = st["par"]
-    pi, pj, m = K.list_pairs(x, nf, grid, 2 * st["h"] + par[K.SKIN])
-    arrays = dict(x=x, v=st["vel"].copy(), rho=rho, p=np.zeros(nf + nw), nf=nf, walls=walls, box=box, grid=grid,
-                  par=par, xref=x[:nf].copy(), pi=pi, pj=pj, m=m, wk=np.empty(len(pi)), fk=np.empty(len(pi)),
-                  acc=np.zeros((nf, 2)), wall_force=np.zeros((nw, 2)), wsum=np.zeros((nw, 3)),
-                  force_sum=np.zeros((nw, 2)), panel0=np.zeros(len(walls), np.int64),
-                  npanel=np.ones(len(walls), np.int64), panel_sum=np.zeros((len(walls), 2)), diag=np.zeros(4))
-    a = arrays
-    K.evaluate(a["x"], a["v"], a["rho"], a["p"], nf, pi, pj, m, a["wk"], a["fk"], par, a["acc"], a["wall_force"], a["wsum"])
+    rc = 2 * st["h"] + par[K.SKIN]
+    lo, hi = np.minimum(box[:2], st["wpos"].min(0)) - rc, np.maximum(box[2:], st["wpos"].max(0)) + rc
+    grid = np.array([lo[0], lo[1], hi[0], hi[1]])
+    lst = K.list_pairs(x, nf, grid, rc, walls, K.reach_of(par))
+    a = dict(x=x, v=st["vel"].copy(), rho=rho, p=np.zeros(nf + nw), nf=nf, walls=walls, box=box, grid=grid,
+             par=par, xref=x[:nf].copy(), lst=lst, wk=np.empty(len(lst[0])), fk=np.empty(len(lst[0])),
+             acc=np.zeros((nf, 2)), wall_force=np.zeros((nw, 2)), force_sum=np.zeros((nw, 2)),
+             panel0=np.zeros(len(walls), np.int64), npanel=np.ones(len(walls), np.int64),
+             panel_sum=np.zeros((len(walls), 2)), diag=np.zeros(4))
+    K.evaluate(a["x"], a["v"], a["rho"], a["p"], nf, walls, par, lst, a["wk"], a["fk"], a["acc"], a["wall_force"],
+               a["panel0"], a["npanel"], a["panel_sum"], 1)
     return a, nw
 
 
-def advance(a, steps):
-    code, done, a["pi"], a["pj"], a["m"], a["wk"], a["fk"] = K.advance(
+def advance(a, steps, threads):
+    code, done, a["lst"], a["wk"], a["fk"] = K.advance(
         a["x"], a["v"], a["rho"], a["p"], a["nf"], a["walls"], a["box"], a["grid"], a["par"], steps, a["xref"],
-        a["pi"], a["pj"], a["m"], a["wk"], a["fk"], a["acc"], a["wall_force"], a["wsum"], a["force_sum"],
-        a["panel0"], a["npanel"], a["panel_sum"], a["diag"])
+        a["lst"], a["wk"], a["fk"], a["acc"], a["wall_force"], a["force_sum"], a["panel0"], a["npanel"],
+        a["panel_sum"], a["diag"], threads)
     assert code == K.OK and done == steps
+
+
+def measure(sizes, variants, reps):
+    """Rows of one process (one OpenMP wait policy)."""
+    tank = load_tank(ROOT / "config" / "tanks" / "single.yaml")
+    load0 = os.getloadavg()[0]
+    rows = []
+    for variant in variants:
+        s = S.resolve(S.load(), variant)
+        for n in sizes:
+            a, nw = state(tank, s, n)
+            steps = max(10, int(2.5e6 / a["nf"]))  # about 0.3 s a chunk on one thread
+            for threads in (1, 2):
+                solver.set_threads(threads)
+                advance(a, 2, threads)  # compile / warm caches
+            times = {1: [], 2: []}
+            for _ in range(reps):
+                for threads in (1, 2):
+                    solver.set_threads(threads)
+                    t0 = time.perf_counter()
+                    advance(a, steps, threads)
+                    times[threads].append(time.perf_counter() - t0)
+            t1, t2 = (float(np.median(times[k])) / steps / a["nf"] * 1e9 for k in (1, 2))
+            rows.append(dict(variant=variant, omp_wait_policy=os.environ["OMP_WAIT_POLICY"], N=a["nf"],
+                             wall_particles=nw, steps=steps, reps=reps, ns_per_particle_step_1thread=t1,
+                             ns_per_particle_step_2threads=t2, parallel_efficiency=t1 / (2 * t2),
+                             pairs_per_particle=a["lst"][2] / a["nf"], list_builds=float(a["diag"][2])))
+            print(rows[-1], file=sys.stderr, flush=True)
+    for r in rows:
+        r.update(load_avg_1min_start=load0, load_avg_1min_end=os.getloadavg()[0])
+    return rows
 
 
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true")
+    ap.add_argument("--reps", type=int, default=5)
+    ap.add_argument("--child", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args()
-    tank = load_tank(ROOT / "config" / "tanks" / "single.yaml")
-    sizes = [180, 684, 1600, 5000, 20000, 102400]
-    if args.quick:
-        sizes = [n for n in sizes if n <= 5000]
+    sizes = [5000, 20000, 50000] if not args.quick else [684, 5000]
+    if args.child:
+        json.dump(measure(sizes, ["wcsph", "delta_wc2"] if os.environ["OMP_WAIT_POLICY"] == "PASSIVE" else ["wcsph"],
+                          args.reps), sys.stdout)
+        return
     rows = []
-    for variant in ("wcsph", "delta_wc2"):
-        s = S.resolve(S.load(), variant)
-        for n in sizes:
-            a, nw = state(tank, s, n)
-            advance(a, 5)  # compile / warm caches
-            steps = max(20, int(2e7 / a["nf"] / 50))
-            best = np.inf
-            for _ in range(3):
-                t0 = time.perf_counter()
-                advance(a, steps)
-                best = min(best, time.perf_counter() - t0)
-            rows.append(dict(variant=variant, N=a["nf"], wall_particles=nw, steps=steps,
-                             ns_per_particle_step=best / steps / a["nf"] * 1e9,
-                             ns_per_all_particle_step=best / steps / (a["nf"] + nw) * 1e9,
-                             pairs_per_particle=a["m"] / a["nf"], list_builds=a["diag"][2]))
-            print(rows[-1], flush=True)
+    for policy in ("PASSIVE", "ACTIVE"):
+        cmd = [sys.executable, __file__, "--child", "--reps", str(args.reps)] + (["--quick"] if args.quick else [])
+        out = subprocess.run(cmd, env={**os.environ, "OMP_WAIT_POLICY": policy}, check=True, capture_output=True,
+                             text=True)
+        rows += json.loads(out.stdout)
     df = pd.DataFrame(rows)
     out = ROOT / "benchmarks" / "results" / ("quick" if args.quick else "")
     out.mkdir(parents=True, exist_ok=True)
-    df.to_csv(out / "sph_step_cost.csv", index=False)
-    for variant, g in df.groupby("variant"):
-        k = np.polyfit(np.log(g.N), np.log(g.ns_per_particle_step * g.N), 1)[0]
-        big = g[g.N >= 5000].ns_per_particle_step
-        print(f"{variant}: time per step ~ N^{k:.2f}; {big.min():.0f}-{big.max():.0f} ns/particle-step at N >= 5000 "
-              f"(target 250)")
-    isa = ROOT / "benchmarks" / "results" / "step_cost.csv"
-    if isa.exists():
-        i = pd.read_csv(isa)
-        i = i[i.impl == "numba"]
-        print(f"ISA (paper's method): {i.ns_per_particle_step.min():.1f}-{i.ns_per_particle_step.max():.1f} ns/particle-step")
+    df.to_csv(out / "sph_step_cost.csv", index=False, float_format="%.4g")
+    for (variant, policy), g in df.groupby(["variant", "omp_wait_policy"]):
+        big = g[g.N >= 19000]  # the 20,000 requested (19,920 on the lattice) and up
+        print(f"{variant}, {policy}: N >= 20,000: {big.ns_per_particle_step_1thread.min():.0f}-"
+              f"{big.ns_per_particle_step_1thread.max():.0f} ns/particle-step on 1 thread, "
+              f"{big.ns_per_particle_step_2threads.min():.0f}-{big.ns_per_particle_step_2threads.max():.0f} on 2 "
+              f"(target 100), efficiency {big.parallel_efficiency.min():.2f}-{big.parallel_efficiency.max():.2f}; "
+              f"load average {g.load_avg_1min_start.iloc[0]:.1f} -> {g.load_avg_1min_end.iloc[0]:.1f} on "
+              f"{os.cpu_count()} cores")
 
 
 if __name__ == "__main__":

@@ -8,7 +8,9 @@ pressure), so a full lattice support (water + ring) is in equilibrium at uniform
 takes the equal and opposite force, m^2 2 p_a / rho_a^2 grad_a W_ab: the pressure traction on the
 ring, spread over the layers the kernel reaches.  The ring's velocity enters the continuity
 equation, so as the ring expands the water's density and pressure drop (by K dA / A).  Monaghan
-artificial viscosity alpha (settings).  Units cm, N, s.
+artificial viscosity alpha (settings).  The kernel, the eq. 9 bracket with its viscosity and the
+equation of state are the SPH package's (methods.sph.kernels.kernel_wf, pair_momentum;
+methods.sph.eos.pressure_of, linear: p = p0 + c0^2 (rho - rho0), c0^2 = K / rho0).  Units cm, N, s.
 """
 
 import time
@@ -18,15 +20,24 @@ from numba import njit
 
 from isaflow.core import smoothing as SM
 from isaflow.core.neighbours import build_pairs
+from isaflow.methods.sph.eos import pressure_of
+from isaflow.methods.sph.kernels import kernel_wf, pair_momentum
 
 JIT = dict(cache=True, nogil=True)
+
+
+@njit(**JIT)
+def water_pressure(rho, rho0, c0, p0):
+    """p0 + the SPH package's linear equation of state c0^2 (rho - rho0) [N/cm^2]."""
+    return p0 + pressure_of(rho, rho0, c0, 1.0, False, False)
 
 
 @njit(**JIT)
 def water_forces(pos, vel, rho, nw, m, h, kind, norm, K, rho0, p0, alpha, c0, fw, fs, drho):
     """Forces fw (nw, 2) on the water, fs (N - nw, 2) of the water on the ring [N], and drho/dt (nw,).
 
-    pos, vel (N, 2): water first (nw), then the ring.  m: water particle mass; norm = sigma / h^2."""
+    pos, vel (N, 2): water first (nw), then the ring.  m: water particle mass; norm = sigma / h^2;
+    K = rho0 c0^2 the bulk modulus (the equation of state takes c0)."""
     box = np.empty(4)
     box[0] = pos[:, 0].min()
     box[1] = pos[:, 1].min()
@@ -36,6 +47,7 @@ def water_forces(pos, vel, rho, nw, m, h, kind, norm, K, rho0, p0, alpha, c0, fw
     fw[:, :] = 0.0
     fs[:, :] = 0.0
     drho[:] = 0.0
+    ih = 1.0 / h
     for k in range(npair):
         a = pi[k]
         b = pj[k]
@@ -45,25 +57,21 @@ def water_forces(pos, vel, rho, nw, m, h, kind, norm, K, rho0, p0, alpha, c0, fw
             a, b = b, a
         dx = pos[a, 0] - pos[b, 0]
         dy = pos[a, 1] - pos[b, 1]
-        r = np.sqrt(dx * dx + dy * dy)
-        if r == 0.0 or r >= 2.0 * h:
+        r2 = dx * dx + dy * dy
+        if r2 == 0.0 or r2 >= 4.0 * h * h:
             continue
-        g = norm / h * SM.dw(kind, r / h) / r  # grad_a W = g (x_a - x_b)
+        _, g = kernel_wf(r2, ih, kind, norm)  # grad_a W = g (x_a - x_b)
         dvx = vel[a, 0] - vel[b, 0]
         dvy = vel[a, 1] - vel[b, 1]
-        pa = p0 + K * (rho[a] / rho0 - 1.0)
+        pa = water_pressure(rho[a], rho0, c0, p0)
         if b < nw:
             rb = rho[b]
-            pb = p0 + K * (rb / rho0 - 1.0)
+            pb = water_pressure(rb, rho0, c0, p0)
         else:
             rb = rho[a]
             pb = pa
         vr = dvx * dx + dvy * dy
-        visc = 0.0
-        if vr < 0.0:
-            mu = h * vr / (r * r + 0.01 * h * h)
-            visc = -alpha * c0 * mu / (0.5 * (rho[a] + rb))
-        coef = -m * m * (pa / rho[a] ** 2 + pb / rb**2 + visc) * g
+        coef = -m * m * pair_momentum(pa / rho[a] ** 2, pb / rb**2, vr, r2, h, alpha, c0, 0.5 * (rho[a] + rb)) * g
         fx = coef * dx
         fy = coef * dy
         fw[a, 0] += fx
@@ -122,7 +130,7 @@ def coupled_history(cfg, dt, steps, every):
         if step % every == 0:
             t.append(step * dt)
             ui.append(radial(st, inner).mean())
-            pw.append(float(np.mean(p0 + K * (rho / rho0 - 1.0))))
+            pw.append(float(np.mean(p0 + c0 * c0 * (rho - rho0))))  # water_pressure, vectorised
     st.wall_time = time.perf_counter() - t0  # the coupled loop: water and ring
     return np.array(t), np.array(ui), np.array(pw), st, inner, rho
 

@@ -2,7 +2,8 @@
 
 Modules: ``kernels`` (numba pair passes and the compiled leapfrog loop),
 ``eos`` (equations of state), ``repulsion`` (Lennard-Jones wall safety net),
-``particles`` (liquid lattice, wall particles, wall contacts), ``settings``
+``particles`` (liquid lattice, wall particles, wall contacts), ``pairs`` (pair
+list, thin-wall visibility, the colouring of the parallel passes), ``settings``
 (config/methods/sph.yaml and its schema), ``solver`` (chunks, rest test,
 outcome -> contract.Result), ``analysis`` (measures, summary, claims, report),
 ``figures``, ``workflow`` (what the Snakemake rules call).
@@ -15,8 +16,11 @@ METHOD = Method(
     label="weakly compressible SPH",
     paper="marko2017",
     variants={
-        "wcsph": Variant("wcsph", "WCSPH: marko2017 eqs. 4, 6, 9 + Tait EOS, artificial viscosity, Adami walls "
-                                  "(completions from literature)", "tab:orange", "D"),
+        "wcsph": Variant("wcsph", "WCSPH: marko2017 eqs. 4, 9 with continuity density in place of eq. 6 (free "
+                                  "surface) + Tait EOS, artificial viscosity, Adami walls (completions from literature)",
+                         "tab:orange", "D"),
+        "wcsph_eq6": Variant("wcsph_eq6", "WCSPH with marko2017 eq. 6 literally (summed density, P >= 0; its surface "
+                                          "band reads low)", "tab:brown", "d"),
         "delta_wc2": Variant("delta_wc2", "delta-SPH, Wendland C2: continuity density + density diffusion "
                                           "(variant, not marko2017)", "tab:red", "v"),
     },

@@ -75,7 +75,7 @@ def flow(paths, out):
 def snapshots(path, out):
     """Snapshots of one flow run at the recorded times."""
     ds = runfile.read(path)
-    t = ds["snap_time"].values
+    t = ds["snap_time"].values - float(ds.attrs.get("start_time", 0.0))  # time since the opening
     n = len(t)
     fig, axes = plt.subplots((n + 1) // 2, 2, figsize=(12, 3.3 * ((n + 1) // 2) + 0.8), squeeze=False)
     for k, ax in enumerate(axes.ravel()):
@@ -84,7 +84,7 @@ def snapshots(path, out):
             continue
         ax.scatter(*ds["snap_pos"].values[k].T, s=max(0.5, 1000 / ds.sizes["particle"]), color="tab:blue")
         _walls(ax, ds)
-        ax.set(aspect="equal", xlabel="x (cm)", ylabel="y (cm)", title=f"t = {t[k]:.2f} s")
+        ax.set(aspect="equal", xlabel="x (cm)", ylabel="y (cm)", title=f"{t[k]:.2f} s after the opening")
         ax.title.set_fontsize(9)
     _method_title(fig, ds, f"flow snapshots, {ds.sizes['particle']} particles")
     fig.tight_layout()

@@ -4,33 +4,34 @@ Arrays (units cm, N, s; masses N s^2/cm, densities N s^2/cm^4, pressures N/cm^2)
 - x (n, 2): positions, rows 0..nf-1 liquid particles, rows nf..n-1 wall
   (boundary) particles, which never move;
 - v (nf, 2) velocities; rho (n,) densities; p (n,) pressures;
-- pairs (pi, pj, m): half list of core.neighbours.build_pairs over all
-  particles within rc = 2 h + skin, wall-wall pairs dropped, pi always
-  liquid (pj >= nf marks a wall particle), in runs of equal pi: every pass
-  keeps pi's running sum in a register along a run (a run's particle is never
-  pj inside its run, so every sum still adds the pairs in list order);
-  the passes read pi, pj as unsigned (np.uint32) so that numba indexes
-  without its negative-index wraparound;
-- par (NPAR,) float64 settings, indices below (see :func:`pack`).
+- lst: the pair list of :func:`pairs.build`, a tuple (pi, pj, m, col, wrow, wpair, close,
+  dwall): half list, pi liquid, pj liquid or wall (pj >= nf), grouped by cell columns so that
+  the pair passes run the even columns, then the odd ones, each column in list order
+  (in parallel with ``threads`` > 1, bit-identical to the serial passes: see pairs);
+- par (NPAR,) float64 settings, indices below (see solver.pack).
 
-Equations: marko2017 eq. 6 (density summation) or the continuity equation,
-eq. 9 in its symmetric form -sum_b m_b (P_a/rho_a^2 + P_b/rho_b^2) grad_a W_ab,
-Tait or linear equation of state, Monaghan (1992) artificial viscosity, Adami,
-Hu & Adams (2012) wall pressure, optional density diffusion (Molteni &
-Colagrossi 2009, hydrostatic part removed as Fourtakas et al. 2019).
+Equations: marko2017 eq. 6 (density summation) or the continuity equation
+drho_a/dt = sum_b m_b v_ab . grad_a W_ab (Monaghan 1992), eq. 9 in its symmetric
+form -sum_b m_b (P_a/rho_a^2 + P_b/rho_b^2 + Pi_ab) grad_a W_ab, Tait or linear equation
+of state, Monaghan (1992) artificial viscosity Pi_ab, Adami, Hu & Adams (2012) wall
+pressure, optional density diffusion (Molteni & Colagrossi 2009, hydrostatic part removed
+as Fourtakas et al. 2019).  Per-particle loops run over fixed chunks of CHUNK particles and
+reduce chunk by chunk in chunk order, so they too do not depend on the thread count.
 """
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from ...core.geometry import crossed_wall
-from ...core.neighbours import build_pairs
 from ...core.smoothing import dw as kernel_dw
 from ...core.smoothing import w as kernel_w
 from .eos import density_of, pressure_of
+from .pairs import build
 from .repulsion import wall_repulsion
 
 JIT = dict(cache=True, nogil=True)
+PJIT = dict(cache=True, nogil=True, parallel=True)
+CHUNK = 1024  # particles per chunk of the per-particle loops (fixed: results do not depend on threads)
 
 # indices into par
 (H, MASS, RHO0, C0, GAMMA, ALPHA, DELTA, GRAV, DT, SKIN, KERNEL, NORM, TAIT, CLAMP, SUMMATION,
@@ -39,165 +40,113 @@ JIT = dict(cache=True, nogil=True)
 OK, CROSSED, LEFT_BOX, NONFINITE = range(4)
 
 
-@njit(**JIT)
-def list_pairs(x, nf, box, rc):
-    """Pair list over all particles within rc, wall-wall pairs dropped, pi liquid.
-
-    build_pairs' order and orientation (pi runs over its rows), swapped only where
-    pi would be a wall particle: the passes keep pi's sums in registers along a run.
-    """
-    pi, pj, m = build_pairs(x, box, rc)
-    k = 0
-    for q in range(m):
-        a = pi[q]
-        b = pj[q]
-        if a >= nf:
-            a, b = b, a
-        if a < nf:
-            pi[k] = a
-            pj[k] = b
-            k += 1
-    return pi, pj, k
+def list_pairs(x, nf, box, rc, walls, reach=0.0):
+    """The pair list tuple (pi, pj, m, col, wrow, wpair, close, dwall) of all particles x within rc
+    (pairs.build; close: the liquid particles within ``reach`` of a wall at the build)."""
+    return build(x, nf, box, rc, walls, np.empty(16, np.int32), np.empty(16, np.int32), reach)
 
 
 @njit(inline="always", **JIT)
-def pair_kernel(xa, ya, x, b, h, kind, c):
-    """(W_ab [1/cm^2], (dW/dr)/r [1/cm^4]) of particle b and a particle at (xa, ya) (0 beyond 2h); c = norm / h^2."""
-    dx = xa - x[b, 0]
-    dy = ya - x[b, 1]
-    r = np.sqrt(dx * dx + dy * dy)
-    q = r / h
-    if q >= 2.0:
-        return 0.0, 0.0
-    return c * kernel_w(kind, q), (c * kernel_dw(kind, q) / (h * r) if r > 0.0 else 0.0)
+def reach_of(par):
+    """Distance [cm] from a wall within which, at a list build, a particle can feel the Lennard-Jones net
+    before the next build: r0 + skin / 2 (a particle moves less than skin / 2 between builds)."""
+    return par[LJ_R0] + 0.5 * par[SKIN]
+
+
+@njit(inline="always", **JIT)
+def shape(kind, q):
+    """(f(q), f'(q)) of the kernel's unnormalised shape, branch-free (core.smoothing.w, dw to round-off;
+    0 for q >= 2): cubic spline f = (2 - q)_+^3 / 4 - (1 - q)_+^3, Wendland C2 (1 - q/2)_+^4 (1 + 2 q)."""
+    if kind == 0:
+        t = 2.0 - q
+        t = t if t > 0.0 else 0.0
+        u = 1.0 - q
+        u = u if u > 0.0 else 0.0
+        return 0.25 * t * t * t - u * u * u, 3.0 * u * u - 0.75 * t * t
+    if kind == 1:
+        o = 1.0 - 0.5 * q
+        o = o if o > 0.0 else 0.0
+        o3 = o * o * o
+        return o3 * o * (1.0 + 2.0 * q), -5.0 * q * o3
+    return kernel_w(kind, q), kernel_dw(kind, q)
+
+
+@njit(inline="always", **JIT)
+def kernel_wf(r2, ih, kind, c):
+    """(W [1/cm^2], (dW/dr)/r [1/cm^4]) at squared distance r2 [cm^2] (0, 0 beyond 2h); ih = 1 / h,
+    c = norm / h^2.  f'(0) = 0, so r = 0 gives (dW/dr)/r = 0."""
+    r = np.sqrt(r2)
+    f, df = shape(kind, r * ih)
+    return c * f, c * ih * df / (r if r > 1e-300 else 1e-300)
+
+
+@njit(inline="always", **JIT)
+def pair_momentum(pa_rho2, pb_rho2, vr, r2, h, alpha, c0, rho_mean):
+    """P_a/rho_a^2 + P_b/rho_b^2 + Pi_ab [cm^2/s^2 per density, i.e. cm^6/(N s^4)]: the bracket of eq. 9 with
+    Monaghan's (1992) viscosity Pi_ab = -alpha c0 mu / rho_mean, mu = h min(v_ab . x_ab, 0) / (r^2 + 0.01 h^2)
+    (approaching pairs only; written without a branch)."""
+    return pa_rho2 + pb_rho2 - alpha * c0 * h * min(vr, 0.0) / ((r2 + 0.01 * h * h) * rho_mean)
 
 
 @njit(**JIT)
-def kernel_pass(x, pi, pj, m, par, wk, fk):
-    """Per pair: wk = W(r) [1/cm^2] and fk = (dW/dr)/r [1/cm^4] (0 beyond 2h), so grad_a W = fk (x_a - x_b)."""
-    h = par[H]
-    kind = int(par[KERNEL])
-    c = par[NORM] / (h * h)
-    for k in range(m):
-        a = np.uint32(pi[k])
-        wk[k], fk[k] = pair_kernel(x[a, 0], x[a, 1], x, np.uint32(pj[k]), h, kind, c)
-
-
-@njit(**JIT)
-def kernel_density_pass(x, rho, nf, pi, pj, m, par, wk, fk):
-    """kernel_pass and, in the same sweep, rho[:nf] = sum_b m_b W_ab over liquid and wall particles,
-    self included (marko2017 eq. 6)."""
-    mass, h = par[MASS], par[H]
-    kind = int(par[KERNEL])
-    c = par[NORM] / (h * h)
-    w0 = mass * par[NORM] / (h * h) * kernel_w(kind, 0.0)
-    for a in range(nf):
-        rho[a] = w0
-    run = -1  # the run's particle pi: its density is summed in ra, its position held in (xa, ya)
-    ra = xa = ya = 0.0
-    for k in range(m):
-        a = np.uint32(pi[k])
-        b = np.uint32(pj[k])
-        if a != run:
-            if run >= 0:
-                rho[run] = ra
-            run = a
-            ra, xa, ya = rho[a], x[a, 0], x[a, 1]
-        w, f = pair_kernel(xa, ya, x, b, h, kind, c)
-        wk[k] = w
-        fk[k] = f
-        ra += mass * w
-        if b < nf:
-            rho[b] += mass * w
-    if run >= 0:
-        rho[run] = ra
-
-
-@njit(**JIT)
-def density_rate(x, v, rho, nf, pi, pj, m, fk, par, drho):
-    """drho (nf,) = continuity sum_b m_b v_ab . grad_a W_ab (walls at rest) plus, with delta > 0,
-    the density diffusion delta h c0 sum_b V_b psi_ab . grad_a W_ab among liquid particles, its
-    hydrostatic part rho0 g (y_a - y_b) / c0^2 removed.  Uses the cached fk of the pairs."""
+def kernel_range(lo, hi, x, v, rho, nf, pi, pj, par, wk, fk, out):
+    """Pairs lo..hi-1: wk = W, fk = (dW/dr)/r (so grad_a W = fk (x_a - x_b)); out (nf,) += the summed
+    density m W (SUMMATION) or the continuity rate m v_ab . grad_a W (walls at rest) plus, with
+    delta > 0, the density diffusion delta h c0 sum_b V_b psi_ab . grad_a W_ab among liquid particles,
+    its hydrostatic part rho0 g (y_a - y_b) / c0^2 removed.  Along a run of equal pi its sum is held
+    in a register (pi is never pj within its run), which adds the terms in list order all the same."""
     mass, h, c0, rho0, g, delta = par[MASS], par[H], par[C0], par[RHO0], par[GRAV], par[DELTA]
-    drho[:nf] = 0.0
-    run = -1  # the run's particle pi: its rate is summed in da, its state held in registers
-    da = xa = ya = vxa = vya = ra = 0.0
-    for k in range(m):
-        f = fk[k]
-        if f == 0.0:
-            continue
+    kind = int(par[KERNEL])
+    c = par[NORM] / (h * h)
+    ih = 1.0 / h
+    summation = par[SUMMATION] > 0
+    run = -1
+    sa = xa = ya = vxa = vya = ra = ira = 0.0
+    for k in range(lo, hi):
         a = np.uint32(pi[k])
         b = np.uint32(pj[k])
         if a != run:
             if run >= 0:
-                drho[run] = da
+                out[run] = sa
             run = a
-            da = drho[a]
+            sa = out[a]
             xa, ya, vxa, vya, ra = x[a, 0], x[a, 1], v[a, 0], v[a, 1], rho[a]
+            ira = 1.0 / ra
         dx = xa - x[b, 0]
         dy = ya - x[b, 1]
-        if b >= nf:
-            da += mass * f * (vxa * dx + vya * dy)
-            continue
-        dd = mass * f * ((vxa - v[b, 0]) * dx + (vya - v[b, 1]) * dy)
-        da += dd
-        drho[b] += dd
-        if delta > 0.0:
-            d = (rho[b] - ra) - rho0 * g * dy / (c0 * c0)
-            t = -2.0 * delta * h * c0 * mass * d * f
-            da += t / rho[b]
-            drho[b] -= t / ra
+        w, f = kernel_wf(dx * dx + dy * dy, ih, kind, c)
+        wk[k] = w
+        fk[k] = f
+        if summation:
+            sa += mass * w
+            if b < nf:
+                out[b] += mass * w
+        elif b >= nf:
+            sa += mass * f * (vxa * dx + vya * dy)
+        else:
+            dd = mass * f * ((vxa - v[b, 0]) * dx + (vya - v[b, 1]) * dy)
+            if delta > 0.0:
+                rb = rho[b]
+                t = -2.0 * delta * h * c0 * mass * f * ((rb - ra) - rho0 * g * dy / (c0 * c0))
+                sa += dd + t / rb
+                out[b] += dd - t * ira
+            else:
+                sa += dd
+                out[b] += dd
     if run >= 0:
-        drho[run] = da
+        out[run] = sa
 
 
 @njit(**JIT)
-def forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum, p_rho2):
-    """Pressures (liquid: equation of state; walls: Adami et al. 2012 eq. 27) and accelerations.
-
-    rho[:nf] is read; rho[nf:] and p are overwritten.  acc (nf, 2) cm/s^2
-    includes gravity; wall_force (nw, 2) N: force of each wall particle on the
-    liquid; wsum (nw, 3) and p_rho2 (n,) (P / rho^2 per particle) scratch.  Every pair force is applied with opposite
-    signs to both particles (eq. 9 in its symmetric form).
-    """
-    mass, rho0, c0, gamma = par[MASS], par[RHO0], par[C0], par[GAMMA]
-    h, g = par[H], par[GRAV]
-    tait, clamp = par[TAIT] > 0, par[CLAMP] > 0
-    for a in range(nf):
-        p[a] = pressure_of(rho[a], rho0, c0, gamma, tait, clamp)
-    # walls at rest: p_w = (sum_f p_f W_wf + g . sum_f rho_f r_wf W_wf) / sum_f W_wf
-    wsum[:] = 0.0
-    for k in range(m):
-        b = np.uint32(pj[k])
-        if b >= nf and wk[k] > 0.0:
-            a = np.uint32(pi[k])
-            q = b - nf
-            wsum[q, 0] += wk[k]
-            wsum[q, 1] += p[a] * wk[k]
-            wsum[q, 2] += rho[a] * (-g) * (x[b, 1] - x[a, 1]) * wk[k]
-    for q in range(wsum.shape[0]):
-        pw = 0.0
-        if wsum[q, 0] > 0.0:
-            pw = (wsum[q, 1] + wsum[q, 2]) / wsum[q, 0]
-        if clamp and pw < 0.0:
-            pw = 0.0
-        p[nf + q] = pw
-        rho[nf + q] = density_of(pw, rho0, c0, gamma, tait)
-    for a in range(p.shape[0]):
-        p_rho2[a] = p[a] / (rho[a] * rho[a])
-    alpha = par[ALPHA]
-    wall_visc = par[WALL_VISC] > 0
-    eps2 = 0.01 * h * h
-    for a in range(nf):
-        acc[a, 0] = 0.0
-        acc[a, 1] = -g
-    wall_force[:] = 0.0
-    run = -1  # the run's particle pi: its acceleration is summed in (sx, sy), its state held in registers
+def force_range(lo, hi, x, v, rho, p_rho2, nf, pi, pj, par, fk, acc, wall_force):
+    """Pairs lo..hi-1: eq. 9 with viscosity, applied with opposite signs to both particles; a wall
+    particle's share goes to wall_force (its force on the liquid, N).  Run sums in registers as
+    kernel_range."""
+    mass, h, c0, alpha = par[MASS], par[H], par[C0], par[ALPHA]
+    alpha_wall = alpha if par[WALL_VISC] > 0 else 0.0
+    run = -1
     sx = sy = xa = ya = vxa = vya = ra = pa = 0.0
-    for k in range(m):
-        f = fk[k]
-        if f == 0.0:
-            continue
+    for k in range(lo, hi):
         a = np.uint32(pi[k])
         b = np.uint32(pj[k])
         if a != run:
@@ -209,28 +158,23 @@ def forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum, p_rh
             xa, ya, vxa, vya, ra, pa = x[a, 0], x[a, 1], v[a, 0], v[a, 1], rho[a], p_rho2[a]
         dx = xa - x[b, 0]
         dy = ya - x[b, 1]
-        wall = b >= nf
-        if wall:
-            dvx = vxa
-            dvy = vya
-        else:
-            dvx = vxa - v[b, 0]
-            dvy = vya - v[b, 1]
-        rb = rho[b]
-        s = pa + p_rho2[b]
-        vr = dvx * dx + dvy * dy
-        if vr < 0.0 and alpha > 0.0 and (wall_visc or not wall):
-            mu = h * vr / (dx * dx + dy * dy + eps2)
-            s += -alpha * c0 * mu / (0.5 * (ra + rb))
-        s *= mass * f
-        ax = -s * dx
-        ay = -s * dy
-        sx += ax
-        sy += ay
-        if wall:
+        f = fk[k]
+        if b >= nf:
+            s = mass * f * pair_momentum(pa, p_rho2[b], vxa * dx + vya * dy, dx * dx + dy * dy, h, alpha_wall, c0,
+                                         0.5 * (ra + rho[b]))
+            ax = -s * dx
+            ay = -s * dy
+            sx += ax
+            sy += ay
             wall_force[b - nf, 0] += mass * ax
             wall_force[b - nf, 1] += mass * ay
         else:
+            s = mass * f * pair_momentum(pa, p_rho2[b], (vxa - v[b, 0]) * dx + (vya - v[b, 1]) * dy,
+                                         dx * dx + dy * dy, h, alpha, c0, 0.5 * (ra + rho[b]))
+            ax = -s * dx
+            ay = -s * dy
+            sx += ax
+            sy += ay
             acc[b, 0] -= ax
             acc[b, 1] -= ay
     if run >= 0:
@@ -238,99 +182,292 @@ def forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum, p_rh
         acc[run, 1] = sy
 
 
+@njit(**PJIT)
+def _kernel_par(col, x, v, rho, nf, pi, pj, par, wk, fk, out):
+    ncol = col.shape[0] - 1
+    for colour in range(2):
+        for cc in prange((ncol - colour + 1) // 2):
+            c = 2 * cc + colour
+            kernel_range(col[c], col[c + 1], x, v, rho, nf, pi, pj, par, wk, fk, out)
+
+
 @njit(**JIT)
-def evaluate(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum):
-    """Kernels, densities (summed, eq. 6, or rho[:nf] as given) and forces of a state (see forces)."""
-    if par[SUMMATION] > 0:
-        kernel_density_pass(x, rho, nf, pi, pj, m, par, wk, fk)
+def _kernel_ser(col, x, v, rho, nf, pi, pj, par, wk, fk, out):
+    ncol = col.shape[0] - 1
+    for colour in range(2):
+        for cc in range((ncol - colour + 1) // 2):
+            c = 2 * cc + colour
+            kernel_range(col[c], col[c + 1], x, v, rho, nf, pi, pj, par, wk, fk, out)
+
+
+@njit(**PJIT)
+def _force_par(col, x, v, rho, p_rho2, nf, pi, pj, par, fk, acc, wall_force):
+    ncol = col.shape[0] - 1
+    for colour in range(2):
+        for cc in prange((ncol - colour + 1) // 2):
+            c = 2 * cc + colour
+            force_range(col[c], col[c + 1], x, v, rho, p_rho2, nf, pi, pj, par, fk, acc, wall_force)
+
+
+@njit(**JIT)
+def _force_ser(col, x, v, rho, p_rho2, nf, pi, pj, par, fk, acc, wall_force):
+    ncol = col.shape[0] - 1
+    for colour in range(2):
+        for cc in range((ncol - colour + 1) // 2):
+            c = 2 * cc + colour
+            force_range(col[c], col[c + 1], x, v, rho, p_rho2, nf, pi, pj, par, fk, acc, wall_force)
+
+
+@njit(**JIT)
+def liquid_range(lo, hi, rho, rate, p, p_rho2, acc, par, update):
+    """Particles lo..hi-1: rho += dt rate if update (continuity density), pressure (equation of state),
+    P / rho^2, and acc reset to gravity."""
+    rho0, c0, gamma, g, dt = par[RHO0], par[C0], par[GAMMA], par[GRAV], par[DT]
+    tait, clamp = par[TAIT] > 0, par[CLAMP] > 0
+    for a in range(lo, hi):
+        if update:
+            rho[a] += dt * rate[a]
+        pa = pressure_of(rho[a], rho0, c0, gamma, tait, clamp)
+        p[a] = pa
+        p_rho2[a] = pa / (rho[a] * rho[a])
+        acc[a, 0] = 0.0
+        acc[a, 1] = -g
+
+
+@njit(**JIT)
+def wall_range(lo, hi, x, rho, p, p_rho2, nf, pi, wrow, wpair, wk, par, wall_force):
+    """Wall particles lo..hi-1 (at rest): Adami et al. (2012) eq. 27, p_w = (sum_f p_f W_wf +
+    g . sum_f rho_f r_wf W_wf) / sum_f W_wf over the liquid particles that see it (p_w >= 0 when
+    clamping), rho_w from the inverse equation of state; wall_force reset."""
+    rho0, c0, gamma, g = par[RHO0], par[C0], par[GAMMA], par[GRAV]
+    tait, clamp = par[TAIT] > 0, par[CLAMP] > 0
+    for q in range(lo, hi):
+        s0 = 0.0
+        s1 = 0.0
+        yq = x[nf + q, 1]
+        for e in range(wrow[q], wrow[q + 1]):
+            k = wpair[e]
+            w = wk[k]
+            if w > 0.0:
+                a = pi[k]
+                s0 += w
+                s1 += (p[a] - rho[a] * g * (yq - x[a, 1])) * w
+        pw = s1 / s0 if s0 > 0.0 else 0.0
+        if clamp and pw < 0.0:
+            pw = 0.0
+        rw = density_of(pw, rho0, c0, gamma, tait)
+        p[nf + q] = pw
+        rho[nf + q] = rw
+        p_rho2[nf + q] = pw / (rw * rw)
+        wall_force[q, 0] = 0.0
+        wall_force[q, 1] = 0.0
+
+
+@njit(**PJIT)
+def _particles_par(nf, nw, x, rho, rate, p, p_rho2, acc, par, update, pi, wrow, wpair, wk, wall_force):
+    for ch in prange((nf + CHUNK - 1) // CHUNK):
+        liquid_range(ch * CHUNK, min(nf, (ch + 1) * CHUNK), rho, rate, p, p_rho2, acc, par, update)
+
+
+@njit(**PJIT)
+def _walls_par(nf, nw, x, rho, p, p_rho2, pi, wrow, wpair, wk, par, wall_force):
+    for ch in prange((nw + CHUNK - 1) // CHUNK):
+        wall_range(ch * CHUNK, min(nw, (ch + 1) * CHUNK), x, rho, p, p_rho2, nf, pi, wrow, wpair, wk, par,
+                   wall_force)
+
+
+@njit(**JIT)
+def state_forces(x, v, rho, p, nf, walls, par, lst, wk, fk, acc, wall_force, panel0, npanel, panel_sum,
+                 rate, p_rho2, update, threads):
+    """Kernels, densities, pressures and accelerations acc (nf, 2) [cm/s^2, gravity included] of a state.
+
+    Summed density: rho[:nf] from the positions.  Continuity density: rate (nf,) = drho/dt at
+    (x, v), and rho[:nf] += dt rate if update (else rho[:nf] is the state's).  Then the pressures,
+    the wall particles' pressures and densities, eq. 9 and the Lennard-Jones safety net
+    (repulsion.wall_repulsion on the particles near a wall; its force on the panels is added to
+    panel_sum (P, 2) N).  wall_force (nw, 2) N: force of each wall particle on the liquid.
+    """
+    pi, pj, m, col, wrow, wpair, close, dwall = lst
+    nw = x.shape[0] - nf
+    summation = par[SUMMATION] > 0
+    if summation:
+        h = par[H]
+        w0 = par[MASS] * par[NORM] / (h * h) * kernel_w(int(par[KERNEL]), 0.0)
+        rho[:nf] = w0
+        out = rho
     else:
-        kernel_pass(x, pi, pj, m, par, wk, fk)
-    forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum, np.empty(x.shape[0]))
+        rate[:] = 0.0
+        out = rate
+    if threads > 1:
+        _kernel_par(col, x, v, rho, nf, pi, pj, par, wk, fk, out)
+        _particles_par(nf, nw, x, rho, rate, p, p_rho2, acc, par, update and not summation, pi, wrow, wpair, wk,
+                       wall_force)
+        _walls_par(nf, nw, x, rho, p, p_rho2, pi, wrow, wpair, wk, par, wall_force)
+        _force_par(col, x, v, rho, p_rho2, nf, pi, pj, par, fk, acc, wall_force)
+    else:
+        _kernel_ser(col, x, v, rho, nf, pi, pj, par, wk, fk, out)
+        liquid_range(0, nf, rho, rate, p, p_rho2, acc, par, update and not summation)
+        wall_range(0, nw, x, rho, p, p_rho2, nf, pi, wrow, wpair, wk, par, wall_force)
+        _force_ser(col, x, v, rho, p_rho2, nf, pi, pj, par, fk, acc, wall_force)
+    wall_repulsion(x, close, walls, panel0, npanel, par[LJ_D], par[LJ_R0], par[MASS], acc, panel_sum)
+
+
+@njit(**PJIT)
+def _kick_par(nf, v, acc, half, part):
+    for ch in prange((nf + CHUNK - 1) // CHUNK):
+        s = 0.0
+        for a in range(ch * CHUNK, min(nf, (ch + 1) * CHUNK)):
+            v[a, 0] += half * acc[a, 0]
+            v[a, 1] += half * acc[a, 1]
+            s += v[a, 0] * v[a, 0] + v[a, 1] * v[a, 1]
+        part[ch] = s
 
 
 @njit(**JIT)
-def advance(x, v, rho, p, nf, walls, box, grid_box, par, n_steps, xref, pi, pj, m, wk, fk, acc,
-            wall_force, wsum, force_sum, panel0, npanel, panel_sum, diag):
+def _kick_ser(nf, v, acc, half, part):
+    for ch in range((nf + CHUNK - 1) // CHUNK):
+        s = 0.0
+        for a in range(ch * CHUNK, min(nf, (ch + 1) * CHUNK)):
+            v[a, 0] += half * acc[a, 0]
+            v[a, 1] += half * acc[a, 1]
+            s += v[a, 0] * v[a, 0] + v[a, 1] * v[a, 1]
+        part[ch] = s
+
+
+@njit(**JIT)
+def _move_range(lo, hi, x, v, acc, xref, half, dt, box, walls, dwall, slack, finish):
+    """Particles lo..hi-1: if finish, the second kick of the last step (v += dt/2 acc) and its |v|^2
+    sum; then the first kick of this step and the drift.  A particle whose move could reach a wall
+    (dt |v| >= its distance to the walls at the last build minus slack = skin / 2, the most it has
+    moved since) is tested (core.geometry.crossed_wall) and, if it would cross, left where it is.
+    Returns (sum |v|^2 after the finishing kick, largest squared move since xref, first particle that
+    would cross a wall or -1, first particle that left box or became non-finite or -1)."""
+    v2 = 0.0
+    moved2 = 0.0
+    cross = -1
+    bad = -1
+    for a in range(lo, hi):
+        if finish:
+            v[a, 0] += half * acc[a, 0]
+            v[a, 1] += half * acc[a, 1]
+            v2 += v[a, 0] * v[a, 0] + v[a, 1] * v[a, 1]
+        v[a, 0] += half * acc[a, 0]
+        v[a, 1] += half * acc[a, 1]
+        x0 = x[a, 0]
+        y0 = x[a, 1]
+        x1 = x0 + dt * v[a, 0]
+        y1 = y0 + dt * v[a, 1]
+        step2 = (x1 - x0) * (x1 - x0) + (y1 - y0) * (y1 - y0)
+        reach = dwall[a] - slack
+        if not (step2 < reach * reach and reach > 0.0):
+            if crossed_wall(x0, y0, x1, y1, walls) >= 0:
+                if cross < 0:
+                    cross = a
+                continue
+        if bad < 0 and not (np.isfinite(x1) and np.isfinite(y1) and box[0] <= x1 <= box[2] and box[1] <= y1 <= box[3]):
+            bad = a
+        x[a, 0] = x1
+        x[a, 1] = y1
+        ddx = x1 - xref[a, 0]
+        ddy = y1 - xref[a, 1]
+        moved2 = max(moved2, ddx * ddx + ddy * ddy)
+    return v2, moved2, cross, bad
+
+
+@njit(**PJIT)
+def _move_par(nf, x, v, acc, xref, half, dt, box, walls, dwall, slack, finish, part, moved, cross, bad):
+    for ch in prange((nf + CHUNK - 1) // CHUNK):
+        part[ch], moved[ch], cross[ch], bad[ch] = _move_range(ch * CHUNK, min(nf, (ch + 1) * CHUNK), x, v, acc, xref,
+                                                              half, dt, box, walls, dwall, slack, finish)
+
+
+@njit(**JIT)
+def advance(x, v, rho, p, nf, walls, box, grid_box, par, n_steps, xref, lst, wk, fk, acc,
+            wall_force, force_sum, panel0, npanel, panel_sum, diag, threads):
     """Velocity Verlet (kick-drift-kick) for n_steps steps; acc must hold the current state's.
 
-    Summed density: a function of the positions.  Continuity density: a
-    position-like variable, rho_{n+1} = rho_n + dt/2 (D(x_n) + D(x_{n+1})) with
-    both rates D taken at the half-step velocities (trapezoidal drift), so the
-    pressure is never a half step behind the positions.  Rebuilds the pair
-    list (cells over grid_box) when a particle has moved more than skin / 2
-    since the last build (xref).  Stops early if a particle crosses a wall,
-    leaves box (the walls' bounding box), or a value is not finite.
-    force_sum (nw, 2) += wall_force every step; panel_sum (P, 2) += the
-    wall_repulsion forces on the panels (panel0, npanel per wall).  diag (4,) out: max over the
-    steps of the rms speed [cm/s], final kinetic energy [N cm], list builds,
-    offending particle (or -1).  Returns (code, steps done, pi, pj, m, wk, fk).
+    Continuity density is a position-like variable: rho_{n+1} = rho_n + dt D(x_{n+1}, v_{n+1/2}),
+    its rate taken in the same pass as the kernels at the drifted positions (for fixed
+    positions this is the Stormer-Verlet step of the acoustic system (rho, v)).  A step's
+    second kick is done with the next step's first kick and drift, in one pass over the
+    particles (the same two additions).  The pair list is rebuilt (cells over grid_box, from
+    the positions, so from xref) when a particle has moved more than skin / 2 since the last
+    build.  Stops in a step in which a particle would cross a wall (core.geometry.crossed_wall,
+    tested for the particles whose move could reach a wall), and after one in which a particle
+    left box (the walls' bounding box) or became non-finite.  force_sum (nw, 2) += wall_force
+    every step; panel_sum (P, 2) += the Lennard-Jones forces on the panels.  diag (4,) out: max
+    over the steps of the rms speed [cm/s], final kinetic energy [N cm], list builds,
+    offending particle (or -1).  threads > 1: the parallel passes (bit-identical to the serial
+    ones).  Returns (code, steps done, lst, wk, fk).
     """
     dt = par[DT]
     half = 0.5 * dt
     lim2 = (0.5 * par[SKIN]) ** 2
     rc = 2.0 * par[H] + par[SKIN]
-    summation = par[SUMMATION] > 0
+    slack = 0.5 * par[SKIN]
     mass = par[MASS]
-    rate0 = np.zeros(nf)
-    rate1 = np.zeros(nf)
-    rho_n = np.zeros(nf)
-    p_rho2 = np.empty(x.shape[0])
+    n = x.shape[0]
+    nch = (nf + CHUNK - 1) // CHUNK
+    part = np.zeros(nch)
+    moved = np.zeros(nch)
+    cross = np.full(nch, -1, np.int64)
+    bad = np.full(nch, -1, np.int64)
+    rate = np.zeros(nf)
+    p_rho2 = np.empty(n)
     diag[0] = 0.0
     diag[2] = 0.0
     diag[3] = -1.0
-    for step in range(n_steps):
-        for a in range(nf):
-            v[a, 0] += half * acc[a, 0]
-            v[a, 1] += half * acc[a, 1]
-        if not summation:
-            density_rate(x, v, rho, nf, pi, pj, m, fk, par, rate0)
-            rho_n[:] = rho[:nf]
+    for step in range(n_steps + 1):
+        finish = step > 0
+        if step == n_steps:  # the last step's second kick
+            if threads > 1:
+                _kick_par(nf, v, acc, half, part)
+            else:
+                _kick_ser(nf, v, acc, half, part)
+        elif threads > 1:
+            _move_par(nf, x, v, acc, xref, half, dt, box, walls, lst[7], slack, finish, part, moved, cross, bad)
+        else:
+            for ch in range(nch):
+                part[ch], moved[ch], cross[ch], bad[ch] = _move_range(
+                    ch * CHUNK, min(nf, (ch + 1) * CHUNK), x, v, acc, xref, half, dt, box, walls, lst[7], slack, finish)
+        if finish:  # diagnostics of the finished step
+            v2 = 0.0
+            for ch in range(nch):
+                v2 += part[ch]
+            if not np.isfinite(v2):
+                return NONFINITE, step, lst, wk, fk
+            diag[0] = max(diag[0], np.sqrt(v2 / nf))
+            diag[1] = 0.5 * mass * v2
+        if step == n_steps:
+            break
         moved2 = 0.0
-        for a in range(nf):
-            x0 = x[a, 0]
-            y0 = x[a, 1]
-            x1 = x0 + dt * v[a, 0]
-            y1 = y0 + dt * v[a, 1]
-            if not (np.isfinite(x1) and np.isfinite(y1)):
+        for ch in range(nch):
+            moved2 = max(moved2, moved[ch])
+            if cross[ch] >= 0:  # a move across a wall stops the run (that particle not moved)
+                diag[3] = cross[ch]
+                return CROSSED, step, lst, wk, fk
+            if bad[ch] >= 0:
+                a = bad[ch]
                 diag[3] = a
-                return NONFINITE, step, pi, pj, m, wk, fk
-            if crossed_wall(x0, y0, x1, y1, walls) >= 0:
-                diag[3] = a
-                return CROSSED, step, pi, pj, m, wk, fk
-            if x1 < box[0] or x1 > box[2] or y1 < box[1] or y1 > box[3]:
-                diag[3] = a
-                return LEFT_BOX, step, pi, pj, m, wk, fk
-            x[a, 0] = x1
-            x[a, 1] = y1
-            ddx = x1 - xref[a, 0]
-            ddy = y1 - xref[a, 1]
-            moved2 = max(moved2, ddx * ddx + ddy * ddy)
+                return (LEFT_BOX if np.isfinite(x[a, 0]) and np.isfinite(x[a, 1]) else NONFINITE), step + 1, lst, wk, fk
         if moved2 > lim2:
-            pi, pj, m = list_pairs(x, nf, grid_box, rc)
-            if wk.shape[0] < m:
-                wk = np.empty(pi.shape[0])
-                fk = np.empty(pi.shape[0])
+            lst = build(x, nf, grid_box, rc, walls, lst[0], lst[1], reach_of(par))
+            if wk.shape[0] < lst[2]:
+                wk = np.empty(lst[0].shape[0])
+                fk = np.empty(lst[0].shape[0])
             xref[:nf] = x[:nf]
             diag[2] += 1.0
-        if summation:
-            kernel_density_pass(x, rho, nf, pi, pj, m, par, wk, fk)
-        else:
-            kernel_pass(x, pi, pj, m, par, wk, fk)
-            density_rate(x, v, rho, nf, pi, pj, m, fk, par, rate1)
-            for a in range(nf):
-                rho[a] = rho_n[a] + half * (rate0[a] + rate1[a])
-        forces(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum, p_rho2)
-        wall_repulsion(x, nf, walls, panel0, npanel, par[LJ_D], par[LJ_R0], mass, acc, panel_sum)
-        v2 = 0.0
-        for a in range(nf):
-            v[a, 0] += half * acc[a, 0]
-            v[a, 1] += half * acc[a, 1]
-            v2 += v[a, 0] * v[a, 0] + v[a, 1] * v[a, 1]
-        if not np.isfinite(v2):
-            return NONFINITE, step + 1, pi, pj, m, wk, fk
-        diag[0] = max(diag[0], np.sqrt(v2 / nf))
-        diag[1] = 0.5 * mass * v2
+        state_forces(x, v, rho, p, nf, walls, par, lst, wk, fk, acc, wall_force, panel0, npanel, panel_sum,
+                     rate, p_rho2, True, threads)
         for q in range(force_sum.shape[0]):
             force_sum[q, 0] += wall_force[q, 0]
             force_sum[q, 1] += wall_force[q, 1]
-    return OK, n_steps, pi, pj, m, wk, fk
+    return OK, n_steps, lst, wk, fk
+
+
+@njit(**JIT)
+def evaluate(x, v, rho, p, nf, walls, par, lst, wk, fk, acc, wall_force, panel0, npanel, panel_sum, threads):
+    """Accelerations (and pressures, wall pressures, kernels) of a state without advancing it
+    (continuity density: rho[:nf] kept), as advance computes them at the end of a step."""
+    state_forces(x, v, rho, p, nf, walls, par, lst, wk, fk, acc, wall_force, panel0, npanel, panel_sum,
+                 np.zeros(nf), np.empty(x.shape[0]), False, threads)

@@ -44,12 +44,14 @@ def _logger():
     return log
 
 
-def run_case(cfg, tank, outputs, case, variant, rid, start=None):
+def run_case(cfg, tank, outputs, case, variant, rid, start=None, threads=1):
     """Run one case ('single', 'flow' from run file ``start``, or 'stab' with rid the case name) with the
-    settings file ``cfg`` in the tank file ``tank``; write its run file outputs[0]."""
+    settings file ``cfg`` in the tank file ``tank`` on ``threads`` numba threads (the results do not
+    depend on it; recorded as the run file's ``threads``); write its run file outputs[0].  A flow
+    continues the start run's clock and step count."""
     log, cfg_path, out = _logger(), cfg, outputs[0]
     spec = settings.load(cfg_path)
-    solver.warm_up()  # compile outside the timing
+    solver.warm_up(threads)  # compile outside the timing
     inputs = {"tank": tank, "settings": cfg_path}
     tank = load_tank(tank)
     kw = {}
@@ -63,7 +65,7 @@ def run_case(cfg, tank, outputs, case, variant, rid, start=None):
     else:
         kw["resolution"] = resolution_of(spec, case, rid)
     started = runfile.now()
-    res = solver.solve(tank, variant, settings_path=cfg_path, log=log.info, **kw)
+    res = solver.solve(tank, variant, settings_path=cfg_path, log=log.info, threads=threads, **kw)
     if case == "stab":
         res.params["stability_case"] = rid
         res.params["stability_label"] = spec["runs"]["stability"][rid]["label"]
@@ -104,7 +106,14 @@ def row(path):
                wall_particles=int(a["wall_particles"]), wall_time_s=float(ds["wall_time"]),
                force_evals=int(ds["force_evals"]), status=a["status"], sim_time_s=float(ds["sim_time"]),
                rms_speed_cm_s=float(ds["residual"]), stability_case=a.get("stability_case", ""),
-               ns_per_particle_step=float(ds["wall_time"]) / max(int(ds["steps"]), 1) / ds.sizes["particle"] * 1e9)
+               ns_per_particle_step=float(ds["wall_time"]) / max(int(ds["steps"]) - int(ds["start_step"]), 1)
+               / ds.sizes["particle"] * 1e9, threads=int(a.get("threads", 1)),
+               escaped=a["status"] == "escaped", time_to_rest_s=float(a.get("time_to_rest", np.nan)),
+               start_time_s=float(a.get("start_time", 0.0)), final_energy_ratio=float(a.get("final_energy_ratio", np.nan)))
+    out["run_time_s"] = out["sim_time_s"] - out["start_time_s"]
+    depth, width = float(a["liquid_depth"]), float(a["first_vessel_width"])
+    tank_gamma = float(ds["weight"].values.sum()) / (width * depth)  # rho g of the tank, N/cm^3
+    out["side_theory_tank_N"] = tank_gamma * depth**2 / 2  # rho g H^2 / 2 of the tank (3262.5 N)
     vessel = None
     if "vessel" in ds.coords:
         names = [str(n) for n in ds["vessel"].values]
@@ -121,6 +130,16 @@ def row(path):
         out["level_cm"] = level(ds, vessel)
         out["surface_cm"] = out["level_cm"] + float(a["cell_dy"]) / 2  # top particle centres + half a cell
         out["surface_expected_cm"] = v2["floor_y"] + (w.sum() - out["mass_left_N"]) / (gamma * v2["width"])
+    else:  # single vessel: side walls and surface against the tank's own depth (3262.5 N, 72.5 cm)
+        names = [str(n) for n in ds["wall"].values]
+        res = ds["wall_resultant"].values
+        sides = [abs(res[names.index(n), 0]) for n in ("left", "right") if n in names]
+        if sides:
+            out["side_err_tank"] = float(np.mean(sides)) / out["side_theory_tank_N"] - 1
+        pos = ds["pos"].values
+        nx = int(round(float(a["first_vessel_width"]) / float(a["cell_dx"])))
+        out["surface_cm"] = float(np.sort(pos[:, 1])[-nx:].mean() + float(a["cell_dy"]) / 2)
+        out["surface_err_tank_cm"] = out["surface_cm"] - float(a["liquid_depth"])
     if np.isfinite(ds["pos"].values).all():
         try:
             out.update(metrics.hydrostatic_errors(ds, vessel=vessel))

@@ -93,19 +93,45 @@ def is_solid(px, py, walls):
     return out
 
 
-def wall_particles(walls, dx, dy, support, origin=(0.0, 0.0)):
-    """Wall particles behind every wall, covering `support` [cm] (the kernel's 2 h).
+def wet_back(walls, vessels):
+    """(W,) bool: walls whose back (right-hand) face the liquid can wet too (thin dividing walls).
+
+    A wall's back is wettable when the point a hair behind its middle lies inside a vessel,
+    between its x bounds and above its floor (the lowest horizontal wall over it).
+    vessels: [(name, (xmin, xmax) cm)]."""
+    walls = np.asarray(walls, float)
+    horiz = np.isclose(walls[:, 1], walls[:, 3])
+    out = np.zeros(len(walls), bool)
+    for w, (x0, y0, x1, y1) in enumerate(walls):
+        L = np.hypot(x1 - x0, y1 - y0)
+        px = 0.5 * (x0 + x1) + 1e-6 * (y1 - y0) / L
+        py = 0.5 * (y0 + y1) - 1e-6 * (x1 - x0) / L
+        for _, (a, b) in vessels:
+            over = horiz & (np.minimum(walls[:, [0, 2]].max(1), b) - np.maximum(walls[:, [0, 2]].min(1), a) > 1e-9)
+            if a < px < b and over.any() and py > walls[over, 1].min():
+                out[w] = True
+    return out
+
+
+def wall_particles(walls, dx, dy, support, origin=(0.0, 0.0), two_faced=None):
+    """Wall particles behind every wall face, covering `support` [cm] (the kernel's 2 h).
 
     Each wall gets layers (k - 1/2) d_n behind it (d_n = dy for horizontal,
     dx for vertical walls, sqrt(dx dy) otherwise), points d_t apart along it in
     the phase of the lattice through `origin`; at joints the layers run on
-    past the end to fill the corner, kept where behind the walls (is_solid).
+    past the end to fill the corner, kept where behind the walls (is_solid); at a
+    free end a column stands at the very tip.  Walls flagged in two_faced (W,) bool
+    (thin dividing walls, see wet_back) get the same layers in front too (face 1),
+    for the liquid on their back; the pair list's visibility rule (pairs) lets each
+    liquid particle see only the layers across the wall from it.
     Points closer than half a spacing to an earlier one are dropped.
-    Returns (pos (P, 2) cm, wall (P,) int: the wall each belongs to).
+    Returns (pos (P, 2) cm, wall (P,) int: the wall each belongs to, face (P,) int:
+    0 behind the wall (serving its front, the liquid side), 1 in front (serving its back)).
     """
     walls = np.asarray(walls, float)
+    two_faced = np.zeros(len(walls), bool) if two_faced is None else np.asarray(two_faced, bool)
     jt = joints(walls)
-    pts, owner, extra = [], [], []
+    pts, owner, extra, faces = [], [], [], []
     for w, (x0, y0, x1, y1) in enumerate(walls):
         ex, ey = x1 - x0, y1 - y0
         L = np.hypot(ex, ey)
@@ -120,32 +146,36 @@ def wall_particles(walls, dx, dy, support, origin=(0.0, 0.0)):
         layers = int(np.ceil(support / d_n))
         s_org = (origin[0] - x0) * tx + (origin[1] - y0) * ty  # lattice phase along the wall
         n_ext = int(np.ceil(support / d_t))
-        # past a joint: fill the corner; at a free end: cover the wall to its tip
-        lo = -n_ext * d_t if (w, 0) in jt else -0.5 * d_t
-        hi = L + n_ext * d_t if (w, 1) in jt else L + 0.5 * d_t
-        j = np.arange(np.floor((lo - s_org) / d_t) - 1, np.ceil((hi - s_org) / d_t) + 1)
-        s = s_org + (j + 0.5) * d_t
-        s = s[(s >= lo) & (s <= hi)]
         tips = [e for e, free in ((0.0, (w, 0) not in jt), (L, (w, 1) not in jt)) if free]
-        s = np.concatenate([tips, s])  # free ends: a column at the very tip (later duplicates dropped)
-        for k in range(1, layers + 1):
-            off = (k - 0.5) * d_n
-            px, py = x0 + s * tx + off * nx_, y0 + s * ty + off * ny_
-            pts.append(np.column_stack([px, py]))
-            owner.append(np.full(len(s), w))
-            extra.append(((s < 0) & ((w, 0) in jt)) | ((s > L) & ((w, 1) in jt)))
+        for face in ((0, 1) if two_faced[w] else (0,)):
+            # face 0, past a joint: fill the corner; at a free end (and on face 1): up to the tip column
+            lo = -n_ext * d_t if (w, 0) in jt and face == 0 else 0.0
+            hi = L + n_ext * d_t if (w, 1) in jt and face == 0 else L
+            j = np.arange(np.floor((lo - s_org) / d_t) - 1, np.ceil((hi - s_org) / d_t) + 1)
+            s = s_org + (j + 0.5) * d_t
+            s = s[(s >= lo) & (s <= hi)]
+            s = np.concatenate([tips, s])  # free ends: a column at the very tip (later duplicates dropped)
+            sign = 1.0 if face == 0 else -1.0
+            for k in range(1, layers + 1):
+                off = sign * (k - 0.5) * d_n
+                px, py = x0 + s * tx + off * nx_, y0 + s * ty + off * ny_
+                pts.append(np.column_stack([px, py]))
+                owner.append(np.full(len(s), w))
+                faces.append(np.full(len(s), face))
+                extra.append(((s < 0) & ((w, 0) in jt)) | ((s > L) & ((w, 1) in jt)))
     pos, owner, extra = np.concatenate(pts), np.concatenate(owner), np.concatenate(extra)
+    faces = np.concatenate(faces)
     keep = ~extra | is_solid(pos[:, 0], pos[:, 1], walls)
     # layer points first, then corner points; keep(fewer than half a spacing apart: drop the later)
     order = np.flatnonzero(keep)[np.argsort(extra[keep], kind="stable")]
-    pos, owner = pos[order], owner[order]
+    pos, owner, faces = pos[order], owner[order], faces[order]
     lo, hi = pos.min(0) - 1.0, pos.max(0) + 1.0
     pi, pj, m = build_pairs(pos, np.array([lo[0], lo[1], hi[0], hi[1]]), 0.5 * min(dx, dy))
     drop = np.zeros(len(pos), bool)
     for a, b in sorted(zip(np.minimum(pi[:m], pj[:m]), np.maximum(pi[:m], pj[:m]))):
         if not drop[a]:
             drop[b] = True
-    return pos[~drop], owner[~drop]
+    return pos[~drop], owner[~drop], faces[~drop]
 
 
 def wall_contacts(walls, wpos, owner, force):

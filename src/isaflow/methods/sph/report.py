@@ -35,26 +35,36 @@ def claims(df):
 def fragment(df):
     """Markdown of report section 50 from the summary table."""
     out = ["## Weakly compressible SPH on the same tank", "",
-           "The liquid of marko2017 section 2 (cubic spline eq. 4, summed density eq. 6, symmetric pressure "
-           "gradient eq. 9) completed with a Tait equation of state, Monaghan's artificial viscosity, Adami et "
-           "al. (2012) wall particles with a Lennard-Jones safety net (marko2017 eq. 7) and a leapfrog step "
-           "(config/methods/sph.yaml gives every setting and its source).  Wall loads: wall-particle forces on "
-           "the liquid averaged over the final rest window, summed over the 10 cm wall panels.  Errors from "
-           "isaflow.metrics on the run files.", "", "### Single vessel", "",
-           "| variant | particles | spacing (cm) | outcome | t (s) | side error | "
-           "per-panel RMS | resultant height error (cm) | level (cm) |", "|---|---|---|---|---|---|---|---|---|"]
+           "The liquid of marko2017 section 2 (cubic spline eq. 4, symmetric pressure gradient eq. 9) with the "
+           "continuity equation in place of eq. 6's summed density (variant `wcsph`; eq. 6 literally is variant "
+           "`wcsph_eq6`: its density is deficient within 2h of the free surface, so the surface band reads low), "
+           "completed with a Tait equation of state, Monaghan's artificial viscosity, Adami et al. (2012) wall "
+           "particles on every wetted wall face (both faces of the thin dividing wall) with a Lennard-Jones safety "
+           "net (marko2017 eq. 7) and a leapfrog step (config/methods/sph.yaml gives every setting and its source).  "
+           "At rest means isaflow.rest's criterion (kinetic energy / (W h) below its ratio for its window); wall "
+           "loads are the wall-particle forces on the liquid averaged over the final rest window, summed over the "
+           "10 cm wall panels.  The weakly compressible column at rest is short of the tank's 72.5 cm by "
+           "g H^2 / (2 c0^2) and of its side load rho g H^2 / 2 = 3,262.5 N by (2/3) g H / c0^2 (0.20 %).",
+           "", "### Single vessel", "",
+           "| variant | particles | spacing (cm) | outcome | escaped | t (s) | time to rest (s) | final rms speed (cm/s) "
+           "| side load vs 3,262.5 N | surface (cm) | side error (measured level) | per-panel RMS |",
+           "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in df[df.case == "single"].sort_values(["variant", "spacing_cm"], ascending=[True, False]).itertuples():
-        out.append(f"| {r.variant} | {r.particles} | {r.spacing_cm:.3g} | {r.status} | {r.sim_time_s:.2f} | "
-                   f"{_fmt(getattr(r, 'side_err', np.nan), '+.2%')} | "
-                   f"{_fmt(getattr(r, 'contact_rms', np.nan))} | {_fmt(getattr(r, 'side_height_err_cm', np.nan), '+.2f')} | "
-                   f"{_fmt(getattr(r, 'level_cm', np.nan), '.2f')} |")
+        out.append(f"| {r.variant} | {r.particles} | {r.spacing_cm:.3g} | {r.status} | {'yes' if r.escaped else 'no'} | "
+                   f"{r.sim_time_s:.2f} | {_fmt(getattr(r, 'time_to_rest_s', np.nan), '.2f')} | "
+                   f"{r.rms_speed_cm_s:.3g} | {_fmt(getattr(r, 'side_err_tank', np.nan), '+.2%')} | "
+                   f"{_fmt(getattr(r, 'surface_cm', np.nan), '.2f')} | {_fmt(getattr(r, 'side_err', np.nan), '+.2%')} | "
+                   f"{_fmt(getattr(r, 'contact_rms', np.nan))} |")
     out += ["", "### Flow into the second vessel", "",
-            "| variant | particles | outcome | t (s) | weight left | surface (cm) | flat surface of the "
-            "weight held (cm) | slope (deg) |", "|---|---|---|---|---|---|---|---|"]
-    for r in df[df.case == "flow"].sort_values(["variant", "spacing_cm"], ascending=[True, False]).itertuples():
-        out.append(f"| {r.variant} | {r.particles} | {r.status} | {r.sim_time_s:.1f} | "
-                   f"{r.mass_left_fraction:.1%} | {r.surface_cm:.2f} | {r.surface_expected_cm:.2f} | "
-                   f"{r.surface_slope_deg:.2g} |")
+            "Flows continue the single run's state and clock (t below); they run until at rest or 40 s after the "
+            "opening.", "",
+            "| run | particles | outcome | t (s) | flow time (s) | final rms speed (cm/s) | particles left | "
+            "weight left | surface (cm) | flat surface of the weight held (cm) | slope (deg) |",
+            "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in df[df.case == "flow"].sort_values(["run"]).itertuples():
+        out.append(f"| {r.run} | {r.particles} | {r.status} | {r.sim_time_s:.1f} | {r.run_time_s:.1f} | "
+                   f"{r.rms_speed_cm_s:.3g} | {r.particles_left} | {r.mass_left_fraction:.1%} | {r.surface_cm:.2f} | "
+                   f"{r.surface_expected_cm:.2f} | {r.surface_slope_deg:.2g} |")
     out += ["", "### Stability cases", "", "| case | particles | outcome | t (s) | rms speed (cm/s) |", "|---|---|---|---|---|"]
     for r in df[df.case == "stab"].itertuples():
         out.append(f"| {r.stability_case} | {r.particles} | {r.status} | {r.sim_time_s:.2f} | {r.rms_speed_cm_s:.3g} |")
@@ -66,9 +76,10 @@ def fragment(df):
 def timing(df):
     """Markdown for docs/timing.md: solver time and cost per particle-step of every SPH run."""
     out = ["## Weakly compressible SPH: solver times (results/sph/summary.csv)", "",
-           "| run | particles | outcome | simulated t (s) | wall time (s) | ns/particle-step |", "|---|---|---|---|---|---|"]
+           "| run | particles | threads | outcome | simulated t of the run (s) | wall time (s) | ns/particle-step |",
+           "|---|---|---|---|---|---|---|"]
     for r in df.sort_values(["case", "variant", "spacing_cm"], ascending=[True, True, False]).itertuples():
-        out.append(f"| {r.run} | {r.particles} | {r.status} | {r.sim_time_s:.2f} | {r.wall_time_s:.1f} | "
+        out.append(f"| {r.run} | {r.particles} | {r.threads} | {r.status} | {r.run_time_s:.2f} | {r.wall_time_s:.1f} | "
                    f"{r.ns_per_particle_step:.0f} |")
     return "\n".join(out + [""])
 

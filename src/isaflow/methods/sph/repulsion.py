@@ -10,17 +10,19 @@ JIT = dict(cache=True, nogil=True)
 
 
 @njit(**JIT)
-def wall_repulsion(x, nf, walls, panel0, npanel, D, r0, mass, acc, panel_force):
+def wall_repulsion(x, near, walls, panel0, npanel, D, r0, mass, acc, panel_force):
     """Lennard-Jones wall repulsion (marko2017 eq. 7, Monaghan 1994: M = 12, N = 4) as a safety net.
 
-    A liquid particle closer than r0 [cm] to a wall segment gets
+    A liquid particle of ``near`` (int array: the candidates, in order) closer than r0 [cm] to a
+    wall segment (either side) gets
     D ((r0/d)^12 - (r0/d)^4) / d [cm/s^2] along the wall's normal through it
     (D [cm^2/s^2]; mass [N s^2/cm] of a particle).  The force of the wall on the liquid is added to
     panel_force[panel0[w] + k] (N) for the panel k of the wall's npanel[w] equal panels.
     """
     if r0 <= 0.0:
         return
-    for a in range(nf):
+    for e in range(near.shape[0]):
+        a = near[e]
         px = x[a, 0]
         py = x[a, 1]
         for w in range(walls.shape[0]):

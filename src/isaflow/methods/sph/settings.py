@@ -38,8 +38,6 @@ SETTINGS = {
     "repulsion_radius": _NONNEG,  # Lennard-Jones wall repulsion range / cell spacing (0: off)
     "cfl": _POS,                 # dt = cfl h / c0
     "skin": _NONNEG,             # neighbour-list skin / h
-    "rest_speed": _POS,          # cm/s
-    "rest_window": _POS,         # s
     "t_max_single": _POS,        # s
     "t_max_flow": _POS,          # s
     "chunk_time": _POS,          # s

@@ -1,18 +1,25 @@
 """Run WCSPH on a tank: set up, advance the compiled loop in chunks, classify -> contract.Result.
 
-Outcomes: ``converged`` (rms speed below rest_speed for rest_window s),
-``step_limit`` (time limit), ``escaped`` (a particle crossed a wall or left
-the walls' bounding box), ``nonfinite``.  Wall loads are the wall particles'
-forces on the liquid averaged over the last rest_window s, summed over the
-tank's wall panels (core.panels).  Units cm, N, s (core.units).
+Outcomes: ``converged`` (the liquid is at rest by isaflow.rest, the one criterion of every
+dynamic method: e = KE / (W h) below its ratio for its window), ``step_limit`` (the run's
+time limit), ``escaped`` (a particle would cross a wall, or left the walls' bounding box,
+which is open max_drop above the walls' top: a splash may rise over the walls and fall back),
+``nonfinite``.  Wall loads are the wall particles' forces on the liquid averaged over the
+last rest window, spread over the tank's wall panels (core.panels), one set of panels per
+wetted face.  A run continued from a run file (``start``) keeps the chain's clock and step
+count and rebuilds the pair list where the run it continues had built it, so that a split run
+equals a straight one bit for bit.  Units cm, N, s (core.units).
 """
 
 import collections
 import math
+import os
 import time
 
+import numba
 import numpy as np
 
+from ... import rest as R
 from ...contract import Result
 from ...core import smoothing
 from ...core.geometry import bounding_box
@@ -28,7 +35,9 @@ CODES = {K.CROSSED: "escaped", K.LEFT_BOX: "escaped", K.NONFINITE: "nonfinite"}
 def vessels_of(tank):
     """[(name, (xmin, xmax) cm)] of the tank's vessels; one spanning the walls if it names none."""
     w = tank.walls
-    return tank.vessels or [("vessel", (float(w[:, [0, 2]].min()), float(w[:, [0, 2]].max())))]
+    if tank.spec.get("vessels"):
+        return [(v["name"], tuple(float(a) for a in v["x"])) for v in tank.spec["vessels"]]
+    return [("vessel", (float(w[:, [0, 2]].min()), float(w[:, [0, 2]].max())))]
 
 
 def first_vessel(tank):
@@ -71,17 +80,29 @@ def pack(s, h, mass, rho_ref, c0, dt, kind, cell=0.0):
     return par
 
 
+def _start_value(start, name, default):
+    if name in start:
+        return start[name].values
+    return start.attrs.get(name, default)
+
+
 def setup(tank, s, resolution, start=None, on_wall=False):
-    """Initial state: dict of arrays and scalars (see solve).  start: a run Dataset
-    to continue (its pos, velocity, density and lattice cell)."""
+    """Initial state: dict of arrays and scalars (see _run).  start: a run Dataset to continue
+    (its pos, velocity, density, list_pos, acceleration, weight, lattice cell, clock and step count)."""
     x0, x1, floor_y = first_vessel(tank)
     kind = smoothing.kernel_id(s["kernel"])
     c0 = s["sound_speed_factor"] * math.sqrt(2 * G * s["max_drop"])
+    t0, step0, acc = 0.0, 0, None
     if start is not None:
         dx, dy = float(start.attrs["cell_dx"]), float(start.attrs["cell_dy"])
         pos = start["pos"].values.copy()
         vel = start["velocity"].values.copy()
         mass = float(start["weight"].values[0]) / G
+        t0 = float(_start_value(start, "sim_time", 0.0))
+        step0 = int(_start_value(start, "steps", 0))
+        xref = start["list_pos"].values.copy() if "list_pos" in start else pos.copy()
+        acc = start["acceleration"].values.copy() if "acceleration" in start else None
+        depth0 = float(start.attrs.get("initial_depth", tank.depth))
     else:
         nx, ny = P.lattice_shape(x1 - x0, tank.depth, resolution.get("particles"), resolution.get("spacing"))
         pos, (dx, dy) = P.liquid_lattice(x0, floor_y, x1 - x0, tank.depth, nx, ny)
@@ -96,15 +117,36 @@ def setup(tank, s, resolution, start=None, on_wall=False):
         if on_wall:
             k = np.argmin(np.hypot(pos[:, 0] - 0.5 * (x0 + x1), pos[:, 1] - floor_y))
             pos[k, 1] = floor_y
+        xref = pos.copy()
+        depth0 = float(pos[:, 1].max() - floor_y + dy / 2)
     else:
         rho = start["density"].values.copy()
-    wpos, owner = P.wall_particles(tank.walls, dx, dy, 2 * h, origin=(x0, floor_y))
+    two = P.wet_back(tank.walls, vessels_of(tank)) if tank.spec.get("vessels") else None
+    wpos, owner, face = P.wall_particles(tank.walls, dx, dy, 2 * h, origin=(x0, floor_y), two_faced=two)
     dt = min(s["cfl"] * h / c0, 0.25 * math.sqrt(h / G))
-    return dict(pos=pos, vel=vel, rho=rho, wpos=wpos, owner=owner, dx=dx, dy=dy, h=h, c0=c0, dt=dt,
-                mass=mass, rho_ref=rho_ref, kind=kind, par=pack(s, h, mass, rho_ref, c0, dt, kind, math.sqrt(dx * dy)))
+    return dict(pos=pos, vel=vel, rho=rho, xref=xref, wpos=wpos, owner=owner, face=face, dx=dx, dy=dy, h=h, c0=c0,
+                dt=dt, mass=mass, rho_ref=rho_ref, kind=kind, t0=t0, step0=step0, depth0=depth0, acc=acc,
+                par=pack(s, h, mass, rho_ref, c0, dt, kind, math.sqrt(dx * dy)))
 
 
-def warm_up():
+def set_threads(threads):
+    """Use ``threads`` numba threads (1: the serial passes); ValueError beyond numba's pool.
+
+    With more than one thread, OMP_WAIT_POLICY defaults to PASSIVE (unless the caller set it) before
+    numba starts its OpenMP pool: a step has seven parallel regions, and on the shared 2-core machine
+    (load 4-6) the default spin-then-sleep waiting made 2 threads 15-25x slower than 1 (measured
+    2,300-4,500 against 250-270 ns per particle-step at N = 20,000), passive waiting 200 ns."""
+    threads = int(threads)
+    if threads < 1 or threads > numba.config.NUMBA_NUM_THREADS:
+        raise ValueError(f"threads = {threads}: choose 1 to {numba.config.NUMBA_NUM_THREADS} "
+                         "(NUMBA_NUM_THREADS bounds numba's pool)")
+    if threads > 1:
+        os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+        numba.set_num_threads(threads)
+    return threads
+
+
+def warm_up(threads=1):
     """Compile (or load from numba's cache) the kernels so timings exclude it."""
     from ...tank import Tank
 
@@ -114,27 +156,63 @@ def warm_up():
                             "liquid": {"weight": 1.0, "depth": 2.0}}, "")
     for variant in ("summation", "continuity"):
         s = {k: v["value"] for k, v in S.load()["settings"].items()}
-        s.update(density=variant, t_max_single=0.002, chunk_time=0.001)
-        _run(tank, s, {"spacing": 1.0}, None, False, None, lambda *a: None)
+        s.update(density=variant, chunk_time=0.001)
+        _run(tank, s, {"spacing": 1.0}, None, False, 0.002, lambda *a: None, threads)
 
 
 def solve(tank, variant="wcsph", resolution=None, overrides=None, start=None, on_wall=False, t_max=None,
-          settings_path=S.DEFAULT_PATH, log=print):
+          settings_path=S.DEFAULT_PATH, log=print, threads=1):
     """Run SPH on a scene.Tank; returns contract.Result.
 
     resolution: {"particles": N} or {"spacing": cm} (ignored with start);
     overrides: {setting: value}; start: run Dataset to continue (the flow starts
-    from the single vessel at rest); on_wall: put the liquid particle nearest
-    the floor's middle on the floor; t_max: time limit s (default t_max_single
-    or t_max_flow from the settings, by whether the tank has vessels).
+    from the single vessel at rest; a continuation keeps the chain's clock and
+    steps); on_wall: put the liquid particle nearest the floor's middle on the
+    floor; t_max: time limit of this run, s simulated from its start (default
+    t_max_single or t_max_flow from the settings, by whether the tank has
+    vessels); threads: numba threads of the pair passes (results do not depend
+    on it; recorded in params['threads']).
     """
     s = S.resolve(S.load(settings_path), variant, overrides)
-    res = _run(tank, s, resolution or {"particles": 180}, start, on_wall, t_max, log)
+    res = _run(tank, s, resolution or {"particles": 180}, start, on_wall, t_max, log, set_threads(threads))
     res.variant = variant
     return res
 
 
-def _run(tank, s, resolution, start, on_wall, t_max, log):
+def start_dataset(res):
+    """The part of a run file a continuation reads (setup), from a Result: pos, velocity, density,
+    list_pos, acceleration, weight, sim_time, steps and the lattice cell (xarray Dataset)."""
+    import xarray as xr
+
+    f = res.fields
+    return xr.Dataset({"pos": (("particle", "xy"), res.pos), "velocity": f["velocity"][:2],
+                       "density": f["density"][:2], "list_pos": f["list_pos"][:2],
+                       "acceleration": f["acceleration"][:2],
+                       "weight": (("particle",), res.weight), "sim_time": ((), res.sim_time),
+                       "steps": ((), res.steps)},
+                      attrs={k: res.params[k] for k in ("cell_dx", "cell_dy", "initial_depth")})
+
+
+def _panels(walls, length, owner, face, wpos, force, dx, dy):
+    """Contacts of the wall-particle forces: per face, spread over the panels (face 1: the back of a
+    thin wall, its loaded panels only).  Returns (wall, point, force, side) with side 0 front (liquid
+    side), 1 back."""
+    out = [], [], [], []
+    for f in (0, 1):
+        on = face == f
+        if f == 1 and not on.any():
+            continue
+        cw, cpt, cf = P.wall_contacts(walls, wpos[on], owner[on], force[on])
+        pw, pc, pf = P.spread_to_panels(walls, length, cw, cpt, cf, dx, dy)
+        if f == 1:  # only the loaded back-face panels (a dry back face adds no contacts)
+            keep = np.isin(pw, np.unique(owner[on])) & (np.abs(pf).sum(1) > 0)
+            pw, pc, pf = pw[keep], pc[keep], pf[keep]
+        for lst, arr in zip(out, (pw, pc, pf, np.full(len(pw), f))):
+            lst.append(arr)
+    return tuple(np.concatenate(a) for a in out)
+
+
+def _run(tank, s, resolution, start, on_wall, t_max, log, threads=1):
     st = setup(tank, s, resolution, start, on_wall)
     nf, nw = len(st["pos"]), len(st["wpos"])
     x = np.concatenate([st["pos"], st["wpos"]])
@@ -142,105 +220,148 @@ def _run(tank, s, resolution, start, on_wall, t_max, log):
     rho = np.concatenate([st["rho"], np.full(nw, st["rho_ref"])])
     p = np.zeros(nf + nw)
     walls = tank.walls
-    box = bounding_box(walls)
-    lo, hi = x.min(0) - 2 * st["h"], x.max(0) + 2 * st["h"]
-    grid_box = np.array([min(lo[0], box[0]), min(lo[1], box[1]), max(hi[0], box[2]), max(hi[1], box[3])])
-    pi, pj, m = K.list_pairs(x, nf, grid_box, 2 * st["h"] + par[K.SKIN])
-    wk, fk = np.empty(len(pi)), np.empty(len(pi))
+    # the vessels are open at the top: a splash may rise above the walls and fall back in, by at most the
+    # largest free fall max_drop (a particle faster than sqrt(2 g max_drop) breaks the Mach 0.1 design)
+    wall_box = bounding_box(walls)
+    box = wall_box + [0.0, 0.0, 0.0, s["max_drop"]]
+    rc = 2 * st["h"] + par[K.SKIN]
+    # the cell grid depends on the tank and the lattice only, so a continuation builds the same lists
+    lo, hi = np.minimum(wall_box[:2], st["wpos"].min(0)) - rc, np.maximum(wall_box[2:], st["wpos"].max(0)) + rc
+    grid_box = np.array([lo[0], lo[1], hi[0], hi[1]])
+    xref = st["xref"]
+    lst = K.list_pairs(np.concatenate([xref, st["wpos"]]), nf, grid_box, rc, walls, K.reach_of(par))
+    wk, fk = np.empty(len(lst[0])), np.empty(len(lst[0]))
     acc = np.zeros((nf, 2))
-    wall_force, wsum, force_sum = np.zeros((nw, 2)), np.zeros((nw, 3)), np.zeros((nw, 2))
-    K.evaluate(x, v, rho, p, nf, pi, pj, m, wk, fk, par, acc, wall_force, wsum)
-    xref, diag = x[:nf].copy(), np.zeros(4)
+    wall_force, force_sum = np.zeros((nw, 2)), np.zeros((nw, 2))
     pw, pc, _, _ = wall_panels(walls, s["panel_length"])
     npanel = np.bincount(pw, minlength=len(walls)).astype(np.int64)
     panel0 = np.concatenate([[0], np.cumsum(npanel)[:-1]]).astype(np.int64)
     panel_sum = np.zeros((len(pw), 2))
-    lj_window = collections.deque()
+    K.evaluate(x, v, rho, p, nf, walls, par, lst, wk, fk, acc, wall_force, panel0, npanel, panel_sum, threads)
+    if st["acc"] is not None:  # the viscosity took the half-step velocities: the run's own accelerations
+        acc[:] = st["acc"]
+    diag = np.zeros(4)
     flow = len(tank.spec.get("vessels", [])) > 1
     t_max = t_max or (s["t_max_flow"] if flow else s["t_max_single"])
     dt = st["dt"]
+    n_total = max(1, int(round(t_max / dt)))
     n_chunk = max(1, int(round(s["chunk_time"] / dt)))
-    window = collections.deque(maxlen=max(1, int(math.ceil(s["rest_window"] / (n_chunk * dt)))))
+    rest_cfg = R.load()
+    monitor = R.Monitor(rest_cfg["energy_ratio"], rest_cfg["window"])
+    held = st["mass"] * G * nf
+    n_window = max(1, int(math.ceil(rest_cfg["window"] / (n_chunk * dt))))
+    window, lj_window = collections.deque(maxlen=n_window), collections.deque(maxlen=n_window)
     vessels = vessels_of(tank)
     rec = collections.defaultdict(list)
     snaps = sorted(s["snapshot_times"])
-    steps, t, rest, status, message = 0, 0.0, 0.0, None, ""
+    t0, step0 = st["t0"], st["step0"]
+    done_total, builds, status, message = 0, 0, None, ""
+    ke = 0.5 * st["mass"] * float(np.sum(v * v))
     started = last_log = time.perf_counter()
     while status is None:
-        while snaps and snaps[0] <= t + 0.5 * dt:
+        t = t0 + done_total * dt
+        while snaps and snaps[0] <= done_total * dt + 0.5 * dt:
             rec["snap_time"].append(t)
             rec["snap_pos"].append(x[:nf].copy())
             snaps.pop(0)
-        n = min(n_chunk, max(1, int(round((t_max - t) / dt))))
+        n = min(n_chunk, n_total - done_total)
         force_sum[:] = 0.0
         panel_sum[:] = 0.0
-        code, done, pi, pj, m, wk, fk = K.advance(x, v, rho, p, nf, walls, box, grid_box, par, n, xref, pi, pj, m,
-                                                   wk, fk, acc, wall_force, wsum, force_sum, panel0, npanel,
-                                                   panel_sum, diag)
-        steps += done
-        t += done * dt
+        code, done, lst, wk, fk = K.advance(x, v, rho, p, nf, walls, box, grid_box, par, n, xref, lst, wk, fk, acc,
+                                            wall_force, force_sum, panel0, npanel, panel_sum, diag, threads)
+        done_total += done
+        builds += int(diag[2])
+        t = t0 + done_total * dt
         if done:
             window.append(force_sum / done)
             lj_window.append(panel_sum / done)
-            while len(lj_window) > window.maxlen:
-                lj_window.popleft()
-        rest = rest + done * dt if diag[0] < s["rest_speed"] else 0.0
+            ke = diag[1]
+        at_rest = monitor.update(t, R.energy_ratio(ke, held, st["depth0"]))
         rec["sample_time"].append(t)
         rec["sample_vrms"].append(diag[0])
-        rec["sample_kinetic"].append(diag[1])
+        rec["sample_kinetic"].append(ke)
         per_wall = np.zeros((len(walls), 2))
         np.add.at(per_wall, st["owner"], window[-1] if window else 0.0)
         rec["sample_wall_resultant"].append(per_wall)
         rec["sample_vessel_weight"].append([st["mass"] * G * np.count_nonzero((x[:nf, 0] >= a) & (x[:nf, 0] < b))
                                             for _, (a, b) in vessels])
+        steps = step0 + done_total
+        rms = math.sqrt(2 * ke / (st["mass"] * nf))
         if code != K.OK:
             status = CODES[code]
-            what = {K.CROSSED: "crossed a wall", K.LEFT_BOX: "left the walls' bounding box",
+            what = {K.CROSSED: "would cross a wall", K.LEFT_BOX: "left the walls' bounding box (open max_drop above)",
                     K.NONFINITE: "became non-finite"}[code]
             k = int(diag[3])
-            message = f"particle {k}, at ({x[k, 0]:.4g}, {x[k, 1]:.4g}) cm before the step, {what} at step {steps} (t = {t:.4g} s)"
-        elif rest >= s["rest_window"] - 0.5 * dt:
+            message = f"particle {k}, at ({x[k, 0]:.4g}, {x[k, 1]:.4g}) cm, {what} at step {steps} (t = {t:.4g} s)"
+        elif at_rest:
             status = "converged"
-            message = (f"at rest: rms speed < {s['rest_speed']:g} cm/s for {s['rest_window']:g} s "
-                       f"at t = {t:.4g} s (step {steps})")
-        elif t >= t_max - 0.5 * dt:
+            message = (f"at rest: e = KE / (W h) < {rest_cfg['energy_ratio']:g} for {rest_cfg['window']:g} s from "
+                       f"t = {monitor.time_to_rest():.4g} s, reached at t = {t:.4g} s (step {steps}); rms speed "
+                       f"{rms:.3g} cm/s")
+        elif done_total >= n_total:
             status = "step_limit"
-            message = f"time limit {t_max:g} s reached at step {steps}, rms speed {diag[0]:.3g} cm/s"
+            message = (f"time limit {t_max:g} s reached at t = {t:.4g} s (step {steps}), not at rest: e = "
+                       f"{monitor.last:.3g}, rms speed {rms:.3g} cm/s")
         now = time.perf_counter()
         if now - last_log > 30.0:
-            log(f"sph: t = {t:.3f} s / {t_max:g} s, step {steps}, rms speed {diag[0]:.3g} cm/s, "
-                f"{nf} particles, {(now - started) / max(steps, 1) / nf * 1e9:.0f} ns/particle-step")
+            log(f"sph: t = {t:.3f} s ({done_total * dt:.3f} / {t_max:g} s of this run), step {steps}, rms speed "
+                f"{rms:.3g} cm/s, {nf} particles, {(now - started) / max(done_total, 1) / nf * 1e9:.0f} ns/particle-step")
             last_log = now
     wall_time = time.perf_counter() - started
     mean_force = np.mean(np.array(window), axis=0) if window else np.zeros((nw, 2))
-    cw, cpt, cf = P.wall_contacts(walls, st["wpos"], st["owner"], mean_force)
-    pw, pc, pf = P.spread_to_panels(walls, s["panel_length"], cw, cpt, cf, st["dx"], st["dy"])
-    if lj_window:
-        pf = pf + np.mean(np.array(lj_window), axis=0)
+    cw, cp, cf, side = _panels(walls, s["panel_length"], st["owner"], st["face"], st["wpos"], mean_force,
+                               st["dx"], st["dy"])
+    if lj_window:  # the safety net's panel forces, with the front faces' panels
+        front = np.flatnonzero(side == 0)
+        cf[front] += np.mean(np.array(lj_window), axis=0)
+    x0, x1, floor_y = first_vessel(tank)
+    left = int(np.count_nonzero((x[:nf, 0] >= x0) & (x[:nf, 0] < x1)))
     history = {
-        "sample_time": (("sample",), np.array(rec["sample_time"]), "s", "time at the end of the diagnostic chunk"),
+        "sample_time": (("sample",), np.array(rec["sample_time"]), "s", "chain time at the end of the diagnostic chunk"),
         "sample_vrms": (("sample",), np.array(rec["sample_vrms"]), VELOCITY, "largest rms liquid speed in the chunk"),
         "sample_kinetic": (("sample",), np.array(rec["sample_kinetic"]), "N cm", "kinetic energy at the chunk's end"),
         "sample_wall_resultant": (("sample", "wall", "xy"), np.array(rec["sample_wall_resultant"]), "N",
-                                  f"force of each wall on the liquid, mean over the last {s['rest_window']:g} s"),
+                                  "force of each wall on the liquid, mean over the chunk"),
         "sample_vessel_weight": (("sample", "vessel"), np.array(rec["sample_vessel_weight"]), "N",
                                  "weight of the liquid in each vessel"),
-        "snap_time": (("snapshot",), np.array(rec["snap_time"]), "s", "time of the position snapshot"),
-        "snap_pos": (("snapshot", "particle", "xy"), np.array(rec["snap_pos"]), "cm", "liquid particle positions"),
+        "snap_time": (("snapshot",), np.array(rec["snap_time"]), "s", "chain time of the position snapshot"),
+        "snap_pos": (("snapshot", "particle", "xy"), np.array(rec["snap_pos"]).reshape(-1, nf, 2), "cm",
+                     "liquid particle positions"),
+        "contact_side": (("contact",), side.astype(np.int8), "1",
+                         "wall face of the panel: 0 its front (left, liquid side), 1 its back (thin dividing wall)"),
     }
     fields = {
         "pressure": (("particle",), p[:nf].copy(), "N cm-2", "particle pressure (equation of state)"),
         "density": (("particle",), rho[:nf].copy(), DENSITY_2D, "particle density"),
         "velocity": (("particle", "xy"), v.copy(), VELOCITY, "particle velocity"),
+        "list_pos": (("particle", "xy"), xref.copy(), "cm",
+                     "positions at the last pair-list build (a continuation rebuilds the list there)"),
+        "acceleration": (("particle", "xy"), acc.copy(), "cm s-2",
+                         "acceleration at the end (its viscosity took the half-step velocities; a continuation "
+                         "starts from it)"),
     }
     params = {f"sph_{k}": (str(v_) if isinstance(v_, (bool, list)) else v_) for k, v_ in s.items()}
-    params.update(liquid_depth=tank.depth, first_vessel_width=float(np.diff(first_vessel(tank)[:2])[0]), cell_dx=st["dx"], cell_dy=st["dy"], smoothing_length=st["h"], sound_speed=st["c0"], dt=dt,
-                  particle_mass=st["mass"], rho_ref=st["rho_ref"], wall_particles=nw, t_max=t_max,
-                  panel_length=s["panel_length"], load_window=len(window) * n_chunk * dt,
-                  resolution=str(resolution) if start is None else "continued", on_wall=str(bool(on_wall)))
+    initial_depth = st["depth0"]
+    diff = [f"weakly compressible: the column holds {held:g} N compressed to its hydrostatic density, its "
+            f"surface {initial_depth:.4g} cm (tank {tank.depth:g} cm)"] if start is None else [
+            f"continues a run whose initial depth was {initial_depth:.4g} cm (tank {tank.depth:g} cm)"]
+    if abs(held - tank.weight) > 1e-9 * tank.weight:
+        diff.append(f"weight held {held:g} N (tank {tank.weight:g} N)")
+    params.update(
+        liquid_depth=tank.depth, first_vessel_width=float(x1 - x0), cell_dx=st["dx"], cell_dy=st["dy"],
+        smoothing_length=st["h"], sound_speed=st["c0"], dt=dt, particle_mass=st["mass"], rho_ref=st["rho_ref"],
+        wall_particles=nw, two_faced_walls=", ".join(n for n, f in zip(tank.wall_names, P.wet_back(walls, vessels))
+                                                     if f and flow) or "none",
+        t_max=t_max, panel_length=s["panel_length"], load_window=len(window) * n_chunk * dt,
+        resolution=str(resolution) if start is None else "continued", on_wall=str(bool(on_wall)),
+        threads=int(threads), layer_pitch=st["dy"], held_weight=held, initial_depth=initial_depth,
+        tank_difference="; ".join(diff), rest_energy_ratio=rest_cfg["energy_ratio"], rest_window=rest_cfg["window"],
+        time_to_rest=monitor.time_to_rest() if status == "converged" else math.nan, start_time=t0,
+        final_energy_ratio=monitor.last, final_rms_speed=math.sqrt(2 * ke / (st["mass"] * nf)),
+        particles_left=left, list_builds=builds)
     return Result(
         method="sph", variant="custom", pos0=st["pos"], pos=x[:nf].copy(), weight=np.full(nf, st["mass"] * G),
-        contact_wall=pw, contact_point=pc, contact_force=pf, status=status, message=message,
-        steps=steps, start_step=0, wall_time=wall_time, force_evals=steps + 1,
-        residual=float(diag[0]), residual_name="rms speed", residual_units=VELOCITY, sim_time=t,
-        history=history, fields=fields, params=params)
+        contact_wall=cw, contact_point=cp, contact_force=cf, status=status, message=message,
+        steps=step0 + done_total, start_step=step0, wall_time=wall_time, force_evals=done_total + 1,
+        residual=math.sqrt(2 * ke / (st["mass"] * nf)), residual_name="rms speed", residual_units=VELOCITY,
+        sim_time=t0 + done_total * dt, history=history, fields=fields, params=params)
