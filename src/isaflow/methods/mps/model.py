@@ -20,7 +20,7 @@ from .operators import (DIM, DUMMY, FLUID, GRADIENTS, JIT, PAR, WALL, distances,
 # source terms of the pressure equation (settings name -> id)
 SOURCES = {"standard": 0, "hattori": 1, "mixed": 2}
 # free-surface pressure conditions (settings name -> id)
-SURFACE = {"zero": 0, "hydrostatic": 1}
+SURFACE = {"zero": 0, "hydrostatic": 1, "extrapolated": 2}
 
 
 @njit(**JIT)
@@ -126,6 +126,46 @@ def surface(pos, kind, start, nbr, dist, re_s, n0_s, beta, dist_thr, rc):
             normal[i, 0] = -sw[i, 0] / L
             normal[i, 1] = -sw[i, 1] / L
     return surf, normal
+
+
+@njit(**PAR)
+def surface_values(pos, p_prev, kind, surf, normal, start, nbr, dist, re, n0, delta):
+    """(N,) Dirichlet pressure [N/cm^2] of the free-surface particles: P = 0 at the free surface, delta [cm]
+    outside the particle along its normal, extrapolated linearly to the particle with the normal pressure
+    gradient of the previous step's pressures p_prev: P_i = delta max(0, -n_i . grad P_i).  The gradient is
+    the consistent one, sum (p_j - p_i) with the corrective matrix (Khayyer & Gotoh 2011), over fluid and
+    wall neighbours within re (exact for linear pressure on any arrangement); 0 where it is near singular."""
+    n = pos.shape[0]
+    out = np.zeros(n)
+    a = DIM / n0
+    for i in prange(n):
+        if not surf[i]:
+            continue
+        gx = gy = mxx = mxy = myy = 0.0
+        for k in range(start[i], start[i + 1]):
+            j = nbr[k]
+            if kind[j] == DUMMY:
+                continue
+            wt = weight(dist[k], re)
+            if wt == 0.0:
+                continue
+            dx = pos[j, 0] - pos[i, 0]
+            dy = pos[j, 1] - pos[i, 1]
+            r2 = dist[k] * dist[k]
+            q = (p_prev[j] - p_prev[i]) / r2 * wt
+            gx += q * dx
+            gy += q * dy
+            mxx += dx * dx / r2 * wt
+            mxy += dx * dy / r2 * wt
+            myy += dy * dy / r2 * wt
+        mxx *= a
+        mxy *= a
+        myy *= a
+        det = mxx * myy - mxy * mxy
+        if det > 0.01:
+            gx, gy = a * (myy * gx - mxy * gy) / det, a * (mxx * gy - mxy * gx) / det
+            out[i] = delta * max(0.0, -(normal[i, 0] * gx + normal[i, 1] * gy))
+    return out
 
 
 @njit(**JIT)

@@ -151,6 +151,8 @@ def step(s, dt, source, cfg, timers=None):
     p_dir = np.zeros(len(ps))
     if s.surface_mode == 1:
         p_dir[surf] = s.rho0 * units.G * 0.5 * s.l0 * np.maximum(normal[surf, 1], 0.0)
+    elif s.surface_mode == 2:
+        p_dir = model.surface_values(ps, s.p, s.kind, surf, normal, s.start, s.nbr, dist, s.re_g, s.n0_g, 0.5 * s.l0)
     sound = cfg["model.sound_speed"]
     extra = s.lam * s.n0_l / (2.0 * model.DIM * sound**2 * dt**2) if sound > 0 else 0.0
     row, indptr, indices, data, rhs = model.assemble(s.kind, surf, p_dir, b, s.start, s.nbr, dist, s.re_l, s.n0_l,
