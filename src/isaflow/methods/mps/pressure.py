@@ -29,7 +29,9 @@ def csr(indptr, indices, data):
     return A
 
 
-PAR_MIN = 4096  # rows from which the solve runs its loops in parallel when numba has more than one thread
+PAR_MIN = 50000  # rows from which the solve runs its loops in parallel when numba has more than one thread (below it
+# the per-iteration thread synchronisations cost more than they save: 2 threads made the 5,000-particle solve
+# 1.6x slower on the shared 2-core machine, 42 against 26 ms)
 
 
 @njit(cache=True, nogil=True)

@@ -7,7 +7,13 @@ Rest: isaflow.rest (one criterion for every dynamic method).  Units: cm, N, s; p
 (2D, per cm of thickness).
 """
 
+import os
 import time
+
+# numba's OpenMP threads spin while waiting by default; on a shared (oversubscribed) machine that made every
+# parallel loop of a 2-thread run wait for a scheduler time slice (11.7 ms per loop instead of 11 us).  Passive
+# waiting is set before numba starts its threads (the first parallel loop), unless the environment says otherwise.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
 import numba
 import numpy as np
@@ -265,7 +271,12 @@ def _solve(tank, cfg, variant, l0, t_end, probes, start, snapshots, log, threads
             status, message = ("escaped", f"step {step0 + k}: particle {bad[1]} crossed wall '{tank.wall_names[bad[2]]}' "
                                           f"(more than {s.graze_depth:.3g} cm past it)")
         elif bad[0] == 3:
-            status, message = "escaped", f"step {step0 + k}: particle {bad[1]} left the walls' bounding box by more than {s.graze_depth:.3g} cm"
+            x, y = s.pos[bad[1]]
+            vx, vy = s.vel[bad[1]]
+            where = "over the top" if y > s.escape_box[3] + s.graze_depth else "through a side or the bottom"
+            status, message = "escaped", (f"step {step0 + k}: particle {bad[1]} left the walls' bounding box by more than "
+                                          f"{s.graze_depth:.3g} cm ({where}: at ({x:.1f}, {y:.1f}) cm, velocity "
+                                          f"({vx:.0f}, {vy:.0f}) cm/s)")
         elif bad[0] == 4 or not resid <= fail_tol:
             status, message = "solver_failed", (f"step {step0 + k}: pressure solve residual {resid:.3g} > {fail_tol:.3g} "
                                                 f"after {its} iterations {s.solve_error}").strip()
