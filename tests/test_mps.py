@@ -22,7 +22,6 @@ CFG = ROOT / "config" / "methods" / "mps.yaml"
 COARSE = 100.0 / 18.0  # cm: the coarse spacing of the settings (runs.single_spacings)
 FINE = 100.0 / 29.0
 VARIANTS = ("standard", "hattori", "mixed")
-NO_THIN = (np.zeros(0, np.int64), np.zeros((0, 4)))
 
 
 def lattice(n=21, l0=1.0):

@@ -366,7 +366,3 @@ def probe_pressure(pos, p, kind, probes, re):
             out[k] = sp / sw
     return out
 
-
-def no_thin():
-    """Arguments (tw, tside, thin) for particles without thin walls, for n particles via tw[:n]."""
-    return np.zeros((0, 4))
