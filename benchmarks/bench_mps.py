@@ -1,21 +1,25 @@
-"""MPS cost per step against N: predict (numba: explicit step, neighbour lists, number density, CSR assembly),
-pressure solve (amg, cg_jacobi, direct) and correct (numba: gradient, update), each timed separately.
+"""MPS cost per step against N: predict (numba: neighbour lists, explicit step, collision, number density,
+free surface, source term, CSR assembly), pressure solve and correct (numba: gradient, update, wall check),
+each timed separately, for the pressure solvers (cg_jacobi: compiled, bit-identical for any thread count;
+scipy_cg, amg, direct) and for 1 and 2 numba threads (cg_jacobi).
 
 A liquid block at rest in the single tank with a spacing giving about N liquid particles (a whole number of
-columns, so the lattice is square and starts at n = n0); 20 steps after 2 warm-up steps, median per step.  Writes benchmarks/results/mps_step_cost.csv.  Run: python benchmarks/bench_mps.py [--quick]
+columns, so the lattice is square and starts at n = n0); 30 warm-up steps (the lattice starts to disorder,
+the CG is warm-started from the previous step's pressures as in the runs), then the median of 20 steps.
+Writes benchmarks/results/mps_step_cost.csv.  Run: python benchmarks/bench_mps.py [--quick]
 
-One core, as the step-cost target: BLAS (the CG's dot products), OpenMP and numba get one thread unless the
-environment says otherwise (on the shared 2-core machine a threaded OpenBLAS made the CG solve at 20,000
-particles slower, ~150 against ~95 ms per step in one check, and changes its round-off).
+BLAS and OpenMP get one thread unless the environment says otherwise (scipy_cg's dot products; a threaded
+OpenBLAS was slower on the shared 2-core machine and changes round-off); numba's threads are set per row.
 """
 
 import os
 import sys
 from pathlib import Path
 
-for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "NUMBA_NUM_THREADS"):
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
+import numba  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
@@ -24,7 +28,7 @@ from isaflow.scene import load_tank  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 SIZES = (180, 720, 2000, 5000, 20000)
-SOLVERS = ("amg", "cg_jacobi", "direct")
+RUNS = (("cg_jacobi", 1), ("cg_jacobi", 2), ("scipy_cg", 1), ("amg", 1), ("direct", 1))
 
 
 def main(quick=False):
@@ -32,24 +36,29 @@ def main(quick=False):
     rows = []
     for n in SIZES[:3] if quick else SIZES:
         l0 = 100.0 / round(np.sqrt(n * 100.0 / 72.5))  # whole columns: the lattice is square (dx = l0)
-        for method in SOLVERS:
+        for method, threads in RUNS:
             if method == "direct" and n > 5000:
                 continue
+            if threads > numba.config.NUMBA_NUM_THREADS:
+                continue
+            numba.set_num_threads(threads)
             cfg = settings.load(ROOT / "config/methods/mps.yaml").with_overrides(**{"pressure.solver": method})
             xr, floor = solver.first_vessel(tank)
             fluid = boundary.liquid_block(xr, floor, tank.depth, l0)
             s = solver.State(tank, cfg, l0, fluid, np.zeros_like(fluid))
             dt = solver.time_step(tank, l0, cfg["time.courant"])
-            for _ in range(2):
+            for _ in range(30):
                 solver.step(s, dt, "standard", cfg)
-            per = []
+            per, its = [], []
             for _ in range(20):
                 t = np.zeros(3)
-                solver.step(s, dt, "standard", cfg, t)
+                _, _, it = solver.step(s, dt, "standard", cfg, t)
                 per.append(t)
+                its.append(it)
             per = np.median(np.array(per), axis=0) * 1e3
-            rows.append(dict(liquid_particles=s.nf, all_particles=len(s.pos), solver=method, predict_ms=per[0],
-                             solve_ms=per[1], correct_ms=per[2], step_ms=per.sum()))
+            rows.append(dict(liquid_particles=s.nf, all_particles=len(s.pos), solver=method, threads=threads,
+                             predict_ms=per[0], solve_ms=per[1], correct_ms=per[2], step_ms=per.sum(),
+                             solve_iterations=float(np.median(its))))
             print(rows[-1], flush=True)
     out = ROOT / "benchmarks/results" / ("mps_step_cost_quick.csv" if quick else "mps_step_cost.csv")
     pd.DataFrame(rows).to_csv(out, index=False, float_format="%.4g")

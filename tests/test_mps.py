@@ -1,21 +1,28 @@
-"""MPS (isaflow.methods.mps): operators, the eq. (1)-(5) identity, the pressure equation, source terms, settings.
+"""MPS (isaflow.methods.mps): operators, the eq. (1)-(5) identity, the pressure equation, source terms, walls
+(both faces of thin walls, the drop test at the flow's impact speed), the hydrostatic side load, rest, threads,
+continuations, settings.
 
-Coarse cases only (l0 = 5 cm in the 100 cm tank, under 0.3 s of physical time).
+Coarse cases only (l0 = 100/18 cm = 5.56 cm in the 100 cm tank unless a test says otherwise).
 """
 
+import numba
 import numpy as np
 import pytest
 
 from isaflow import runfile
 from isaflow.core import units
 from isaflow.methods import registry
-from isaflow.methods.mps import boundary, model, pressure, settings, solver
+from isaflow.methods.mps import boundary, model, operators, pressure, settings, solver
 from isaflow.inputs import InputError as SceneError
 from isaflow.tank import load as load_tank
 
 ROOT = __import__("pathlib").Path(__file__).resolve().parents[1]
 TANK = ROOT / "config" / "tanks" / "single.yaml"
+FLOWS = [ROOT / "config" / "tanks" / f"{t}.yaml" for t in ("flow_step50", "flow_samefloor")]
 CFG = ROOT / "config" / "methods" / "mps.yaml"
+COARSE = 100.0 / 18.0  # cm: the coarse spacing of the settings (runs.single_spacings)
+FINE = 100.0 / 29.0
+VARIANTS = ("standard", "hattori", "mixed")
 
 
 def lattice(n=21, l0=1.0):
@@ -24,9 +31,13 @@ def lattice(n=21, l0=1.0):
     return np.column_stack([X.ravel(), Y.ravel()])
 
 
-def pairs(pos, rc):
+def lists(pos, rc, kind=None):
+    """Full neighbour lists and distances of free particles (no walls)."""
+    kind = np.zeros(len(pos), np.int64) if kind is None else kind
     box = np.array([pos[:, 0].min() - 1, pos[:, 1].min() - 1, pos[:, 0].max() + 1, pos[:, 1].max() + 1])
-    return model.build_pairs(pos, box, rc)
+    start, nbr = model.neighbour_list(pos, kind, box, rc, np.full(len(pos), -1, np.int64), np.ones(len(pos), np.int64),
+                                      np.zeros((0, 4)))
+    return start, nbr, model.distances(pos, start, nbr)
 
 
 def interior(pos, margin):
@@ -40,8 +51,8 @@ def test_number_density_and_lambda_of_the_lattice():
     """n of an interior lattice particle is n0 exactly; lambda is the weighted mean of r^2 (K&O 1996)."""
     pos = lattice(l0=2.0)
     n0, lam = model.lattice_constants(2.1, 2.0)
-    pi, pj, m = pairs(pos, 4.2)
-    n = model.number_density(pos, pi, pj, m, 4.2)
+    start, nbr, dist = lists(pos, 4.2)
+    n = model.number_density(start, nbr, dist, 4.2)
     inner = interior(pos, 6.0)
     assert np.allclose(n[inner], n0, rtol=1e-12)
     # r_e = 2.1 l0: 4 neighbours at l0, 4 at sqrt(2) l0, 4 at 2 l0
@@ -57,30 +68,55 @@ def test_laplacian_exact_for_quadratics_on_the_lattice(re):
     l0 = 1.5
     pos = lattice(l0=l0)
     n0, lam = model.lattice_constants(re, l0)
-    pi, pj, m = pairs(pos, re * l0)
+    start, nbr, dist = lists(pos, re * l0)
     kind = np.zeros(len(pos), np.int64)
     f = (pos[:, 0] ** 2 + 3 * pos[:, 1] ** 2)[:, None] + 5.0
-    lap = model.laplacian(pos, f, kind, pi, pj, m, re * l0, n0, lam)[:, 0]
+    lap = model.laplacian(f, kind, start, nbr, dist, re * l0, n0, lam)[:, 0]
     inner = interior(pos, re * l0)
     assert np.allclose(lap[inner], 8.0, rtol=1e-10)
 
 
-def test_gradient_and_divergence_exact_for_linear_fields():
-    """Gradient of 2 x - 3 y + 1 is (2, -3) and the divergence of (2 x, -5 y) is -3 away from the edge:
-    sum r r^T / r^2 w = n0 / d I on the square lattice (tolerance: round-off)."""
+@pytest.mark.parametrize("mode", sorted(operators.GRADIENTS))
+def test_gradient_and_divergence_exact_for_linear_fields(mode):
+    """Gradient of 2 x - 3 y + 101 is (2, -3) and the divergence of (2 x, -5 y) is -3 away from the edge:
+    sum r r^T / r^2 w = n0 / d I and sum r / r^2 w = 0 on the square lattice (tolerance: round-off)."""
     l0 = 2.0
     pos = lattice(l0=l0)
     n0, _ = model.lattice_constants(2.1, l0)
-    pi, pj, m = pairs(pos, 2.1 * l0)
+    start, nbr, dist = lists(pos, 2.1 * l0)
     kind = np.zeros(len(pos), np.int64)
     p = 2 * pos[:, 0] - 3 * pos[:, 1] + 1 + 100.0
-    g = model.gradient(pos, p, kind, pi, pj, m, 2.1 * l0, n0)
+    g = model.gradient(pos, p, kind, start, nbr, dist, 2.1 * l0, n0, operators.GRADIENTS[mode])
     inner = interior(pos, 2.1 * l0)
-    # p^_i = min over neighbours shifts every term by (p_i - p^_i) sum r/r^2 w = 0 in the interior
     assert np.allclose(g[inner], [2.0, -3.0], rtol=1e-10)
     vel = np.column_stack([2 * pos[:, 0], -5 * pos[:, 1]])
-    div = model.divergence(pos, vel, pi, pj, m, 2.1 * l0, n0)
+    div = model.divergence(pos, vel, start, nbr, dist, 2.1 * l0, n0)
     assert np.allclose(div[inner], -3.0, rtol=1e-10)
+
+
+def test_corrected_gradient_exact_at_the_free_edge_and_on_disorder():
+    """The corrective matrix C_i (Khayyer & Gotoh 2011) makes the gradient of a linear pressure exact where the
+    neighbourhood is one-sided: at the top row of a lattice under p = 100 - 3 y (p^_i = p_i there) the corrected
+    gradient is -3 to round-off, K&O's plain sum gives about half (-1.5 +- 0.3).  The surface extrapolation's
+    consistent form (p_j - p_i with C_i, model.surface_values) is exact on a disordered arrangement: with normal
+    (0, 1) and delta 1 cm it returns -dp/dy = 3 at every particle (round-off)."""
+    pos = lattice(n=15)
+    n0, _ = model.lattice_constants(2.1)
+    start, nbr, dist = lists(pos, 2.1)
+    kind = np.zeros(len(pos), np.int64)
+    p = 100.0 - 3 * pos[:, 1]
+    top = (pos[:, 1] == pos[:, 1].max()) & (np.abs(pos[:, 0]) < pos[:, 0].max() - 2.5)
+    gc = model.gradient(pos, p, kind, start, nbr, dist, 2.1, n0, operators.GRADIENTS["corrected"])
+    g0 = model.gradient(pos, p, kind, start, nbr, dist, 2.1, n0, operators.GRADIENTS["min"])
+    assert np.allclose(gc[top], [0.0, -3.0], atol=1e-12)
+    assert np.all(np.abs(g0[top, 1] + 1.5) < 0.3)
+    rng = np.random.default_rng(3)
+    pos = pos + rng.uniform(-0.2, 0.2, pos.shape)
+    start, nbr, dist = lists(pos, 2.1)
+    p = 2 * pos[:, 0] - 3 * pos[:, 1] + 100.0
+    normal = np.tile([0.0, 1.0], (len(pos), 1))
+    out = model.surface_values(pos, p, kind, np.ones(len(pos), np.bool_), normal, start, nbr, dist, 2.1, n0, 1.0)
+    assert np.allclose(out, 3.0, rtol=1e-10)
 
 
 # --- the seed's checkable statement ---------------------------------------------
@@ -91,26 +127,31 @@ def manual_step(l0=5.0, seed=0, dt=1e-3, nu=7.0):
 
     nu = 7 cm^2/s: a viscosity large enough that the viscous term shows in the balance."""
     tank = load_tank(TANK)
-    cfg = settings.load(CFG)
+    cfg = settings.load(CFG).with_overrides(**{"model.collision_distance": 0.0})
     rng = np.random.default_rng(seed)
     fluid = boundary.liquid_block((0.0, 100.0), 0.0, 50.0, l0)
     fluid = fluid + rng.normal(0, 0.05 * l0, fluid.shape)
     s = solver.State(tank, cfg, l0, fluid, rng.normal(0, 5.0, fluid.shape))
+    s.neighbours(s.pos)
     pos_n, vel_n = s.pos.copy(), s.vel.copy()
-    pi, pj, m = model.build_pairs(pos_n, s.grid_box, s.re_l)
-    lap = model.laplacian(pos_n, vel_n, s.kind, pi, pj, m, s.re_l, s.n0_l, s.lam)
-    ps, vs, n_star, div, dirichlet, qi, qj, qm, system = model.predict(
-        pos_n, vel_n, s.kind, s.grid_box, dt, 0.0, -units.G, nu, s.re_n, s.re_g, s.re_l, s.n0_n, s.n0_g, s.n0_l, s.lam,
-        0.97, s.rho0, 0, 0.0, cfg["model.relaxation"], cfg["model.sound_speed"], 0.0, 0.2)
-    row, indptr, indices, data, rhs = system
-    x, resid, _ = pressure.solve(pressure.csr(indptr, indices, data), rhs, "direct")
+    dist = model.distances(pos_n, s.start, s.nbr)
+    lap = model.laplacian(vel_n, s.kind, s.start, s.nbr, dist, s.re_l, s.n0_l, s.lam)
+    ps, vs = model.explicit(pos_n, vel_n, s.kind, lap, dt, 0.0, -units.G, nu)
+    assert s.list_valid(ps)
+    d = model.distances(ps, s.start, s.nbr)
+    n_star = model.number_density(s.start, s.nbr, d, s.re_n)
+    div = model.divergence(ps, vs, s.start, s.nbr, d, s.re_g, s.n0_g)
+    surf, _ = model.surface(ps, s.kind, s.start, s.nbr, d, s.re_s, s.n0_s, 0.97, s.l0, s.rmax)
+    b = model.source_term_all(n_star, div, s.n0_n, s.rho0, dt, 0, 0.0, cfg["model.relaxation"], True)
+    row, indptr, indices, data, rhs = model.assemble(s.kind, surf, np.zeros(len(ps)), b, s.start, s.nbr, d, s.re_l,
+                                                     s.n0_l, s.lam, 0.0)
+    x, resid, _ = pressure.solve_csr(indptr, indices, data, rhs, "direct")
     p = np.zeros(len(s.pos))
     p[row >= 0] = x[row[row >= 0]]
     p = np.maximum(p, 0.0)
-    pos1, vel1, grad, bad, _ = model.correct(pos_n, ps, vs, p, s.kind, qi, qj, qm, s.re_g, s.n0_g, s.rho0, dt,
-                                             s.walls, s.escape_box, s.graze_depth)
-    return dict(s=s, dt=dt, nu=nu, pos_n=pos_n, vel_n=vel_n, lap=lap, p=p, pos1=pos1, vel1=vel1, grad=grad,
-                bad=bad, resid=resid)
+    grad = model.gradient(ps, p, s.kind, s.start, s.nbr, d, s.re_g, s.n0_g, 0)
+    pos1, vel1 = model.update(ps, vs, s.kind, grad, s.rho0, dt)
+    return dict(s=s, dt=dt, nu=nu, pos_n=pos_n, vel_n=vel_n, lap=lap, p=p, pos1=pos1, vel1=vel1, grad=grad, resid=resid)
 
 
 def test_eqs_3_and_5_add_up_to_the_discrete_navier_stokes_eqs_1_2():
@@ -120,7 +161,7 @@ def test_eqs_3_and_5_add_up_to_the_discrete_navier_stokes_eqs_1_2():
     st = manual_step()
     s, dt = st["s"], st["dt"]
     f = slice(0, s.nf)
-    assert st["bad"][0] == 0 and st["resid"] < 1e-10
+    assert st["resid"] < 1e-10
     accel = st["nu"] * st["lap"][f] + np.array([0.0, -units.G]) - st["grad"][f] / s.rho0
     scale = np.abs(accel).max()
     assert np.abs((st["vel1"][f] - st["vel_n"][f]) / dt - accel).max() < 1e-9 * scale
@@ -133,18 +174,18 @@ def test_eqs_3_and_5_add_up_to_the_discrete_navier_stokes_eqs_1_2():
 def test_pressure_gradient_at_new_positions_equals_the_one_used():
     st = manual_step()
     s = st["s"]
-    pi, pj, m = model.build_pairs(st["pos1"], s.grid_box, s.re_l)
-    g_new = model.gradient(st["pos1"], st["p"], s.kind, pi, pj, m, s.re_g, s.n0_g)
+    d = model.distances(st["pos1"], s.start, s.nbr)
+    g_new = model.gradient(st["pos1"], st["p"], s.kind, s.start, s.nbr, d, s.re_g, s.n0_g, 0)
     f = slice(0, s.nf)
     assert np.abs(g_new[f] - st["grad"][f]).max() < 1e-9 * np.abs(st["grad"][f]).max()
 
 
-# --- source terms -----------------------------------------------------------------
+# --- source terms and the pressure equation ---------------------------------------
 
 
 def test_source_terms():
     """standard = relax rho0/dt^2 (n0-n*)/n0; hattori adds (rho0 - Rho*)/dt div V* to the unrelaxed density term;
-    mixed = rho0/dt div + gamma (unrelaxed standard)."""
+    mixed = rho0/dt div + gamma (unrelaxed standard); relax_all multiplies hattori and mixed by relax too."""
     n0, rho, dt, gam, relax = 10.0, 2.0, 0.01, 0.05, 0.2
     std = model.source_term(9.9, 3.0, n0, rho, dt, 0, gam, 1.0)
     assert std == pytest.approx(rho / dt**2 * 0.01)
@@ -153,30 +194,170 @@ def test_source_terms():
     assert model.source_term(9.9, 3.0, n0, rho, dt, 2, gam, relax) == pytest.approx(rho / dt * 3.0 + gam * std)
     # at rest (div V* = 0) hattori reduces to the unrelaxed standard source
     assert model.source_term(9.9, 0.0, n0, rho, dt, 1, gam, relax) == std
+    ns, dv = np.array([9.9]), np.array([3.0])
+    for src in (0, 1, 2):
+        alone = model.source_term(9.9, 3.0, n0, rho, dt, src, gam, relax)
+        assert model.source_term_all(ns, dv, n0, rho, dt, src, gam, relax, False)[0] == alone
+        assert model.source_term_all(ns, dv, n0, rho, dt, src, gam, relax, True)[0] == pytest.approx(
+            alone if src == 0 else relax * alone)
 
 
 def test_compressibility_term_makes_a_pressure_equation_without_free_surface_definite():
-    """A block whose particles are all 'inner' (no Dirichlet particle: the pure-Neumann block that made SuperLU
-    report 'exactly singular') has a singular Laplacian; the compressibility term c of MPS-Basic lifts every
-    eigenvalue by c (Laplacian rows are diagonally dominant, so the smallest eigenvalue is >= c up to round-off)."""
+    """A block whose particles are all 'inner' (no Dirichlet particle) has a singular Laplacian; the
+    compressibility term c of MPS-Basic lifts every eigenvalue by c (Laplacian rows are diagonally dominant,
+    so the smallest eigenvalue is >= c up to round-off).  The matrix is symmetric (lists are symmetric)."""
     pos = lattice(n=9, l0=1.0)
     n0, lam = model.lattice_constants(3.1)
-    pi, pj, m = pairs(pos, 3.1)
+    start, nbr, dist = lists(pos, 3.1)
     kind = np.zeros(len(pos), np.int64)
     none = np.zeros(len(pos), np.bool_)
     b = np.ones(len(pos))
     for extra, singular in ((0.0, True), (0.01, False)):
-        row, indptr, indices, data, rhs = model.assemble(pos, kind, none, b, pi, pj, m, 3.1, n0, lam, extra)
-        ev = np.linalg.eigvalsh(pressure.csr(indptr, indices, data).toarray())
+        row, indptr, indices, data, rhs = model.assemble(kind, none, np.zeros(len(pos)), b, start, nbr, dist, 3.1, n0,
+                                                         lam, extra)
+        A = pressure.csr(indptr, indices, data).toarray()
+        assert np.array_equal(A, A.T)
+        ev = np.linalg.eigvalsh(A)
         assert ev.min() < 1e-9 if singular else ev.min() >= extra * (1 - 1e-9)
+
+
+def test_compiled_cg_matches_a_direct_solve_and_is_the_same_serial_and_parallel():
+    """Jacobi-CG (numba) solves the pressure equation of a settled step to its tolerance (against SuperLU:
+    relative 1e-6 for rtol 1e-9 at this condition number), and its row-parallel path gives the serial path's
+    numbers bit for bit (fixed reduction order)."""
+    st = manual_step()
+    s = st["s"]
+    d = model.distances(s.pos, s.start, s.nbr)
+    surf, _ = model.surface(s.pos, s.kind, s.start, s.nbr, d, s.re_s, s.n0_s, 0.97, 0.0, s.rmax)
+    b = np.ones(len(s.pos))
+    row, indptr, indices, data, rhs = model.assemble(s.kind, surf, np.zeros(len(s.pos)), b, s.start, s.nbr, d, s.re_l,
+                                                     s.n0_l, s.lam, 0.0)
+    x_lu, _, _ = pressure.solve_csr(indptr, indices, data, rhs, "direct")
+    x0 = np.zeros(len(rhs))
+    x1, r1, _ = pressure.cg_jacobi(indptr, indices, data, rhs, x0, 1e-9, 5000, False)
+    x2, r2, _ = pressure.cg_jacobi(indptr, indices, data, rhs, x0, 1e-9, 5000, True)
+    assert r1 < 1e-9 and np.array_equal(x1, x2) and r1 == r2
+    assert np.abs(x1 - x_lu).max() < 1e-6 * np.abs(x_lu).max()
 
 
 def test_failed_pressure_solve_is_reported_with_its_residual():
     """One CG iteration cannot reach rtol 1e-12: the run stops as solver_failed, naming the residual."""
     tank = load_tank(TANK)
-    cfg = settings.load(CFG).with_overrides(**{"pressure.maxiter": 1, "pressure.solver": "amg", "pressure.rtol": 1e-12})
-    r = solver.solve(tank, cfg, "standard", 10.0, 0.01, cfg["runs.probes_single"])
+    cfg = settings.load(CFG).with_overrides(**{"pressure.maxiter": 1, "pressure.rtol": 1e-12})
+    r = solver.solve(tank, cfg, "standard", 10.0, 0.01, cfg["runs.probes_single"], threads=1)
     assert r.status == "solver_failed" and "residual" in r.message and r.steps <= 2
+
+
+# --- walls ------------------------------------------------------------------------
+
+
+def test_thin_walls_are_the_dividing_walls():
+    """right1 (vessel 1 | vessel 2) is thin in both flow tanks; left2 (step down, solid behind) and every wall
+    of the single tank are not."""
+    for path in FLOWS:
+        tank = load_tank(path)
+        thin = boundary.thin_walls(tank.walls, solver.vessels(tank))
+        assert [n for n, f in zip(tank.wall_names, thin) if f] == ["right1"]
+    tank = load_tank(TANK)
+    assert not boundary.thin_walls(tank.walls, solver.vessels(tank)).any()
+
+
+@pytest.mark.parametrize("path", FLOWS)
+def test_wall_particles_and_panels(path):
+    """Four rows behind every face (two WALL within 2 l0 of the walls, then DUMMY), a thin wall's two faces on
+    either side; each face's first row faces exactly the wall's length; particles of a face at least l0/2
+    apart; P = 1 on every wall particle loads each 10 cm panel of each face with 10 N/cm x 1 cm."""
+    tank = load_tank(path)
+    thin = boundary.thin_walls(tank.walls, solver.vessels(tank))
+    l0 = 5.0
+    b = boundary.wall_particles(tank.walls, l0, 4, 2, thin)
+    assert set(np.unique(b["kind"])) == {model.WALL, model.DUMMY}
+    L = np.hypot(*(tank.walls[:, 2:] - tank.walls[:, :2]).T)
+    for w in range(len(L)):
+        for side in ((1, -1) if thin[w] else (1,)):
+            on = (b["face_wall"] == w) & (b["face_side"] == side)
+            assert b["face_ds"][on].sum() == pytest.approx(L[w])
+    r1 = tank.wall_names.index("right1")
+    back = b["pos"][(b["wall"] == r1) & (b["side"] == -1)]
+    front = b["pos"][(b["wall"] == r1) & (b["side"] == 1)]
+    assert np.all(back[:, 0] < 100.0) and np.all(front[:, 0] > 100.0) and len(back) == len(front)
+    for side in (1, -1):
+        grp = b["pos"][np.where(thin[b["wall"]], b["side"] == side, side == 1)]
+        d = np.sort(np.hypot(*(grp[:, None] - grp[None]).T), axis=1)[:, 1]
+        assert d.min() > 0.5 * l0 - 1e-9
+    pw, pc, ps, M = boundary.load_map(tank.walls, b, 10.0)
+    unit = (M @ np.ones(len(b["pos"]))).reshape(-1, 2)  # P = 1: force = panel length x normal
+    assert np.allclose(np.hypot(*unit.T), 10.0)
+    assert np.count_nonzero(ps < 0) == np.count_nonzero(pw == r1) // 2
+
+
+def test_no_particle_sees_across_a_thin_wall():
+    """Liquid in either vessel beside right1: no list links particles on opposite sides across the wall's
+    segment, a face's particles are seen only from its side, and the lists are symmetric (dummy particles,
+    which have no row, aside)."""
+    tank = load_tank(FLOWS[1])
+    l0 = COARSE
+    left = boundary.liquid_block((100 - 4 * l0, 100.0), 30.0, 4 * l0, l0)
+    right = left + [4 * l0, 0.0]
+    s = solver.State(tank, settings.load(CFG), l0, np.concatenate([left, right]), np.zeros((2 * len(left), 2)))
+    s.neighbours(s.pos)
+    pairs = {(i, int(j)) for i in range(len(s.pos)) for j in s.nbr[s.start[i]:s.start[i + 1]]}
+    assert all((j, i) in pairs for i, j in pairs if s.kind[j] != model.DUMMY)  # dummies have no rows
+    side = np.where(s.pos[:, 0] < 100.0, 1, -1)
+    eff = np.where(s.tw >= 0, s.tside, side)
+    seg = tank.walls[tank.wall_names.index("right1")]
+    for i, j in pairs:
+        if eff[i] != eff[j]:  # opposite sides: only around the wall's lower end, never through it
+            assert s.tw[i] < 0 and s.tw[j] < 0
+            assert not operators.segments_cross(*s.pos[i], *s.pos[j], seg)
+
+
+def drop(tank, wall, side, variant, l0, rows=4):
+    """A rows x rows block of liquid particles thrown along the face's normal at the flow's impact speed
+    sqrt(2 g 122.5) = 490 cm/s (the fall from the first vessel's surface to the second vessel's floor in
+    flow_step50) at the middle of a wall face, from one spacing in front of it; stepped until the block's last
+    row would have reached the wall at that speed, plus as long again.  A splash over a wall's top end is not
+    what this tests (the escape box is opened 1 m upwards).  Returns (first bad step (kind, particle, wall) or
+    None, final velocities (N, 2) cm/s, outward unit normal of the face)."""
+    cfg = settings.load(CFG)
+    walls = tank.walls
+    a, b = walls[wall, :2], walls[wall, 2:]
+    t = (b - a) / np.hypot(*(b - a))
+    n = side * np.array([-t[1], t[0]])
+    g = (np.arange(rows) - (rows - 1) / 2) * l0
+    blob = np.array([a + 0.5 * (b - a) + n * (k + 1) * l0 + t * u for k in range(rows) for u in g])
+    speed = np.sqrt(2 * units.G * 122.5)
+    s = solver.State(tank, cfg, l0, blob, np.tile(-n * speed, (len(blob), 1)))
+    s.escape_box = s.escape_box + np.array([0.0, 0.0, 0.0, 100.0])
+    dt = solver.time_step(tank, l0, cfg["time.courant"])
+    threads = numba.get_num_threads()
+    numba.set_num_threads(1)
+    try:
+        for _ in range(int(np.ceil(2 * (rows + 1) * l0 / speed / dt))):
+            bad, resid, _ = solver.step(s, dt, variant, cfg)
+            if bad[0] != 0:
+                return bad, s.vel[: s.nf], n
+    finally:
+        numba.set_num_threads(threads)
+    return None, s.vel[: s.nf], n
+
+
+@pytest.mark.parametrize("variant", VARIANTS)
+def test_drop_test_no_particle_crosses_any_wall(variant):
+    """A block thrown at 490 cm/s at the middle of every face of every wall of both flow tanks (right1 from
+    both sides) with each source term: no particle crosses a wall (deeper than the graze depth l0/2, the
+    half cell in front of the first wall-particle row) and none becomes non-finite, and the wall takes the
+    block's normal momentum (mean normal velocity after the impact above -0.5 of the impact velocity: the
+    block has stopped or rebounded, not passed through)."""
+    speed = np.sqrt(2 * units.G * 122.5)
+    for path in FLOWS:
+        tank = load_tank(path)
+        thin = boundary.thin_walls(tank.walls, solver.vessels(tank))
+        for w, name in enumerate(tank.wall_names):
+            for side in ((1, -1) if thin[w] else (1,)):
+                bad, vel, n = drop(tank, w, side, variant, COARSE)
+                assert bad is None, (path.stem, name, side, bad)
+                assert (vel @ n).mean() > -0.5 * speed, (path.stem, name, side)
 
 
 # --- the tank at rest -------------------------------------------------------------
@@ -186,14 +367,14 @@ def test_failed_pressure_solve_is_reported_with_its_residual():
 def column_runs():
     tank = load_tank(TANK)
     cfg = settings.load(CFG).with_overrides(**{"time.average_window": 0.1})
-    return {v: solver.solve(tank, cfg, v, 5.0, 0.25, cfg["runs.probes_single"]) for v in ("standard", "hattori", "mixed")}
+    return {v: solver.solve(tank, cfg, v, COARSE, 0.3, cfg["runs.probes_single"], threads=1) for v in VARIANTS}
 
 
-@pytest.mark.parametrize("variant", ["standard", "hattori", "mixed"])
+@pytest.mark.parametrize("variant", VARIANTS)
 def test_time_averaged_pressure_of_a_column_is_hydrostatic(column_runs, variant):
     """Probe pressures averaged over the last 0.1 s vs rho g (y_s - y), y_s the top row's centre (P = 0 there).
     Tolerance rho g l0: the surface sits within l0/2 of y_s and the Laplacian's boundary error adds up to
-    another l0/2 of head (derived from the spacing, l0 = 5 cm)."""
+    another l0/2 of head (derived from the spacing)."""
     r = column_runs[variant]
     h = r.history
     win = h["in_window"][1].astype(bool)
@@ -201,42 +382,106 @@ def test_time_averaged_pressure_of_a_column_is_hydrostatic(column_runs, variant)
     probes = h["probe_point"][1]
     rho_g = r.params["rho0_N_s2_cm4"] * units.G
     y_s = r.pos0[:, 1].max()
-    assert np.all(np.abs(mean - rho_g * (y_s - probes[:, 1])) < rho_g * 5.0)
+    assert np.all(np.abs(mean - rho_g * (y_s - probes[:, 1])) < rho_g * COARSE)
+
+
+@pytest.mark.parametrize("l0", [COARSE, FINE])
+def test_side_wall_load_of_the_column_is_hydrostatic(l0):
+    """Side-wall load (mean of left and right, 0.1-0.3 s: after the start, before the column's particle-scale
+    motion grows) against rho g h^2 / 2 = 3262.5 N.  Tolerance l0/h: P = 0 sits at the top particle centres,
+    the surface is half a pitch above them (the contract's convention), so the surface, and with it the
+    pressure at every depth, is known to within +-l0/2, i.e. rho g (l0/2) h on each wall: +-(l0/h) of the
+    load (7.7 % and 4.8 % at l0 = 5.56 and 3.45 cm; the depth rounded to whole rows, -0.38 % and -0.12 %,
+    is inside it)."""
+    tank = load_tank(TANK)
+    cfg = settings.load(CFG)
+    r = solver.solve(tank, cfg, "standard", l0, 0.3, cfg["runs.probes_single"], threads=1)
+    h = r.history
+    t = h["hist_time"][1]
+    F = np.hypot(*np.moveaxis(h["hist_panel_force"][1], -1, 0))
+    on = (t >= 0.1) & (t <= 0.3)
+    side = np.mean([F[on][:, r.contact_wall == w].sum(1).mean() for w in (0, 2)])
+    assert abs(side / 3262.5 - 1) < l0 / tank.depth
 
 
 def test_mass_momentum_and_recorded_variant(column_runs, tmp_path):
     """Mass is the particle count times the particle weight (never changes); total weight = the tank's W;
-    the floor carries the weight within the hydrostatic tolerance rho g l0 B; the run file records the variant."""
+    the floor carries the weight within the hydrostatic tolerance rho g l0 B; the run file records the variant
+    and the contract's attributes (layer pitch, held weight, depth, tank difference, rest, threads)."""
     tank = load_tank(TANK)
     rho_g = column_runs["standard"].params["rho0_N_s2_cm4"] * units.G
     for v, r in column_runs.items():
         assert r.weight.sum() == pytest.approx(tank.weight, rel=1e-12)
         assert r.status in ("converged", "step_limit")
         assert r.history["hist_vessel_count"][1][:, 0].min() == len(r.pos)
-        ds = runfile.to_dataset(r, tank, {"command": "test"}, runfile.now(), runfile.now(), 5.0)
+        ds = runfile.to_dataset(r, tank, {"command": "test"}, runfile.now(), runfile.now(), COARSE)
         runfile.write(ds, tmp_path / f"{v}.nc")
         back = runfile.read(tmp_path / f"{v}.nc")
         assert back.attrs["variant"] == v and back.attrs["source_term"] == v
         assert back.attrs["variant_label"] == registry()["mps"].variants[v].label
         assert back["pressure"].attrs["units"] == "N cm-2"
+        a = back.attrs
+        assert a["layer_pitch"] == COARSE and a["held_weight"] == pytest.approx(9000.0)
+        assert a["initial_depth"] == pytest.approx(13 * COARSE)
+        assert a["tank_difference"].startswith("depth rounded to whole rows: 72.22 cm (tank 72.5 cm)")
+        assert a["rest_energy_ratio"] == 1e-5 and a["rest_window"] == 1.2 and np.isnan(a["time_to_rest"])
+        assert a["threads"] == 1
         floor = r.contact_force[r.contact_wall == 1, 1].sum()
-        assert abs(floor - tank.weight) < rho_g * 5.0 * 100.0, v
+        assert abs(floor - tank.weight) < rho_g * COARSE * 100.0, v
 
 
-def test_wall_particles_and_panels():
-    """Four rows behind every wall (two WALL, two DUMMY), at least l0/2 apart; each wall's first row faces
-    exactly its length; P = 1 on every wall particle loads each 10 cm panel with 10 N/cm x 1 cm."""
-    tank = load_tank(ROOT / "config" / "tanks" / "flow_step50.yaml")
-    b = boundary.wall_particles(tank.walls, 5.0, 4, 2)
-    assert set(np.unique(b["kind"])) == {model.WALL, model.DUMMY}
-    L = np.hypot(*(tank.walls[:, 2:] - tank.walls[:, :2]).T)
-    for w in range(len(L)):
-        assert b["face_ds"][b["face_wall"] == w].sum() == pytest.approx(L[w])
-    d = np.sort(np.hypot(*(b["pos"][:, None] - b["pos"][None]).T), axis=1)[:, 1]
-    assert d.min() > 0.5 * 5.0 - 1e-9
-    pw, pc, M = boundary.load_map(tank.walls, b, 10.0)
-    unit = (M @ np.ones(len(b["pos"]))).reshape(-1, 2)  # P = 1: force = panel length x normal
-    assert np.allclose(np.hypot(*unit.T), 10.0)
+@pytest.mark.parametrize("variant", VARIANTS)
+@pytest.mark.xfail(strict=True, reason="no MPS source term comes to rest with the literature's practices: single "
+                                       "vessel, l0 = 5.56 cm, 3 s: kinetic energy / (W h) 3.8e-3 (standard), 3.1e-3 "
+                                       "(hattori), 1.5e-3 (mixed) against the rest limit 1e-5 (rms 23, 21, 14 cm/s); "
+                                       "l0 = 3.45 cm: 2.6e-3, 2.6e-3, 1.5e-3")
+def test_column_comes_to_rest(variant):
+    """The column started at rest is at rest by isaflow.rest (kinetic energy / (W h) below 1e-5 for 1.2 s)
+    within the settings' time limit."""
+    tank = load_tank(TANK)
+    cfg = settings.load(CFG)
+    r = solver.solve(tank, cfg, variant, COARSE, cfg["time.single_time"], cfg["runs.probes_single"], threads=1)
+    assert r.status == "converged" and r.params["time_to_rest"] <= cfg["time.single_time"]
+
+
+# --- threads and continuations ------------------------------------------------------
+
+
+def test_one_and_two_threads_give_the_same_run_bit_for_bit():
+    """The particle loops run in parallel by gathering from each particle's own row: 1 and 2 numba threads
+    give identical positions, velocities, pressures and wall loads (a step of the flow, with the thin wall)."""
+    if numba.config.NUMBA_NUM_THREADS < 2:
+        pytest.skip("numba has a single thread here")
+    tank = load_tank(FLOWS[0])
+    cfg = settings.load(CFG)
+    runs = [solver.solve(tank, cfg, "mixed", COARSE, 0.05, cfg["runs.probes_flow"], threads=t) for t in (1, 2)]
+    assert [r.params["threads"] for r in runs] == [1, 2]
+    a, b = runs
+    assert np.array_equal(a.pos, b.pos) and np.array_equal(a.fields["velocity"][1], b.fields["velocity"][1])
+    assert np.array_equal(a.fields["pressure"][1], b.fields["pressure"][1])
+    assert np.array_equal(a.contact_force, b.contact_force)
+
+
+def test_a_continued_run_matches_the_straight_run():
+    """Run 0.1 s straight, or 0.05 s and then 0.05 s from its final state (start dict): same step count and
+    clock, positions equal to round-off (1e-9 cm; the continuation builds its own neighbour lists, whose rows
+    may list the same neighbours in another order)."""
+    tank = load_tank(TANK)
+    cfg = settings.load(CFG)
+    probes = cfg["runs.probes_single"]
+    dt = solver.time_step(tank, COARSE, cfg["time.courant"])
+    n = 30
+    whole = solver.solve(tank, cfg, "standard", COARSE, n * dt, probes, threads=1)
+    first = solver.solve(tank, cfg, "standard", COARSE, (n // 2) * dt, probes, threads=1)
+    second = solver.solve(tank, cfg, "standard", COARSE, (n - n // 2) * dt, probes, threads=1,
+                          start=dict(pos=first.pos, vel=first.fields["velocity"][1], steps=first.steps,
+                                     sim_time=first.sim_time, initial_depth=first.params["initial_depth"]))
+    assert second.steps == whole.steps == n and second.start_step == n // 2
+    assert second.sim_time == pytest.approx(whole.sim_time, abs=1e-12)
+    assert np.abs(second.pos - whole.pos).max() < 1e-9
+
+
+# --- settings and the stiff cases ---------------------------------------------------
 
 
 def test_bad_settings_name_file_and_field(tmp_path):
@@ -262,7 +507,8 @@ def test_stiff_cases_change_only_their_setting():
         new, start = outputs.stiff_settings(cfg, case)
         changed[case] = sorted(k for k in cfg if new[k] != cfg[k])
         assert (start == "on_wall") == (case == "on_wall")
-    assert changed == {"large_dt": ["time.courant"], "small_re": ["model.re_density", "model.re_gradient", "model.re_laplacian"],
+    assert changed == {"large_dt": ["time.courant"], "small_re": ["model.re_density", "model.re_gradient",
+                                                                  "model.re_laplacian", "model.re_surface"],
                        "no_relaxation": ["model.relaxation"], "on_wall": []}
     assert outputs.stiff_settings(cfg, "large_dt")[0]["time.courant"] == cfg["stiff.courant_large"] > cfg["time.courant"]
 
@@ -271,18 +517,15 @@ def test_stiff_cases_change_only_their_setting():
     ((99.5, 0.3), (100.05, -0.05), False),  # cuts the opening's convex corner (crosses floor1 at x = 99.97), ends
                                             # 0.07 cm from floor1's end, in front of left2
     ((99.9, 0.3), (99.9, -0.05), False),    # 0.05 cm past floor1's line: the half cell before the first wall row
-    ((99.9, 0.3), (99.0, -2.0), True),      # 2 cm past floor1's line: through the first wall row (l0/2 = 1.67 cm)
+    ((99.9, 0.3), (99.0, -2.0), True),      # 2 cm past floor1's line: through the first wall row (l0/2 = 1.72 cm)
 ])
 def test_a_wall_crossing_is_an_escape_only_past_the_first_wall_particle_row(begin, end, escaped):
-    """model.correct: a move across a wall line ending within graze = l0/2 of the wall segment is a graze
+    """model.check: a move across a wall line ending within graze = l0/2 of the wall segment is a graze
     (returned, the run goes on), farther is an escape (bad[0] == 2) naming the particle and the wall."""
-    walls = load_tank(ROOT / "config" / "tanks" / "flow_step50.yaml").walls
-    l0 = 10.0 / 3.0
-    start, stop = np.array([begin]), np.array([end])
-    no_pairs = np.zeros(0, np.int64)
-    _, _, _, bad, deepest = model.correct(start, stop, np.zeros((1, 2)), np.zeros(1), np.array([model.FLUID]),
-                                          no_pairs, no_pairs, 0, 1.0, 1.0, 1.0, 1e-3, walls,
-                                          np.array([-1e3, -1e3, 1e3, 1e3]), 0.5 * l0)
+    walls = load_tank(FLOWS[0]).walls
+    l0 = FINE
+    bad, deepest = model.check(np.array([begin]), np.array([end]), np.zeros((1, 2)), np.array([model.FLUID]), walls,
+                               np.array([-1e3, -1e3, 1e3, 1e3]), 0.5 * l0)
     if escaped:
         assert bad[0] == 2 and bad[1] == 0 and bad[2] == 1  # wall 1 is floor1
     else:

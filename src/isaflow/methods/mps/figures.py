@@ -91,21 +91,21 @@ def flow(runs, outputs):
 
 
 def rest(runs, outputs):
-    """One panel per source term: rms speed [cm/s] of the liquid started at rest against time, one line per
-    spacing, dashed: that spacing's rest limit (settings time.rest_fraction)."""
+    """One panel per source term: kinetic energy / (W h) of the liquid started at rest against time, one line
+    per spacing; dashed: the rest limit of isaflow.rest (config/rest.yaml)."""
     dss = [runfile.read(p) for p in runs]
     fig, axes = plt.subplots(1, len(VARIANTS), figsize=(4.2 * len(VARIANTS), 3.4), squeeze=False, sharey=True)
     for ax, name in zip(axes[0], VARIANTS):
         mine = sorted((ds for ds in dss if ds.attrs["variant"] == name), key=lambda d: -float(d.attrs["spacing"]))
         for k, ds in enumerate(mine):
             c = plt.cm.viridis(k / max(1, len(mine) - 1) * 0.85)
-            ax.semilogy(ds["hist_time"].values, ds["hist_rms_speed"].values, color=c, lw=1.2,
+            ax.semilogy(ds["hist_time"].values, ds["hist_energy_ratio"].values, color=c, lw=1.2,
                         label=f"l0 = {float(ds.attrs['spacing']):.3g} cm ({ds.attrs['status']})")
-            ax.axhline(float(ds.attrs["rest_speed_cm_s"]), color=c, ls="--", lw=0.8)
+        if mine:
+            ax.axhline(float(mine[0].attrs["rest_energy_ratio"]), color="k", ls="--", lw=0.8)
         ax.set_title(f"source term: {name}", fontsize=9)
         ax.set_xlabel("time t [s]")
-        ax.set_ylim(0.1, 30)  # room below the rest limits for the legend
-        ax.legend(fontsize=7, loc="lower right", ncol=2)
-    axes[0, 0].set_ylabel("rms speed of the liquid [cm/s]\n(dashed: rest limit)")
+        ax.legend(fontsize=7, loc="lower right")
+    axes[0, 0].set_ylabel("kinetic energy / (W h)\n(dashed: rest limit)")
     fig.tight_layout()
     save(fig, outputs)

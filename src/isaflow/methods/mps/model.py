@@ -1,23 +1,26 @@
-"""The two halves of one MPS time step (numba): the explicit step, source term and pressure-equation
-assembly (predict), and the pressure correction (correct); the collision model.
+"""The stages of one MPS time step (numba): explicit step, collision model, free surface, source term,
+pressure-equation assembly, pressure correction, particle shifting and the wall-crossing check.
 
 Koshizuka & Oka (1996), as the public MPS-Basic code implements it (github.com/MPS-Basic/MPS-Basic,
-src/mps.cpp, src/pressure_calculator/implicit.cpp).  Operators in operators.py (re-exported here).
+src/mps.cpp, src/pressure_calculator/implicit.cpp), with the named options of config/methods/mps.yaml.
+Operators and neighbour lists in operators.py (re-exported here).  Every loop over particles gathers
+from the particle's own neighbour row (numba prange; bit-identical for any thread count).
 Units: cm, s, density N s^2 / cm^4 (2D), pressure N / cm^2.
 """
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from isaflow.core.geometry import crossed_wall, segment_closest
-from isaflow.core.neighbours import build_pairs  # noqa: F401  (re-exported for tests and benchmarks)
 
-from .operators import (DIM, DUMMY, FLUID, JIT, WALL, divergence, gradient, lattice_constants,  # noqa: F401
-                        laplacian, neighbour_offset_sum, number_density, number_density_of_pairs, pair_distances,
-                        probe_pressure, weight)
+from .operators import (DIM, DUMMY, FLUID, GRADIENTS, JIT, PAR, WALL, distances, divergence, gradient,  # noqa: F401
+                        lattice_constants, laplacian, neighbour_list, number_density, offsets, probe_pressure,
+                        weight)
 
 # source terms of the pressure equation (settings name -> id)
 SOURCES = {"standard": 0, "hattori": 1, "mixed": 2}
+# free-surface pressure conditions (settings name -> id)
+SURFACE = {"zero": 0, "hydrostatic": 1, "extrapolated": 2}
 
 
 @njit(**JIT)
@@ -37,22 +40,138 @@ def source_term(n_star, div_star, n0, rho0, dt, source, gamma, relax=1.0):
     return rho0 / dt * div_star + gamma * drho / dt**2
 
 
+@njit(**PAR)
+def source_term_all(n_star, div_star, n0, rho0, dt, source, gamma, relax, relax_all):
+    """(N,) source_term of every particle (dummies' rows are never used); relax_all: the hattori and mixed
+    source terms are multiplied by relax too (the relaxation applied equally to every source term)."""
+    n = n_star.shape[0]
+    out = np.empty(n)
+    scale = relax if relax_all and source != 0 else 1.0
+    for i in prange(n):
+        out[i] = scale * source_term(n_star[i], div_star[i], n0, rho0, dt, source, gamma, relax)
+    return out
+
+
+@njit(**PAR)
+def explicit(pos, vel, kind, lap, dt, gx, gy, nu):
+    """Explicit half (eq. 3): V* = V + dt (nu lap V + g), U* = U + dt V* for the fluid.  Returns (U*, V*)."""
+    ps = pos.copy()
+    vs = vel.copy()
+    for i in prange(pos.shape[0]):
+        if kind[i] == FLUID:
+            vs[i, 0] = vel[i, 0] + dt * (nu * lap[i, 0] + gx)
+            vs[i, 1] = vel[i, 1] + dt * (nu * lap[i, 1] + gy)
+            ps[i, 0] = pos[i, 0] + dt * vs[i, 0]
+            ps[i, 1] = pos[i, 1] + dt * vs[i, 1]
+    return ps, vs
+
+
+@njit(**PAR)
+def collide(ps, vs, kind, start, nbr, cdist, restitution):
+    """Collision model of MPS-Basic (MPS::collision) as a gather: every fluid particle closer than ``cdist``
+    [cm] to a listed neighbour (any kind; wall and dummy particles immovable) takes, for each such pair,
+    the impulse that removes (1 + e) of the approaching normal relative velocity (equal masses share it)
+    and half (fluid-fluid) or all (fluid-wall) of the push back to ``cdist``, all pairs computed from the
+    state before the collision (MPS-Basic updates pair by pair in sequence; here every pair's exchange is
+    the same from both ends, so momentum is conserved and the order does not matter).
+    Returns (U, V) after the collision."""
+    n = ps.shape[0]
+    po = ps.copy()
+    vo = vs.copy()
+    for i in prange(n):
+        if kind[i] != FLUID:
+            continue
+        for k in range(start[i], start[i + 1]):
+            j = nbr[k]
+            dx = ps[j, 0] - ps[i, 0]
+            dy = ps[j, 1] - ps[i, 1]
+            r = np.sqrt(dx * dx + dy * dy)
+            if r >= cdist or r == 0.0:
+                continue
+            ex = dx / r
+            ey = dy / r
+            mass = 0.5 if kind[j] == FLUID else 1.0  # 1 / (1/m_i + 1/m_j), unit fluid masses
+            rel = (vs[j, 0] - vs[i, 0]) * ex + (vs[j, 1] - vs[i, 1]) * ey
+            imp = -(1.0 + restitution) * rel * mass if rel < 0.0 else 0.0
+            push = (cdist - r) * mass
+            vo[i, 0] -= imp * ex
+            vo[i, 1] -= imp * ey
+            po[i, 0] -= push * ex
+            po[i, 1] -= push * ey
+    return po, vo
+
+
+@njit(**PAR)
+def surface(pos, kind, start, nbr, dist, re_s, n0_s, beta, dist_thr, rc):
+    """Free-surface particles and their outward normals.
+
+    Fluid or wall particle i is on the free surface when its number density at radius re_s is below
+    beta n0_s and, if dist_thr > 0 [cm], a component of sum_j r_ij over its neighbours closer than rc
+    exceeds dist_thr (MPS-Basic's particle-distribution test).  Returns (surface (N,) bool, normal (N, 2):
+    -sum_j w r_ij normalised, pointing out of the liquid)."""
+    n = pos.shape[0]
+    n_s = number_density(start, nbr, dist, re_s)
+    s, sw = offsets(pos, start, nbr, dist, rc, re_s)
+    surf = np.zeros(n, np.bool_)
+    normal = np.zeros((n, 2))
+    for i in prange(n):
+        if kind[i] == DUMMY:
+            continue
+        f = n_s[i] < beta * n0_s
+        if f and dist_thr > 0.0:
+            f = abs(s[i, 0]) > dist_thr or abs(s[i, 1]) > dist_thr
+        surf[i] = f
+        L = np.hypot(sw[i, 0], sw[i, 1])
+        if L > 0.0:
+            normal[i, 0] = -sw[i, 0] / L
+            normal[i, 1] = -sw[i, 1] / L
+    return surf, normal
+
+
+@njit(**PAR)
+def surface_values(pos, p_prev, kind, surf, normal, start, nbr, dist, re, n0, delta):
+    """(N,) Dirichlet pressure [N/cm^2] of the free-surface particles: P = 0 at the free surface, delta [cm]
+    outside the particle along its normal, extrapolated linearly to the particle with the normal pressure
+    gradient of the previous step's pressures p_prev: P_i = delta max(0, -n_i . grad P_i).  The gradient is
+    the consistent one, sum (p_j - p_i) with the corrective matrix (Khayyer & Gotoh 2011), over fluid and
+    wall neighbours within re (exact for linear pressure on any arrangement); 0 where it is near singular."""
+    n = pos.shape[0]
+    out = np.zeros(n)
+    a = DIM / n0
+    for i in prange(n):
+        if not surf[i]:
+            continue
+        gx = gy = mxx = mxy = myy = 0.0
+        for k in range(start[i], start[i + 1]):
+            j = nbr[k]
+            if kind[j] == DUMMY:
+                continue
+            wt = weight(dist[k], re)
+            if wt == 0.0:
+                continue
+            dx = pos[j, 0] - pos[i, 0]
+            dy = pos[j, 1] - pos[i, 1]
+            r2 = dist[k] * dist[k]
+            q = (p_prev[j] - p_prev[i]) / r2 * wt
+            gx += q * dx
+            gy += q * dy
+            mxx += dx * dx / r2 * wt
+            mxy += dx * dy / r2 * wt
+            myy += dy * dy / r2 * wt
+        mxx *= a
+        mxy *= a
+        myy *= a
+        det = mxx * myy - mxy * mxy
+        if det > 0.01:
+            gx, gy = a * (myy * gx - mxy * gy) / det, a * (mxx * gy - mxy * gx) / det
+            out[i] = delta * max(0.0, -(normal[i, 0] * gx + normal[i, 1] * gy))
+    return out
+
+
 @njit(**JIT)
-def assemble(pos, kind, dirichlet, b, pi, pj, m, re, n0, lam, diag_extra=0.0):
-    """Pressure equation of the non-Dirichlet fluid and wall particles as CSR.
-
-    Row of unknown i: diag_extra P_i + sum_j w_ij (P_i - P_j) = -(lambda n0 / 2d) b_i,
-    the MPS Laplacian times -(lambda n0 / 2d) plus the compressibility term
-    (as MPS-Basic's PressurePoissonEquation, scaled by rho0 lambda n0 / 2d): symmetric
-    positive definite when diag_extra > 0, or when every cluster touches a Dirichlet particle.  Returns (unknown (N,)
-    row of each particle or -1, indptr, indices, data, rhs).
-    """
-    return assemble_pairs(pair_distances(pos, pi, pj, m), kind, dirichlet, b, pi, pj, m, re, n0, lam, diag_extra)
-
-
-@njit(**JIT)
-def assemble_pairs(dist, kind, dirichlet, b, pi, pj, m, re, n0, lam, diag_extra):
-    """assemble from the pair distances dist (see operators.pair_distances)."""
+def unknown_rows(kind, dirichlet):
+    """(N,) row of each particle in the pressure equation (fluid and wall particles not on the surface), -1 else;
+    and the number of rows."""
     n = kind.shape[0]
     row = np.full(n, -1, np.int64)
     nu = 0
@@ -60,167 +179,135 @@ def assemble_pairs(dist, kind, dirichlet, b, pi, pj, m, re, n0, lam, diag_extra)
         if kind[i] != DUMMY and not dirichlet[i]:
             row[i] = nu
             nu += 1
-    count = np.ones(nu, np.int64)  # diagonal
-    for k in range(m):
-        i, j = np.uint32(pi[k]), np.uint32(pj[k])
-        if row[i] >= 0 and row[j] >= 0:
-            if dist[k] < re:
-                count[row[i]] += 1
-                count[row[j]] += 1
-    indptr = np.zeros(nu + 1, np.int64)
-    for r in range(nu):
-        indptr[r + 1] = indptr[r] + count[r]
-    indices = np.empty(indptr[nu], np.int32)
-    data = np.zeros(indptr[nu])
-    fill = indptr[:-1] + 1
-    for r in range(nu):
-        indices[indptr[r]] = r
-        data[indptr[r]] = diag_extra
-    for k in range(m):
-        i, j = np.uint32(pi[k]), np.uint32(pj[k])
-        if kind[i] == DUMMY or kind[j] == DUMMY or (row[i] < 0 and row[j] < 0):
+    return row, nu
+
+
+@njit(**PAR)
+def assemble(kind, dirichlet, p_dir, b, start, nbr, dist, re, n0, lam, diag_extra):
+    """Pressure equation of the non-Dirichlet fluid and wall particles as CSR.
+
+    Row of unknown i: diag_extra P_i + sum_j w_ij (P_i - P_j) = -(lambda n0 / 2d) b_i over fluid and wall
+    neighbours j (dummies excluded), Dirichlet neighbours' P_j = p_dir[j] moved to the right-hand side:
+    the MPS Laplacian times -(lambda n0 / 2d) plus the compressibility term (MPS-Basic's
+    PressurePoissonEquation scaled by rho0 lambda n0 / 2d).  Symmetric; positive definite when
+    diag_extra > 0 or every cluster touches a Dirichlet particle.  Row i's entries: the diagonal, then
+    its neighbours in list order.  Returns (row (N,), indptr, indices, data, rhs)."""
+    n = kind.shape[0]
+    row, nu = unknown_rows(kind, dirichlet)
+    count = np.zeros(nu + 1, np.int64)
+    for i in prange(n):
+        if row[i] < 0:
             continue
-        r = dist[k]
-        if r >= re:
-            continue
-        wt = weight(r, re)
-        ri, rj = row[i], row[j]
-        if ri >= 0:
-            data[indptr[ri]] += wt
-        if rj >= 0:
-            data[indptr[rj]] += wt
-        if ri >= 0 and rj >= 0:
-            indices[fill[ri]] = rj
-            data[fill[ri]] = -wt
-            fill[ri] += 1
-            indices[fill[rj]] = ri
-            data[fill[rj]] = -wt
-            fill[rj] += 1
+        c = 1
+        for k in range(start[i], start[i + 1]):
+            if dist[k] < re and row[nbr[k]] >= 0:
+                c += 1
+        count[row[i] + 1] = c
+    for r in range(nu):
+        count[r + 1] += count[r]
+    indices = np.empty(count[nu], np.int32)
+    data = np.empty(count[nu])
     rhs = np.empty(nu)
-    c = -lam * n0 / (2.0 * DIM)
-    for i in range(n):
-        if row[i] >= 0:
-            rhs[row[i]] = c * b[i]
-    return row, indptr, indices, data, rhs
-
-
-@njit(**JIT)
-def collide(ps, vs, kind, pi, pj, m, dist, restitution):
-    """Collision model of MPS-Basic (MPS::collision): every pair closer than ``dist`` [cm] with a fluid
-    particle exchanges the normal relative velocity with restitution e if it approaches, and both are
-    pushed apart to ``dist`` (equal masses; wall and dummy particles immovable).  In place."""
-    for k in range(m):
-        i, j = np.uint32(pi[k]), np.uint32(pj[k])
-        if kind[i] != FLUID and kind[j] != FLUID:
+    c0 = -lam * n0 / (2.0 * DIM)
+    for i in prange(n):
+        r = row[i]
+        if r < 0:
             continue
-        dx = ps[j, 0] - ps[i, 0]
-        dy = ps[j, 1] - ps[i, 1]
-        r = np.sqrt(dx * dx + dy * dy)
-        if r >= dist or r == 0.0:
+        q = count[r]
+        indices[q] = r
+        diag = diag_extra
+        extra = 0.0
+        q += 1
+        for k in range(start[i], start[i + 1]):
+            j = nbr[k]
+            if kind[j] == DUMMY or dist[k] >= re:
+                continue
+            wt = weight(dist[k], re)
+            diag += wt
+            if row[j] >= 0:
+                indices[q] = row[j]
+                data[q] = -wt
+                q += 1
+            else:
+                extra += wt * p_dir[j]
+        data[count[r]] = diag
+        rhs[r] = c0 * b[i] + extra
+    return row, count, indices, data, rhs
+
+
+@njit(**PAR)
+def shift(pos, kind, surf, normal, start, nbr, dist, re, n0, coeff, l0):
+    """Particle shifting (Fickian, Lind et al. 2012, in MPS form): dr_i = -coeff l0^2 grad C_i with the
+    concentration gradient grad C_i = d/n0 sum_j r_ij / r_ij^2 w(r_ij) over neighbours of any kind (0 on the
+    full lattice, towards the crowded side elsewhere), limited to 0.2 l0; free-surface particles move only
+    along their surface (normal component removed, Lind et al. 2012).  Returns the shifts (N, 2) [cm]."""
+    n = pos.shape[0]
+    out = np.zeros((n, 2))
+    a = DIM / n0
+    for i in prange(n):
+        if kind[i] != FLUID:
             continue
-        ex = dx / r
-        ey = dy / r
-        mi = 1.0 if kind[i] == FLUID else 0.0  # inverse masses (rho0 cancels)
-        mj = 1.0 if kind[j] == FLUID else 0.0
-        mass = 1.0 / (mi + mj)
-        rel = (vs[j, 0] - vs[i, 0]) * ex + (vs[j, 1] - vs[i, 1]) * ey
-        imp = -(1.0 + restitution) * rel * mass if rel < 0.0 else 0.0
-        push = (dist - r) * mass
-        vs[i, 0] -= imp * mi * ex
-        vs[i, 1] -= imp * mi * ey
-        vs[j, 0] += imp * mj * ex
-        vs[j, 1] += imp * mj * ey
-        ps[i, 0] -= push * mi * ex
-        ps[i, 1] -= push * mi * ey
-        ps[j, 0] += push * mj * ex
-        ps[j, 1] += push * mj * ey
+        gx = gy = 0.0
+        for k in range(start[i], start[i + 1]):
+            wt = weight(dist[k], re)
+            if wt == 0.0:
+                continue
+            j = nbr[k]
+            q = wt / (dist[k] * dist[k])
+            gx += q * (pos[j, 0] - pos[i, 0])
+            gy += q * (pos[j, 1] - pos[i, 1])
+        dx = -coeff * l0 * l0 * a * gx
+        dy = -coeff * l0 * l0 * a * gy
+        if surf[i]:
+            d = dx * normal[i, 0] + dy * normal[i, 1]
+            dx -= d * normal[i, 0]
+            dy -= d * normal[i, 1]
+        L = np.hypot(dx, dy)
+        if L > 0.2 * l0:
+            dx *= 0.2 * l0 / L
+            dy *= 0.2 * l0 / L
+        out[i, 0] = dx
+        out[i, 1] = dy
+    return out
 
 
-@njit(**JIT)
-def predict(pos, vel, kind, box, dt, gx, gy, nu, re_n, re_g, re_l, n0_n, n0_g, n0_l, lam, beta, rho0, source, gamma,
-            relax, sound, coll_dist, restitution, dist_thr=0.0):
-    """Explicit half of a step (eq. 3) and the pressure equation at the moved positions.
-
-    Fluid: V* = V + dt (nu lap V + g), U* = U + dt V* (walls fixed), then the
-    collision model if coll_dist > 0 (cm; see collide).  Then at U*: n* (radius
-    re_n), div V* (re_g), free surface (n* < beta n0 and, if dist_thr > 0 [cm], a
-    component of sum_j r_ij over the neighbours beyond dist_thr: MPS-Basic's
-    particle-distribution test; fluid and wall particles get Dirichlet P = 0), source term (relax: relaxation of the standard
-    source) and the CSR system (see assemble) with the compressibility term
-    1 / (rho0 c^2 dt^2) of sound speed ``sound`` [cm/s] (0: none).
-    Returns (pos*, vel*, n*, div*, dirichlet, (pi, pj, m) at U*, (row, indptr, indices, data, rhs)).
-    """
-    rmax = max(re_n, re_l)
-    pi, pj, m = build_pairs(pos, box, rmax)
-    lap = laplacian(pos, vel, kind, pi, pj, m, re_l, n0_l, lam)
-    ps = pos.copy()
-    vs = vel.copy()
-    for i in range(pos.shape[0]):
-        if kind[i] == FLUID:
-            vs[i, 0] = vel[i, 0] + dt * (nu * lap[i, 0] + gx)
-            vs[i, 1] = vel[i, 1] + dt * (nu * lap[i, 1] + gy)
-            ps[i, 0] = pos[i, 0] + dt * vs[i, 0]
-            ps[i, 1] = pos[i, 1] + dt * vs[i, 1]
-    if coll_dist > 0.0:
-        pi, pj, m = build_pairs(ps, box, coll_dist)
-        collide(ps, vs, kind, pi, pj, m, coll_dist, restitution)
-    pi, pj, m = build_pairs(ps, box, rmax)
-    dist = pair_distances(ps, pi, pj, m)
-    n_star = number_density_of_pairs(ps.shape[0], dist, pi, pj, m, re_n)
-    div = divergence(ps, vs, pi, pj, m, re_g, n0_g)
-    dirichlet = np.zeros(pos.shape[0], np.bool_)
-    b = np.zeros(pos.shape[0])
-    offsets = neighbour_offset_sum(ps, pi, pj, m, rmax)
-    for i in range(pos.shape[0]):
-        if kind[i] != DUMMY:
-            dirichlet[i] = n_star[i] < beta * n0_n
-            if dirichlet[i] and dist_thr > 0.0:
-                dirichlet[i] = abs(offsets[i, 0]) > dist_thr or abs(offsets[i, 1]) > dist_thr
-            b[i] = source_term(n_star[i], div[i], n0_n, rho0, dt, source, gamma, relax)
-    extra = 0.0
-    if sound > 0.0:  # alpha / dt^2 with alpha = 1 / (rho0 c^2), times the row scale lambda n0 rho0 / (2 d)
-        extra = lam * n0_l / (2.0 * DIM * sound**2 * dt**2)
-    system = assemble_pairs(dist, kind, dirichlet, b, pi, pj, m, re_l, n0_l, lam, extra)
-    return ps, vs, n_star, div, dirichlet, pi, pj, m, system
-
-
-@njit(**JIT)
-def correct(pos_old, ps, vs, p, kind, pi, pj, m, re_g, n0_g, rho0, dt, walls, box, graze):
-    """Pressure half of a step (eqs. 4-5): V' = -dt / rho0 grad P, U' = dt V'.
-
-    Returns (pos, vel, grad P (N, 2), bad, deepest graze [cm]): bad = (kind of
-    failure, particle, wall): 0 fine, 1 non-finite, 2 crossed a wall (from
-    pos_old) and ended more than ``graze`` [cm] from it, 3 more than ``graze``
-    outside the box.  A
-    crossing that ends within ``graze`` of the wall segment is a graze: its
-    distance is returned (0.0 when there is none), the step goes on.
-    """
-    g = gradient(ps, p, kind, pi, pj, m, re_g, n0_g)
+@njit(**PAR)
+def update(ps, vs, kind, g, rho0, dt):
+    """Pressure half (eqs. 4-5): V = V* - dt / rho0 grad P, U = U* + dt (V - V*) for the fluid."""
     pos = ps.copy()
     vel = vs.copy()
-    bad = (0, -1, -1)
-    deepest = 0.0
-    for i in range(pos.shape[0]):
+    for i in prange(ps.shape[0]):
         if kind[i] != FLUID:
             continue
         vel[i, 0] = vs[i, 0] - dt / rho0 * g[i, 0]
         vel[i, 1] = vs[i, 1] - dt / rho0 * g[i, 1]
         pos[i, 0] = ps[i, 0] - dt * dt / rho0 * g[i, 0]
         pos[i, 1] = ps[i, 1] - dt * dt / rho0 * g[i, 1]
-        if bad[0] != 0:
+    return pos, vel
+
+
+@njit(**JIT)
+def check(pos_old, pos, vel, kind, walls, box, graze):
+    """First bad particle of a step: (kind of failure, particle, wall), deepest graze [cm].
+
+    0 fine, 1 non-finite position or velocity, 2 crossed a wall (from pos_old) and ended more than
+    ``graze`` [cm] from it, 3 more than ``graze`` outside the box (4,).  A crossing that ends within
+    ``graze`` of the wall segment is a graze: its depth is returned, the step goes on."""
+    bad = (0, -1, -1)
+    deepest = 0.0
+    for i in range(pos.shape[0]):
+        if kind[i] != FLUID:
             continue
         if not (np.isfinite(pos[i, 0]) and np.isfinite(pos[i, 1]) and np.isfinite(vel[i, 0]) and np.isfinite(vel[i, 1])):
-            bad = (1, i, -1)
-            continue
+            return (1, i, -1), deepest
         w = crossed_wall(pos_old[i, 0], pos_old[i, 1], pos[i, 0], pos[i, 1], walls)
         if w >= 0:
             cx, cy = segment_closest(pos[i, 0], pos[i, 1], walls[w, 0], walls[w, 1], walls[w, 2], walls[w, 3])
             depth = np.hypot(pos[i, 0] - cx, pos[i, 1] - cy)
             if depth > graze:
-                bad = (2, i, w)
-            else:
-                deepest = max(deepest, depth)
+                return (2, i, w), deepest
+            deepest = max(deepest, depth)
         elif (pos[i, 0] < box[0] - graze or pos[i, 0] > box[2] + graze or pos[i, 1] < box[1] - graze
               or pos[i, 1] > box[3] + graze):
-            bad = (3, i, -1)
-    return pos, vel, g, bad, deepest
+            return (3, i, -1), deepest
+    return bad, deepest

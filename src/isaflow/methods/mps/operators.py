@@ -2,20 +2,26 @@
 
 - weight w(r) = r_e / r - 1 for r < r_e, else 0;
 - number density n_i = sum_j w(r_ij);
-- gradient <grad phi>_i = d / n0 sum_j (phi_j - phi^_i) r_ij / |r_ij|^2 w(r_ij),
-  phi^_i = min(phi_i, phi_j over neighbours) (K&O 1996's stabilised pressure gradient);
+- gradient <grad phi>_i = d / n0 sum_j (phi_j - phi^_i) r_ij / |r_ij|^2 w(r_ij), phi^_i = min(phi_i, phi_j)
+  (K&O 1996's stabilised pressure gradient), or with the corrective matrix (Khayyer & Gotoh 2011);
 - Laplacian <lap phi>_i = 2 d / (lambda n0) sum_j (phi_j - phi_i) w(r_ij);
 - divergence <div u>_i = d / n0 sum_j (u_j - u_i) . r_ij / |r_ij|^2 w(r_ij).
-r_ij = r_j - r_i; pairs from core.neighbours.build_pairs (read as np.uint32: numba then indexes without
-its negative-index wraparound).  Particle kinds: FLUID,
-WALL (in the pressure equation and the gradient), DUMMY (number density only).
+r_ij = r_j - r_i.  Particle kinds: FLUID, WALL (in the pressure equation and the gradient), DUMMY (number
+density only).
+
+Neighbours are full per-particle lists (CSR: start (N+1,), nbr (M,)), built and used by gathering: every
+pass computes particle i's value from its own row in a fixed order, so the loops over particles run in
+parallel (numba prange) and give bit-identical results for any thread count.  Visibility across thin walls
+(a dividing wall with particles behind both faces, boundary.py): a thin wall's face particles are seen only
+from their own side of the wall, and no pair sees across a thin wall segment.
 Units: cm, s, density N s^2 / cm^4 (2D), pressure N / cm^2.
 """
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 JIT = dict(cache=True, nogil=True)
+PAR = dict(cache=True, nogil=True, parallel=True)
 FLUID, WALL, DUMMY = 0, 1, 2
 DIM = 2
 
@@ -43,117 +49,304 @@ def lattice_constants(re_over_l0, l0=1.0):
     return float(wts.sum()), float((r**2 * wts).sum() / wts.sum() * l0**2)
 
 
-@njit(**JIT)
-def pair_distances(pos, pi, pj, m):
-    """(m,) distance |r_j - r_i| [cm] of every pair (np.hypot), for operators sharing one pair list."""
-    dist = np.empty(m)
-    for k in range(m):
-        i, j = np.uint32(pi[k]), np.uint32(pj[k])
-        dist[k] = np.hypot(pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1])
-    return dist
+# --- neighbour lists ------------------------------------------------------------------------------------
+
+
+@njit(inline="always", **JIT)
+def side_of(x, y, seg):
+    """+1 if (x, y) is on the left (the given orientation's liquid side) of segment seg (4,) or on it, else -1."""
+    c = (seg[2] - seg[0]) * (y - seg[1]) - (seg[3] - seg[1]) * (x - seg[0])
+    return 1 if c >= 0.0 else -1
+
+
+@njit(inline="always", **JIT)
+def segments_cross(x0, y0, x1, y1, seg):
+    """True if segment (x0, y0)-(x1, y1) meets segment seg (4,) (touching counts)."""
+    ex = seg[2] - seg[0]
+    ey = seg[3] - seg[1]
+    s0 = ex * (y0 - seg[1]) - ey * (x0 - seg[0])
+    s1 = ex * (y1 - seg[1]) - ey * (x1 - seg[0])
+    if s0 * s1 > 0.0:
+        return False
+    mx = x1 - x0
+    my = y1 - y0
+    t0 = mx * (seg[1] - y0) - my * (seg[0] - x0)
+    t1 = mx * (seg[3] - y0) - my * (seg[2] - x0)
+    return t0 * t1 <= 0.0
+
+
+@njit(inline="always", **JIT)
+def visible(i, j, pos, tw, tside, near, thin):
+    """Whether particles i and j see each other across the thin walls thin (T, 4).
+
+    tw (N,) the thin wall a face particle belongs to (-1: none), tside (N,) its face (+1 / -1);
+    near (N,) int64 bit t set when the particle is within reach of thin wall t.  A face particle of
+    thin wall t is seen only by particles on its face's side of t (face particles: their face);
+    any other pair is cut when the segment between them meets t.
+    """
+    if tw[i] < 0 and tw[j] < 0 and (near[i] & near[j]) == 0:
+        return True
+    for t in range(thin.shape[0]):
+        if tw[i] == t or tw[j] == t:
+            si = tside[i] if tw[i] == t else side_of(pos[i, 0], pos[i, 1], thin[t])
+            sj = tside[j] if tw[j] == t else side_of(pos[j, 0], pos[j, 1], thin[t])
+            if si != sj:
+                return False
+        elif (near[i] >> t) & 1 and (near[j] >> t) & 1:
+            if segments_cross(pos[i, 0], pos[i, 1], pos[j, 0], pos[j, 1], thin[t]):
+                return False
+    return True
 
 
 @njit(**JIT)
-def number_density(pos, pi, pj, m, re):
-    """(N,) number density of every particle from the pair list (pairs beyond r_e ignored)."""
-    return number_density_of_pairs(pos.shape[0], pair_distances(pos, pi, pj, m), pi, pj, m, re)
+def cell_sort(pos, box, rc):
+    """Counting sort of the particles into square-ish cells >= rc over box (4,) cm (outside: clamped).
+
+    Returns (order (N,) particles cell by cell, ascending within a cell; cstart (C + 1,); cell (N,);
+    ncx, ncy)."""
+    n = pos.shape[0]
+    ncx = max(1, int((box[2] - box[0]) / rc))
+    ncy = max(1, int((box[3] - box[1]) / rc))
+    csx = (box[2] - box[0]) / ncx
+    csy = (box[3] - box[1]) / ncy
+    cell = np.empty(n, np.int64)
+    cstart = np.zeros(ncx * ncy + 1, np.int64)
+    for i in range(n):
+        cx = min(ncx - 1, max(0, int((pos[i, 0] - box[0]) / csx)))
+        cy = min(ncy - 1, max(0, int((pos[i, 1] - box[1]) / csy)))
+        cell[i] = cy * ncx + cx
+        cstart[cell[i] + 1] += 1
+    for c in range(ncx * ncy):
+        cstart[c + 1] += cstart[c]
+    fill = cstart[:-1].copy()
+    order = np.empty(n, np.int64)
+    for i in range(n):
+        order[fill[cell[i]]] = i
+        fill[cell[i]] += 1
+    return order, cstart, cell, ncx, ncy
 
 
-@njit(**JIT)
-def number_density_of_pairs(n_particles, dist, pi, pj, m, re):
-    """number_density from the pair distances dist (see pair_distances)."""
-    n = np.zeros(n_particles)
-    for k in range(m):
-        wt = weight(dist[k], re)
-        n[np.uint32(pi[k])] += wt
-        n[np.uint32(pj[k])] += wt
-    return n
-
-
-@njit(**JIT)
-def neighbour_offset_sum(pos, pi, pj, m, rc):
-    """(N, 2) sum_j (r_j - r_i) [cm] over all neighbours closer than rc (MPS-Basic's particle-distribution test)."""
-    out = np.zeros((pos.shape[0], 2))
-    for k in range(m):
-        i, j = np.uint32(pi[k]), np.uint32(pj[k])
-        dx = pos[j, 0] - pos[i, 0]
-        dy = pos[j, 1] - pos[i, 1]
-        if dx * dx + dy * dy < rc * rc:
-            out[i, 0] += dx
-            out[i, 1] += dy
-            out[j, 0] -= dx
-            out[j, 1] -= dy
+@njit(**PAR)
+def near_thin(pos, thin, reach):
+    """(N,) int64: bit t set when the particle is closer than reach [cm] to thin wall t (4,)."""
+    n = pos.shape[0]
+    out = np.zeros(n, np.int64)
+    for i in prange(n):
+        m = 0
+        for t in range(thin.shape[0]):
+            ax, ay = thin[t, 0], thin[t, 1]
+            ex, ey = thin[t, 2] - ax, thin[t, 3] - ay
+            u = ((pos[i, 0] - ax) * ex + (pos[i, 1] - ay) * ey) / (ex * ex + ey * ey)
+            u = min(1.0, max(0.0, u))
+            dx = pos[i, 0] - ax - u * ex
+            dy = pos[i, 1] - ay - u * ey
+            if dx * dx + dy * dy < reach * reach:
+                m |= np.int64(1) << t
+        out[i] = m
     return out
 
 
-@njit(**JIT)
-def divergence(pos, vel, pi, pj, m, re, n0):
-    """(N,) MPS divergence of vel [1/s] (all neighbours, wall velocity 0)."""
-    div = np.zeros(pos.shape[0])
-    for k in range(m):
-        i, j = np.uint32(pi[k]), np.uint32(pj[k])
-        dx = pos[j, 0] - pos[i, 0]
-        dy = pos[j, 1] - pos[i, 1]
-        r2 = dx * dx + dy * dy
-        wt = weight(np.sqrt(r2), re)
-        if wt == 0.0:
+@njit(**PAR)
+def neighbour_list(pos, kind, box, rc, tw, tside, thin):
+    """Full neighbour lists: every visible j != i closer than rc [cm] (dummy particles get empty rows: no
+    operator is evaluated at them).
+
+    Row i lists its neighbours cell by cell (the 3 x 3 cells around i's, rows of cells from the bottom,
+    left to right) in ascending particle order: a fixed order whatever the thread count.
+    Returns (start (N + 1,) int64, nbr (M,) int32)."""
+    n = pos.shape[0]
+    order, cstart, cell, ncx, ncy = cell_sort(pos, box, rc)
+    near = near_thin(pos, thin, rc)
+    rc2 = rc * rc
+    count = np.zeros(n + 1, np.int64)
+    for i in prange(n):
+        if kind[i] == DUMMY:
             continue
-        s = ((vel[j, 0] - vel[i, 0]) * dx + (vel[j, 1] - vel[i, 1]) * dy) / r2 * wt
-        div[i] += s
-        div[j] += s  # (u_i - u_j) . (r_i - r_j) is the same product
-    return div * (DIM / n0)
+        c = cell[i]
+        cx, cy = c % ncx, c // ncx
+        k = 0
+        for yy in range(max(0, cy - 1), min(ncy, cy + 2)):
+            for xx in range(max(0, cx - 1), min(ncx, cx + 2)):
+                cc = yy * ncx + xx
+                for q in range(cstart[cc], cstart[cc + 1]):
+                    j = order[q]
+                    dx = pos[j, 0] - pos[i, 0]
+                    dy = pos[j, 1] - pos[i, 1]
+                    if j != i and dx * dx + dy * dy < rc2 and visible(i, j, pos, tw, tside, near, thin):
+                        k += 1
+        count[i + 1] = k
+    for i in range(n):
+        count[i + 1] += count[i]
+    nbr = np.empty(count[n], np.int32)
+    for i in prange(n):
+        if kind[i] == DUMMY:
+            continue
+        c = cell[i]
+        cx, cy = c % ncx, c // ncx
+        k = count[i]
+        for yy in range(max(0, cy - 1), min(ncy, cy + 2)):
+            for xx in range(max(0, cx - 1), min(ncx, cx + 2)):
+                cc = yy * ncx + xx
+                for q in range(cstart[cc], cstart[cc + 1]):
+                    j = order[q]
+                    dx = pos[j, 0] - pos[i, 0]
+                    dy = pos[j, 1] - pos[i, 1]
+                    if j != i and dx * dx + dy * dy < rc2 and visible(i, j, pos, tw, tside, near, thin):
+                        nbr[k] = j
+                        k += 1
+    return count, nbr
 
 
-@njit(**JIT)
-def laplacian(pos, f, kind, pi, pj, m, re, n0, lam):
-    """(N, C) MPS Laplacian of f (N, C) over fluid and wall neighbours (dummies excluded)."""
+@njit(**PAR)
+def distances(pos, start, nbr):
+    """(M,) distance [cm] of every list entry at positions pos."""
+    n = pos.shape[0]
+    d = np.empty(nbr.shape[0])
+    for i in prange(n):
+        for k in range(start[i], start[i + 1]):
+            j = nbr[k]
+            d[k] = np.hypot(pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1])
+    return d
+
+
+# --- operators (gathers over the lists) ---------------------------------------------------------------------
+
+
+@njit(**PAR)
+def number_density(start, nbr, dist, re):
+    """(N,) number density sum_j w(r_ij) over every listed neighbour (fluid, wall, dummy)."""
+    n = start.shape[0] - 1
+    out = np.zeros(n)
+    for i in prange(n):
+        s = 0.0
+        for k in range(start[i], start[i + 1]):
+            s += weight(dist[k], re)
+        out[i] = s
+    return out
+
+
+@njit(**PAR)
+def divergence(pos, vel, start, nbr, dist, re, n0):
+    """(N,) MPS divergence of vel [1/s] (all neighbours; wall particles' velocity is theirs, 0)."""
+    n = pos.shape[0]
+    out = np.zeros(n)
+    for i in prange(n):
+        s = 0.0
+        for k in range(start[i], start[i + 1]):
+            wt = weight(dist[k], re)
+            if wt == 0.0:
+                continue
+            j = nbr[k]
+            dx = pos[j, 0] - pos[i, 0]
+            dy = pos[j, 1] - pos[i, 1]
+            s += ((vel[j, 0] - vel[i, 0]) * dx + (vel[j, 1] - vel[i, 1]) * dy) / (dist[k] * dist[k]) * wt
+        out[i] = s * (DIM / n0)
+    return out
+
+
+@njit(**PAR)
+def laplacian(f, kind, start, nbr, dist, re, n0, lam):
+    """(N, C) MPS Laplacian of f (N, C) at the fluid particles over fluid and wall neighbours (0 elsewhere)."""
+    n = f.shape[0]
     out = np.zeros_like(f)
-    for k in range(m):
-        i, j = np.uint32(pi[k]), np.uint32(pj[k])
-        if kind[i] == DUMMY or kind[j] == DUMMY:
+    c = 2.0 * DIM / (lam * n0)
+    for i in prange(n):
+        if kind[i] != FLUID:
             continue
-        wt = weight(np.hypot(pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1]), re)
-        for c in range(f.shape[1]):
-            d = (f[j, c] - f[i, c]) * wt
-            out[i, c] += d
-            out[j, c] -= d
-    return out * (2.0 * DIM / (lam * n0))
+        for k in range(start[i], start[i + 1]):
+            j = nbr[k]
+            if kind[j] == DUMMY:
+                continue
+            wt = weight(dist[k], re)
+            for q in range(f.shape[1]):
+                out[i, q] += (f[j, q] - f[i, q]) * wt
+        for q in range(f.shape[1]):
+            out[i, q] *= c
+    return out
 
 
-@njit(**JIT)
-def gradient(pos, p, kind, pi, pj, m, re, n0):
-    """(N, 2) MPS pressure gradient with p^_i = min over neighbours (K&O 1996).
+GRADIENTS = {"min": 0, "corrected": 1, "symmetric": 2}
 
-    Fluid and wall particles take part; dummy particles (no pressure) do not,
-    neither in the sum nor in the minimum (as MPS-Basic's calPressureGradient).
+
+@njit(**PAR)
+def gradient(pos, p, kind, start, nbr, dist, re, n0, mode):
+    """(N, 2) MPS pressure gradient [N/cm^3] at the fluid particles (0 elsewhere), over fluid and wall
+    neighbours (not dummies).  mode (GRADIENTS): 0 K&O 1996, sum (p_j - p^_i), p^_i the minimum of p_i and
+    its neighbours' (MPS-Basic's calPressureGradient); 1 the same with the corrective matrix
+    C_i = (d/n0 sum_j w r_ij r_ij^T / r^2)^-1 (Khayyer & Gotoh 2011; the plain sum where det C_i^-1 < 0.01);
+    2 sum (p_i + p_j) (pairwise antisymmetric: momentum-conserving).
     """
     n = pos.shape[0]
     pmin = p.copy()
-    for k in range(m):
-        i, j = np.uint32(pi[k]), np.uint32(pj[k])
-        if kind[i] == DUMMY or kind[j] == DUMMY:
+    if mode != 2:
+        for i in prange(n):
+            if kind[i] == DUMMY:
+                continue
+            m = p[i]
+            for k in range(start[i], start[i + 1]):
+                j = nbr[k]
+                if kind[j] != DUMMY and dist[k] < re:
+                    m = min(m, p[j])
+            pmin[i] = m
+    out = np.zeros((n, 2))
+    a = DIM / n0
+    for i in prange(n):
+        if kind[i] != FLUID:
             continue
-        if np.hypot(pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1]) < re:
-            pmin[i] = min(pmin[i], p[j])
-            pmin[j] = min(pmin[j], p[i])
-    g = np.zeros((n, 2))
-    for k in range(m):
-        i, j = np.uint32(pi[k]), np.uint32(pj[k])
-        dx = pos[j, 0] - pos[i, 0]
-        dy = pos[j, 1] - pos[i, 1]
-        if kind[i] == DUMMY or kind[j] == DUMMY:
-            continue
-        r2 = dx * dx + dy * dy
-        wt = weight(np.sqrt(r2), re)
-        if wt == 0.0:
-            continue
-        a = (p[j] - pmin[i]) / r2 * wt
-        b = (p[i] - pmin[j]) / r2 * wt
-        g[i, 0] += a * dx
-        g[i, 1] += a * dy
-        g[j, 0] -= b * dx
-        g[j, 1] -= b * dy
-    return g * (DIM / n0)
+        gx = gy = 0.0
+        mxx = mxy = myy = 0.0
+        for k in range(start[i], start[i + 1]):
+            j = nbr[k]
+            if kind[j] == DUMMY:
+                continue
+            wt = weight(dist[k], re)
+            if wt == 0.0:
+                continue
+            dx = pos[j, 0] - pos[i, 0]
+            dy = pos[j, 1] - pos[i, 1]
+            r2 = dist[k] * dist[k]
+            if mode <= 1:
+                q = (p[j] - pmin[i]) / r2 * wt
+            else:
+                q = (p[j] + p[i]) / r2 * wt
+            gx += q * dx
+            gy += q * dy
+            mxx += dx * dx / r2 * wt
+            mxy += dx * dy / r2 * wt
+            myy += dy * dy / r2 * wt
+        gx *= a
+        gy *= a
+        if mode == 1:
+            mxx *= a
+            mxy *= a
+            myy *= a
+            det = mxx * myy - mxy * mxy
+            if det > 0.01:
+                gx, gy = (myy * gx - mxy * gy) / det, (mxx * gy - mxy * gx) / det
+        out[i, 0] = gx
+        out[i, 1] = gy
+    return out
+
+
+@njit(**PAR)
+def offsets(pos, start, nbr, dist, rc, re):
+    """((N, 2) sum_j r_ij [cm] over neighbours closer than rc (MPS-Basic's particle-distribution test),
+    (N, 2) sum_j w(r_ij; re) r_ij [cm]: points from a surface particle into the liquid)."""
+    n = pos.shape[0]
+    s = np.zeros((n, 2))
+    sw = np.zeros((n, 2))
+    for i in prange(n):
+        for k in range(start[i], start[i + 1]):
+            j = nbr[k]
+            dx = pos[j, 0] - pos[i, 0]
+            dy = pos[j, 1] - pos[i, 1]
+            if dist[k] < rc:
+                s[i, 0] += dx
+                s[i, 1] += dy
+            wt = weight(dist[k], re)
+            sw[i, 0] += wt * dx
+            sw[i, 1] += wt * dy
+    return s, sw
 
 
 @njit(**JIT)
@@ -172,3 +365,4 @@ def probe_pressure(pos, p, kind, probes, re):
         if sw > 0.0:
             out[k] = sp / sw
     return out
+

@@ -68,44 +68,37 @@ def claims(df):
                  + "; standard (relaxed): " + ", ".join(f"{r.panel_noise_rel:.3f}" for r in std.itertuples()),
         verdict="not testable here (the paper states no property of eq. (6) beyond its derivation; the runs only show how it behaves)",
         evidence="results/mps/summary.csv, figures/mps_wall_loads.png",
-        why="eq. (6) is implemented literally (Rho* = rho0 n*/n0), so at rest it is the unrelaxed standard source"))
+        why="eq. (6) is implemented with Rho* = rho0 n*/n0 and the relaxation every source term gets (model.relax_all_sources), "
+            "so at rest it is the standard source"))
     return pd.DataFrame(rows, columns=CLAIM_COLUMNS)
 
 
 def findings(df):
     """Paragraph on rest and escapes, numbers from the table."""
-    single, flow = df[df.case == "single"], df[df.case == "flow"]
-    full = single[single.status != "escaped"]
+    single, flows = df[df.case == "single"], df[df.case == "flow"]
     out = []
-    if len(full):
-        kin = full.rms_speed_cm_s**2 / (2 * 981.0 * full.spacing_cm)
-        out.append(f"No single-vessel run comes to rest ({int((single.status == 'converged').sum())} of {len(single)}).  In the "
-                   f"{len(full)} that run the full {full.sim_time_s.max():.2g} s, after the start transient the rms speed falls to "
-                   f"{full.min_rms_speed_cm_s.min():.2g}-{full.min_rms_speed_cm_s.max():.2g} cm/s and then grows again, to "
-                   f"{full.rms_speed_cm_s.min():.3g}-{full.rms_speed_cm_s.max():.3g} cm/s at the end, a particle-scale disorder with no resolution trend "
-                   f"(figures/mps_rest.png); its kinetic pressure rho u^2/2 is {100 * kin.min():.2g}-{100 * kin.max():.2g} % of "
-                   "rho g l0.  MPS has no damping but the water viscosity, and the neighbourhood-minimum gradient and the "
-                   "density-error source keep feeding it (the known pressure noise of MPS).")
-    esc = single[single.status == "escaped"]
+    if len(single):
+        at_rest = single[single.status == "converged"]
+        moving = single[single.status != "converged"]
+        out.append(f"Single vessel: {len(at_rest)} of {len(single)} runs at rest (isaflow.rest: kinetic energy / (W h) "
+                   f"below {single.rest_energy_ratio.iloc[0]:g} for the rest window).")
+        if len(moving):
+            out.append(f"The others end at the time limit ({moving.sim_time_s.max():.3g} s) with kinetic energy / (W h) "
+                       f"{moving.energy_ratio.min():.2g}-{moving.energy_ratio.max():.2g} (rms speed "
+                       f"{moving.rms_speed_cm_s.min():.3g}-{moving.rms_speed_cm_s.max():.3g} cm/s; figures/mps_rest.png).")
+    esc = df[df.status == "escaped"]
     if len(esc):
-        out.append("Escaped single runs: " + "; ".join(f"{r.run} ({r.message}, t = {r.sim_time_s:.3g} s)" for r in esc.itertuples())
-                   + ".  With the mixed source the density term is weighted by gamma_mixed only, so the compression that "
-                   "raises the wall particles' pressure builds up slowly: the wall particles by the bottom-left corner stay "
-                   "below the pressure of the liquid particle in the corner, which creeps into the corner at a few cm/s "
-                   "until it crosses the wall line.")
-    esc_flow = flow[flow.status == "escaped"]
-    if len(esc_flow):
-        out.append("Escaped flow runs (their measures are those of that moment, not of a drained state): "
-                   + "; ".join(f"{r.run}: {r.message}, t = {r.sim_time_s:.3g} s" for r in esc_flow.itertuples()) + ".")
+        out.append("Escaped runs (measures are those of that moment): " + "; ".join(
+            f"{r.run} ({r.tank}): {r.message}, t = {r.sim_time_s:.3g} s" for r in esc.itertuples()) + ".")
+    if len(flows):
+        out.append(f"Flows: {int((flows.status != 'escaped').sum())} of {len(flows)} without escape; each continues its "
+                   "single run's final state (start_state).")
     grazed = df[df.graze_steps > 0]
     if len(grazed):
         deep = grazed.loc[grazed.deepest_graze_cm.idxmax()]
         out.append(f"Wall-line grazes (a move across a wall line ending within l0/2 of the wall, i.e. short of the first "
                    f"wall-particle row; counted, not escapes) occur in {len(grazed)} of {len(df)} runs, the deepest "
-                   f"{deep.deepest_graze_cm:.2g} cm ({deep.deepest_graze_cm / deep.spacing_cm:.0%} of l0, {deep.run}): "
-                   "the liquid leaving over the end of floor1 (a convex corner) cuts the corner, whose wall particles "
-                   "have n* < beta n0, are free-surface (P = 0) and push nothing back, and the falling jet overshoots "
-                   "the second floor's line before the wall particles stop it.")
+                   f"{deep.deepest_graze_cm:.2g} cm ({deep.deepest_graze_cm / deep.spacing_cm:.0%} of l0, {deep.run}).")
     return "  ".join(out)
 
 
@@ -139,35 +132,36 @@ def fragment(df, cfg):
     single, flow, stiff = df[df.case == "single"], df[df.case == "flow"], df[df.case == "stiff"]
     lines = ["## MPS with three pressure source terms", "",
              "Koshizuka & Oka's semi-implicit MPS as the public MPS-Basic code implements it (pressure equation over "
-             "fluid and wall particles, dummies excluded, surface particles P = 0, compressibility term on the diagonal, "
-             "negative pressures clipped, gradient with the neighbourhood minimum, collision model), on the shared tank, "
-             "with the pressure equation's source term as the variant: `standard` gamma (rho0/dt^2)(n0 - n*)/n0 "
-             f"(relaxation gamma = {cfg['model.relaxation']:g}), `hattori` (eq. 6 of Hattori et al. literally, Rho* = rho0 n*/n0 "
-             "standing in for rho0/det(dU*/dxi)) and `mixed` (Tanaka & Masunaga 2010).  For a liquid at rest div V* is "
-             "about 0, so `hattori` reduces to the unrelaxed standard source on the tank; the flow is where they differ.  "
-             "Wall loads are the first wall row's pressures integrated over 10 cm panels, averaged over the last "
-             f"{cfg['time.average_window']:g} s; noise is the std over that window.  At rest means rms speed below "
-             f"sqrt(2 x {cfg['time.rest_fraction']:g} g l0) (kinetic pressure below {100 * cfg['time.rest_fraction']:g} % "
-             "of the hydrostatic step between neighbours).", ""]
+             "fluid and wall particles, dummies excluded, free-surface particles P = 0, compressibility term on the "
+             "diagonal, negative pressures clipped, gradient with the neighbourhood minimum, collision model), with "
+             f"K&O 1996's number-density radius {cfg['model.re_density']:g} l0 for the source term and the surface test "
+             "(only the outermost row is P = 0), wall and dummy rows behind both faces of the dividing wall (each face seen "
+             "only from its side), on the shared tank, with the pressure equation's source term as the variant: `standard` "
+             f"(rho0/dt^2)(n0 - n*)/n0, `hattori` (eq. 6 of Hattori et al., Rho* = rho0 n*/n0) and `mixed` (Tanaka & "
+             f"Masunaga 2010, gamma_m = {cfg['model.gamma_mixed']:g}), each multiplied by MPS-Basic's relaxation "
+             f"{cfg['model.relaxation']:g}.  For a liquid at rest div V* is about 0, so `hattori` is the standard source "
+             "on the tank; the flows are where they differ.  Wall loads are the first wall row's pressures integrated over "
+             f"10 cm panels, averaged over the last {cfg['time.average_window']:g} s; noise is the std over that window.  "
+             "Rest: isaflow.rest (one criterion for every dynamic method).", ""]
     by_term = single.groupby("source_term", sort=False).agg(
         runs=("run", "size"), at_rest=("status", lambda x: int((x == "converged").sum())),
-        escaped=("status", lambda x: int((x == "escaped").sum())), side_err_min=("side_err", "min"),
-        side_err_max=("side_err", "max"), panel_rms_median=("contact_rms", "median"),
+        escaped=("escapes", "sum"), side_err_min=("side_err_3262", "min"), side_err_max=("side_err_3262", "max"),
+        rms_min=("rms_speed_cm_s", "min"), rms_max=("rms_speed_cm_s", "max"),
         noise_median=("panel_noise_rel", "median")).reset_index()
     lines += ["Single vessel, per source term over the spacings "
               f"{', '.join(f'{x:.3g}' for x in sorted(single.spacing_cm.unique(), reverse=True))} cm (every run: "
-              f"[`docs/tables/{SINGLE_TABLE}`](tables/{SINGLE_TABLE})):", ""]
+              f"[`docs/tables/{SINGLE_TABLE}`](tables/{SINGLE_TABLE})); side load against rho g h^2 / 2 = 3262.5 N:", ""]
     lines += _table(by_term, [("source_term", None), ("runs", g), ("at_rest", g), ("escaped", g), ("side_err_min", g),
-                              ("side_err_max", g), ("panel_rms_median", g), ("noise_median", g)],
-                    ["source term", "runs", "at rest", "escaped", "side err min", "side err max",
-                     "panel rms err (median)", "panel noise std/mean (median)"])
-    lines += [""] + _table(flow, [("run", None), ("status", None), ("sim_time_s", g), ("mass_left_frac", g), ("level", g),
-                                  ("slope_deg", g), ("panel_noise_rel", g), ("time_to_rest_s", g), ("message", None),
-                                  ("escape_depth_cm", g)],
-                           ["flow run", "status", "t end s", "mass left (fraction)", "second-vessel level cm", "slope deg",
-                            "panel noise", "time to rest s", "why it stopped", "depth behind the wall cm"])
+                              ("side_err_max", g), ("rms_min", g), ("rms_max", g), ("noise_median", g)],
+                    ["source term", "runs", "at rest", "escaped", "side err min", "side err max", "final rms min cm/s",
+                     "final rms max cm/s", "panel noise std/mean (median)"])
+    lines += [""] + _table(flow, [("run", None), ("tank", None), ("status", None), ("sim_time_s", g), ("mass_left_frac", g),
+                                  ("level", g), ("rms_speed_cm_s", g), ("time_to_rest_s", g), ("graze_steps", g),
+                                  ("message", None)],
+                           ["flow run", "tank", "status", "t end s", "mass left (fraction)", "second-vessel level cm",
+                            "final rms cm/s", "time to rest s", "graze steps", "why it stopped"])
     lines += ["", "Stiff and extreme cases (standard source, single vessel, "
-              f"l0 = {cfg['stiff.spacing']:g} cm, {cfg['stiff.duration']:g} s): large_dt Courant "
+              f"l0 = {cfg['stiff.spacing']:.3g} cm, {cfg['stiff.duration']:g} s): large_dt Courant "
               f"{cfg['stiff.courant_large']:g}; small_re all radii {cfg['stiff.re_small']:g} l0; no_relaxation gamma = "
               f"{cfg['stiff.relaxation_none']:g} (K&O 1996 literally); on_wall one particle started at "
               f"{tuple(cfg['stiff.on_wall_point'])} cm on the floor.", ""]
@@ -191,17 +185,21 @@ def fragment(df, cfg):
 
 
 def cost(bench, target_n=5000, target_ms=50.0):
-    """Sentence on the step-cost benchmark (benchmarks/results/mps_step_cost.csv): per solver the step time
-    [ms] at the size nearest target_n liquid particles, split into predict / solve / correct, against the target."""
+    """Sentence on the step-cost benchmark (benchmarks/results/mps_step_cost.csv): per solver and thread count the
+    step time [ms] at the size nearest target_n liquid particles, split into predict / solve / correct, against the
+    target."""
     b = pd.read_csv(bench)
+    if "threads" not in b:
+        b["threads"] = 1
     n = b.liquid_particles.iloc[(b.liquid_particles - target_n).abs().argmin()]
     rows = b[b.liquid_particles == n].sort_values("step_ms")
-    parts = [f"`{r.solver}` {r.step_ms:.3g} ms ({r.predict_ms:.3g} + {r.solve_ms:.3g} + {r.correct_ms:.3g})" for r in rows.itertuples()]
+    parts = [f"`{r.solver}` ({r.threads} thread{'s' if r.threads > 1 else ''}) {r.step_ms:.3g} ms "
+             f"({r.predict_ms:.3g} + {r.solve_ms:.3g} + {r.correct_ms:.3g})" for r in rows.itertuples()]
     big = b[b.liquid_particles == b.liquid_particles.max()].sort_values("step_ms").iloc[0]
-    return (f"Step cost (benchmarks/bench_mps.py, one core, shared machine; predict + solve + correct) at {n} liquid "
+    return (f"Step cost (benchmarks/bench_mps.py, shared 2-core machine; predict + solve + correct) at {n} liquid "
             f"particles: " + "; ".join(parts) + f".  Target {target_ms:g} ms: "
             + ("met" if rows.step_ms.min() <= target_ms else "not met") + f" (best {rows.step_ms.min():.3g} ms).  At "
-            f"{big.liquid_particles} particles the fastest is `{big.solver}`, {big.step_ms:.4g} ms per step.")
+            f"{big.liquid_particles} particles the fastest is `{big.solver}` ({big.threads} threads), {big.step_ms:.4g} ms per step.")
 
 
 def timing(df, cfg, bench):
@@ -215,8 +213,9 @@ def timing(df, cfg, bench):
 
 
 SINGLE_TABLE = "mps_single.csv"  # every single-vessel run, next to the report
-SINGLE_COLUMNS = ["run", "source_term", "spacing_cm", "particles", "status", "side_err", "floor_err", "contact_rms",
-                  "panel_noise_rel", "rms_speed_cm_s", "rest_speed_cm_s", "graze_steps", "deepest_graze_cm"]
+SINGLE_COLUMNS = ["run", "source_term", "spacing_cm", "particles", "status", "side_err_3262", "side_err", "floor_err",
+                  "contact_rms", "panel_noise_rel", "rms_speed_cm_s", "energy_ratio", "time_to_rest_s", "escapes",
+                  "graze_steps", "deepest_graze_cm"]
 
 
 def write(summary, cfg, bench, outputs):

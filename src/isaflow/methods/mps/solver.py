@@ -1,16 +1,24 @@
-"""MPS time stepping on a tank: solve(tank, settings, variant, spacing) -> contract.Result.
+"""MPS time stepping on a tank: solve(tank, settings, variant, spacing, ...) -> contract.Result.
 
-Per step: model.predict (numba: explicit step, number density, source, CSR
-system), pressure.solve (scipy / pyamg), model.correct (numba: gradient,
-velocity and position correction, wall-crossing check).  The pressure solve
-is a sparse-library call, so the step loop runs in Python around two compiled
-halves.  Units: cm, N, s; pressure N/cm^2 (2D, per cm of thickness).
+Per step (model.py, numba, every particle loop a gather run in parallel): neighbour list, explicit step,
+collision model, free surface and source term, pressure equation (pressure.py), pressure correction,
+particle shifting, wall-crossing check.  The step loop runs in Python around compiled stages.
+Rest: isaflow.rest (one criterion for every dynamic method).  Units: cm, N, s; pressure N/cm^2
+(2D, per cm of thickness).
 """
 
+import os
 import time
 
+# numba's OpenMP threads spin while waiting by default; on a shared (oversubscribed) machine that made every
+# parallel loop of a 2-thread run wait for a scheduler time slice (11.7 ms per loop instead of 11 us).  Passive
+# waiting is set before numba starts its threads (the first parallel loop), unless the environment says otherwise.
+os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
+
+import numba
 import numpy as np
 
+from isaflow import rest
 from isaflow.contract import Result
 from isaflow.core import units
 from isaflow.core.geometry import bounding_box
@@ -27,11 +35,12 @@ def vessels(tank):
 
 
 def first_vessel(tank):
-    """(x range (cm, cm), floor y cm) of the tank's first vessel (floor: horizontal wall spanning it)."""
+    """(x range (cm, cm), floor y cm) of the tank's first vessel (floor: the highest horizontal wall spanning it
+    with the liquid above, i.e. running in +x)."""
     x0, x1 = vessels(tank)[0][1]
     w = tank.walls
     span = np.minimum(np.maximum(w[:, 0], w[:, 2]), x1) - np.maximum(np.minimum(w[:, 0], w[:, 2]), x0)
-    floors = np.isclose(w[:, 1], w[:, 3]) & (span > 0)
+    floors = np.isclose(w[:, 1], w[:, 3]) & (span > 0) & (w[:, 2] > w[:, 0])
     return (x0, x1), float(w[floors, 1].max())
 
 
@@ -42,24 +51,43 @@ def time_step(tank, l0, courant):
     return courant * l0 / np.sqrt(2.0 * units.G * H)
 
 
+def rows_depth(tank, l0):
+    """Depth [cm] of the initial liquid block: tank.depth rounded to whole rows of l0 (boundary.liquid_block)."""
+    return max(1, int(round(tank.depth / l0))) * l0
+
+
 class State:
     """Particles and constants of one run (fluid first, then wall and dummy particles)."""
 
     def __init__(self, tank, cfg, l0, fluid_pos, fluid_vel):
+        self.cfg = cfg
         self.l0 = l0
-        self.walls = tank.walls
+        self.walls = np.asarray(tank.walls, float)
         self.nf = len(fluid_pos)
+        self.thin_mask = boundary.thin_walls(self.walls, vessels(tank))
         layers = cfg["model.pressure_layers"] + cfg["model.dummy_layers"]
         self.pos, self.kind, self.bnd = boundary.assemble_particles(fluid_pos, self.walls, l0, layers,
-                                                                    cfg["model.pressure_layers"])
+                                                                    cfg["model.pressure_layers"], self.thin_mask)
+        n = len(self.pos)
+        thin_idx = np.full(len(self.walls), -1, np.int64)
+        thin_idx[self.thin_mask] = np.arange(self.thin_mask.sum())
+        self.thin = self.walls[self.thin_mask].copy()
+        self.tw = np.full(n, -1, np.int64)  # thin wall of each face particle
+        self.tside = np.ones(n, np.int64)
+        self.tw[self.nf:] = thin_idx[self.bnd["wall"]]
+        self.tside[self.nf:] = self.bnd["side"]
         self.vel = np.zeros_like(self.pos)
         self.vel[: self.nf] = fluid_vel
-        self.p = np.zeros(len(self.pos))
+        self.p = np.zeros(n)
         self.re_n = cfg["model.re_density"] * l0
         self.re_g = cfg["model.re_gradient"] * l0
         self.re_l = cfg["model.re_laplacian"] * l0
+        self.re_s = cfg["model.re_surface"] * l0
+        self.rmax = max(self.re_n, self.re_g, self.re_l, self.re_s)
+        self.skin = cfg["model.list_skin"] * l0
         self.n0_n, _ = model.lattice_constants(cfg["model.re_density"], l0)
         self.n0_g, _ = model.lattice_constants(cfg["model.re_gradient"], l0)
+        self.n0_s, _ = model.lattice_constants(cfg["model.re_surface"], l0)
         self.n0_l, self.lam = model.lattice_constants(cfg["model.re_laplacian"], l0)
         self.weight = tank.weight / self.nf  # N per particle
         self.rho0 = self.weight / units.G / l0**2  # N s^2 / cm^4
@@ -69,7 +97,29 @@ class State:
         self.escape_box = box
         self.graze_depth = cfg["walls.graze_depth"] * l0  # cm: deeper crossings are escapes
         self.grazes, self.deepest_graze = 0, 0.0  # steps with a graze, deepest graze [cm]
-        self.panel_wall, self.panel_centre, self.load_matrix = boundary.load_map(self.walls, self.bnd, cfg["walls.panel_length"])
+        self.panel_wall, self.panel_centre, self.panel_side, self.load_matrix = boundary.load_map(
+            self.walls, self.bnd, cfg["walls.panel_length"])
+        self.surface_mode = model.SURFACE[cfg["model.surface_pressure"]]
+        self.grad_mode = model.GRADIENTS[cfg["model.gradient"]]
+        self.builds = 0
+        self.start = self.nbr = self.list_pos = None
+        self.surf = np.zeros(n, bool)
+        self.solve_error = ""
+
+    def neighbours(self, pos):
+        """Neighbour lists at pos, radius rmax + skin (start, nbr); reused until a particle has moved more
+        than skin / 2 from where it was at the build (list_valid), so every pair closer than rmax is in them.
+        The rows' order depends on the positions at the build, so a continued run (which builds its own
+        lists) matches the run it continues to round-off, not bit for bit."""
+        self.builds += 1
+        self.list_pos = pos.copy()
+        self.start, self.nbr = model.neighbour_list(pos, self.kind, self.grid_box, self.rmax + self.skin, self.tw, self.tside,
+                                                    self.thin)
+
+    def list_valid(self, pos):
+        """The lists still hold every pair closer than rmax at pos (nobody moved more than skin / 2)."""
+        d = pos[: self.nf] - self.list_pos[: self.nf]
+        return float(np.max(d[:, 0] ** 2 + d[:, 1] ** 2, initial=0.0)) <= (0.5 * self.skin) ** 2
 
     def panel_forces(self):
         """(P, 2) force of each wall panel on the liquid [N] from the wall particles' pressures."""
@@ -77,24 +127,51 @@ class State:
 
 
 def step(s, dt, source, cfg, timers=None):
-    """Advance State s by one step.  Returns (bad, residual, iterations); bad as model.correct
+    """Advance State s by one step.  Returns (bad, residual, iterations); bad as model.check
     (kind 4: the pressure solve failed outright or gave a non-finite pressure; residual inf)."""
     t0 = time.perf_counter()
-    ps, vs, n_star, div, dirichlet, pi, pj, m, system = model.predict(
-        s.pos, s.vel, s.kind, s.grid_box, dt, 0.0, -units.G, cfg["model.kinematic_viscosity"], s.re_n, s.re_g, s.re_l,
-        s.n0_n, s.n0_g, s.n0_l, s.lam, cfg["model.beta"], s.rho0, model.SOURCES[source], cfg["model.gamma_mixed"],
-        cfg["model.relaxation"], cfg["model.sound_speed"], cfg["model.collision_distance"] * s.l0, cfg["model.restitution"],
-        cfg["model.surface_distribution"] * s.l0)
-    row, indptr, indices, data, rhs = system
+    pos_old = s.pos
+    if s.start is None or not s.list_valid(s.pos):
+        s.neighbours(s.pos)
+    nu = cfg["model.kinematic_viscosity"]
+    if nu > 0:
+        dist = model.distances(s.pos, s.start, s.nbr)
+        lap = model.laplacian(s.vel, s.kind, s.start, s.nbr, dist, s.re_l, s.n0_l, s.lam)
+    else:
+        lap = np.zeros_like(s.vel)
+    ps, vs = model.explicit(s.pos, s.vel, s.kind, lap, dt, 0.0, -units.G, nu)
+    if not s.list_valid(ps):
+        s.neighbours(ps)
+    coll = cfg["model.collision_distance"] * s.l0
+    if coll > 0.0:
+        ps, vs = model.collide(ps, vs, s.kind, s.start, s.nbr, coll, cfg["model.restitution"])
+        if not s.list_valid(ps):
+            s.neighbours(ps)
+    dist = model.distances(ps, s.start, s.nbr)
+    n_star = model.number_density(s.start, s.nbr, dist, s.re_n)
+    div = model.divergence(ps, vs, s.start, s.nbr, dist, s.re_g, s.n0_g)
+    dist_thr = cfg["model.surface_distribution"] * s.l0
+    surf, normal = model.surface(ps, s.kind, s.start, s.nbr, dist, s.re_s, s.n0_s, cfg["model.beta"], dist_thr, s.rmax)
+    b = model.source_term_all(n_star, div, s.n0_n, s.rho0, dt, model.SOURCES[source], cfg["model.gamma_mixed"],
+                              cfg["model.relaxation"], cfg["model.relax_all_sources"])
+    p_dir = np.zeros(len(ps))
+    if s.surface_mode == 1:
+        p_dir[surf] = s.rho0 * units.G * 0.5 * s.l0 * np.maximum(normal[surf, 1], 0.0)
+    elif s.surface_mode == 2:
+        p_dir = model.surface_values(ps, s.p, s.kind, surf, normal, s.start, s.nbr, dist, s.re_g, s.n0_g, 0.5 * s.l0)
+    sound = cfg["model.sound_speed"]
+    extra = s.lam * s.n0_l / (2.0 * model.DIM * sound**2 * dt**2) if sound > 0 else 0.0
+    row, indptr, indices, data, rhs = model.assemble(s.kind, surf, p_dir, b, s.start, s.nbr, dist, s.re_l, s.n0_l,
+                                                     s.lam, extra)
     t1 = time.perf_counter()
-    A = pressure.csr(indptr, indices, data)
     unk = row >= 0
-    x0 = np.zeros(A.shape[0])
+    x0 = np.zeros(int(unk.sum()))
     x0[row[unk]] = s.p[unk]
     try:
-        x, resid, its = pressure.solve(A, rhs, cfg["pressure.solver"], cfg["pressure.rtol"], cfg["pressure.maxiter"], x0)
+        x, resid, its = pressure.solve_csr(indptr, indices, data, rhs, cfg["pressure.solver"], cfg["pressure.rtol"],
+                                           cfg["pressure.maxiter"], x0)
     except (RuntimeError, ValueError, ArithmeticError) as err:  # e.g. SuperLU "matrix is exactly singular"
-        x, resid, its = np.full(A.shape[0], np.nan), np.inf, 0
+        x, resid, its = np.full(len(rhs), np.nan), np.inf, 0
         s.solve_error = str(err)
     if not np.all(np.isfinite(x)):
         resid = np.inf
@@ -103,13 +180,21 @@ def step(s, dt, source, cfg, timers=None):
         if timers is not None:
             timers += (t1 - t0, t2 - t1, 0.0)
         return (4, -1, -1), resid, its
-    p = np.zeros(len(s.pos))
+    p = p_dir.copy()
     p[unk] = x[row[unk]]
     if cfg["model.clip_negative"]:
         p = np.maximum(p, 0.0)
-    pos, vel, _, bad, graze = model.correct(s.pos, ps, vs, p, s.kind, pi, pj, m, s.re_g, s.n0_g, s.rho0, dt, s.walls,
-                                            s.escape_box, s.graze_depth)
+    g = model.gradient(ps, p, s.kind, s.start, s.nbr, dist, s.re_g, s.n0_g, s.grad_mode)
+    pos, vel = model.update(ps, vs, s.kind, g, s.rho0, dt)
+    c = cfg["model.shifting"]
+    if c > 0.0:
+        if not s.list_valid(pos):
+            s.neighbours(pos)
+        d2 = model.distances(pos, s.start, s.nbr)
+        pos = pos + model.shift(pos, s.kind, surf, normal, s.start, s.nbr, d2, s.re_n, s.n0_n, c, s.l0)
+    bad, graze = model.check(pos_old, pos, vel, s.kind, s.walls, s.escape_box, s.graze_depth)
     s.pos, s.vel, s.p = pos, vel, p
+    s.surf = surf
     if graze > 0.0:
         s.grazes += 1
         s.deepest_graze = max(s.deepest_graze, graze)
@@ -122,34 +207,52 @@ def _vessel_counts(pos, tank):
     return [int(np.count_nonzero((pos[:, 0] >= a) & (pos[:, 0] < b))) for _, (a, b) in vessels(tank)]
 
 
-def solve(tank, cfg, variant, spacing, t_end, probes, start=None, snapshots=0, log=print):
-    """Run MPS with source term ``variant`` on ``tank`` for ``t_end`` s of physical time.
+def solve(tank, cfg, variant, spacing, t_end, probes, start=None, snapshots=0, log=print, threads=None,
+          rest_settings=None):
+    """Run MPS with source term ``variant`` on ``tank`` until the liquid is at rest (isaflow.rest) or for
+    ``t_end`` s of physical time, whichever comes first.
 
-    spacing l0 [cm]; probes (K, 2) cm; start None (liquid block at rest in the
-    first vessel, depth tank.depth rounded to whole rows) or dict(pos, vel,
-    steps, sim_time) of the run this one continues (the walls are this tank's).
-    snapshots: number of evenly spaced position snapshots kept.  Wall loads
-    (contacts) are the mean panel forces over the last settings
-    'time.average_window' s.  Returns a contract.Result.
+    spacing l0 [cm]; probes (K, 2) cm; start None (liquid block at rest in the first vessel, depth
+    tank.depth rounded to whole rows) or dict(pos, vel, steps, sim_time[, initial_depth]) of the run this
+    one continues (the walls are this tank's; the chain's clock and step count go on).
+    snapshots: number of evenly spaced position snapshots kept.  threads: numba threads of the particle
+    loops (None: numba's current setting; results do not depend on it).  rest_settings: dict
+    (energy_ratio, window) (None: config/rest.yaml).  Wall loads (contacts) are the mean panel forces over
+    the last settings 'time.average_window' s.  Returns a contract.Result.
     """
     if variant not in model.SOURCES:
         raise ValueError(f"unknown MPS source term '{variant}' (choose from {', '.join(model.SOURCES)})")
-    l0 = float(spacing)
+    threads = numba.get_num_threads() if threads is None else int(threads)
+    before = numba.get_num_threads()
+    numba.set_num_threads(threads)
+    try:
+        return _solve(tank, cfg, variant, float(spacing), t_end, probes, start, snapshots, log, threads,
+                      rest.load() if rest_settings is None else rest_settings)
+    finally:
+        numba.set_num_threads(before)
+
+
+def _solve(tank, cfg, variant, l0, t_end, probes, start, snapshots, log, threads, rest_cfg):
+    xr, floor = first_vessel(tank)
     if start is None:
-        xr, floor = first_vessel(tank)
-        fpos, fvel, step0, t0 = boundary.liquid_block(xr, floor, tank.depth, l0), None, 0, 0.0
+        fpos, step0, t0 = boundary.liquid_block(xr, floor, tank.depth, l0), 0, 0.0
         fvel = np.zeros_like(fpos)
+        depth0 = rows_depth(tank, l0)
+        origin = "lattice at rest"
     else:
-        fpos, fvel, step0, t0 = np.asarray(start["pos"], float), np.asarray(start["vel"], float), int(start["steps"]), float(start["sim_time"])
+        fpos, fvel = np.asarray(start["pos"], float), np.asarray(start["vel"], float)
+        step0, t0 = int(start["steps"]), float(start["sim_time"])
+        depth0 = float(start.get("initial_depth", rows_depth(tank, l0)))
+        origin = str(start.get("origin", "given state"))
     s = State(tank, cfg, l0, fpos, fvel)
     pos0 = s.pos[: s.nf].copy()
     dt = time_step(tank, l0, cfg["time.courant"])
     nsteps = int(np.ceil(t_end / dt - 1e-9))
     every = max(1, int(round(cfg["time.sample_interval"] / dt)))
     snap_at = set(np.linspace(0, nsteps, snapshots).round().astype(int)) if snapshots else set()
-    u_rest = np.sqrt(2.0 * cfg["time.rest_fraction"] * units.G * l0)
+    monitor = rest.Monitor(rest_cfg["energy_ratio"], rest_cfg["window"])
     probes = np.asarray(probes, float).reshape(-1, 2)
-    rec = {k: [] for k in ("time", "panel", "probe", "rms", "vmax", "count", "resid", "iters")}
+    rec = {k: [] for k in ("time", "panel", "probe", "rms", "vmax", "energy", "count", "resid", "iters", "surf")}
     snaps, snap_t = [], []
     fail_tol = cfg["pressure.rtol"] * cfg["pressure.fail_factor"]
     status, message, max_resid, iters = None, "", 0.0, []
@@ -168,36 +271,53 @@ def solve(tank, cfg, variant, spacing, t_end, probes, start=None, snapshots=0, l
             status, message = ("escaped", f"step {step0 + k}: particle {bad[1]} crossed wall '{tank.wall_names[bad[2]]}' "
                                           f"(more than {s.graze_depth:.3g} cm past it)")
         elif bad[0] == 3:
-            status, message = "escaped", f"step {step0 + k}: particle {bad[1]} left the walls' bounding box by more than {s.graze_depth:.3g} cm"
+            x, y = s.pos[bad[1]]
+            vx, vy = s.vel[bad[1]]
+            where = "over the top" if y > s.escape_box[3] + s.graze_depth else "through a side or the bottom"
+            status, message = "escaped", (f"step {step0 + k}: particle {bad[1]} left the walls' bounding box by more than "
+                                          f"{s.graze_depth:.3g} cm ({where}: at ({x:.1f}, {y:.1f}) cm, velocity "
+                                          f"({vx:.0f}, {vy:.0f}) cm/s)")
         elif bad[0] == 4 or not resid <= fail_tol:
-            status, message = "solver_failed", f"step {step0 + k}: pressure solve residual {resid:.3g} > {fail_tol:.3g} after {its} iterations"
-        v = s.vel[: s.nf]
-        speed2 = (v**2).sum(1)
+            status, message = "solver_failed", (f"step {step0 + k}: pressure solve residual {resid:.3g} > {fail_tol:.3g} "
+                                                f"after {its} iterations {s.solve_error}").strip()
+        at_rest = False
         if k % every == 0 or status or k == nsteps:
+            v = s.vel[: s.nf]
+            speed2 = (v**2).sum(1)
+            e = rest.energy_ratio(0.5 * speed2.sum() * s.weight / units.G, s.weight * s.nf, depth0)
+            at_rest = monitor.update(t, e)
             rec["time"].append(t)
             rec["panel"].append(s.panel_forces())
             rec["probe"].append(model.probe_pressure(s.pos, s.p, s.kind, probes, s.re_n))
             rec["rms"].append(np.sqrt(speed2.mean()))
             rec["vmax"].append(np.sqrt(speed2.max()))
+            rec["energy"].append(e)
             rec["count"].append(_vessel_counts(s.pos[: s.nf], tank))
             rec["resid"].append(resid)
             rec["iters"].append(its)
+            rec["surf"].append(int(s.surf[: s.nf].sum()))
         if k in snap_at:
             snaps.append(s.pos[: s.nf].copy())
             snap_t.append(t)
         if status:
             break
+        if at_rest:
+            status = "converged"
+            message = (f"step {step0 + k}: t = {t:.3f} s, at rest: kinetic energy / (W h) below "
+                       f"{monitor.limit:g} since t = {monitor.time_to_rest():.3f} s ({monitor.window:g} s window)")
+            break
         now = time.perf_counter()
         if now - last_log > LOG_EVERY:
-            log(f"mps {variant} l0={l0:g} cm: step {k}/{nsteps}, t = {t:.3f} s, rms speed {rec['rms'][-1] if rec['rms'] else 0:.3g} cm/s")
+            log(f"mps {variant} l0={l0:g} cm: step {k}/{nsteps}, t = {t:.3f} s, rms speed "
+                f"{rec['rms'][-1] if rec['rms'] else 0:.3g} cm/s, e = {monitor.last:.3g}")
             last_log = now
     wall = time.perf_counter() - wall0
     rms = float(np.sqrt((s.vel[: s.nf] ** 2).sum(1).mean()))
     if status is None:
-        at_rest = rms < u_rest
-        status = "converged" if at_rest else "step_limit"
-        message = (f"step {step0 + k}: t = {t0 + k * dt:.3f} s, rms speed {rms:.3g} cm/s "
-                   f"{'<' if at_rest else '>='} rest limit {u_rest:.3g} cm/s")
+        status = "step_limit"
+        message = (f"step {step0 + k}: t = {t0 + k * dt:.3f} s (time limit), rms speed {rms:.3g} cm/s, kinetic energy / "
+                   f"(W h) {monitor.last:.3g} (rest: below {monitor.limit:g} for {monitor.window:g} s)")
+    t_rest = monitor.time_to_rest() - t0 if status == "converged" else np.nan
     times = np.array(rec["time"])
     panels = np.array(rec["panel"])
     window = times >= times[-1] - cfg["time.average_window"] + 1e-12
@@ -207,9 +327,11 @@ def solve(tank, cfg, variant, spacing, t_end, probes, start=None, snapshots=0, l
         "hist_probe_pressure": (("sample", "probe"), np.array(rec["probe"]).reshape(len(times), -1), "N cm-2", "pressure at fixed probe"),
         "hist_rms_speed": (("sample",), np.array(rec["rms"]), "cm s-1", "rms speed of the liquid particles"),
         "hist_max_speed": (("sample",), np.array(rec["vmax"]), "cm s-1", "largest liquid particle speed"),
+        "hist_energy_ratio": (("sample",), np.array(rec["energy"]), "1", "kinetic energy / (W h), isaflow.rest"),
         "hist_vessel_count": (("sample", "vessel"), np.array(rec["count"]), "1", "particles per vessel"),
         "hist_solve_residual": (("sample",), np.array(rec["resid"]), "1", "relative residual of the pressure solve"),
         "hist_solve_iterations": (("sample",), np.array(rec["iters"]), "1", "iterations of the pressure solve"),
+        "hist_surface_count": (("sample",), np.array(rec["surf"]), "1", "liquid particles on the free surface"),
         "probe_point": (("probe", "xy"), probes, "cm", "pressure probe position"),
         "in_window": (("sample",), window.astype(np.int8), "1", "1 if the sample is in the averaging window"),
     }
@@ -221,19 +343,28 @@ def solve(tank, cfg, variant, spacing, t_end, probes, start=None, snapshots=0, l
         "velocity": (("particle", "xy"), s.vel[: s.nf].copy(), "cm s-1", "velocity of each liquid particle at the end"),
     }
     nb = np.bincount(s.kind, minlength=3)
+    rows_note = (f"depth rounded to whole rows: {depth0:.4g} cm (tank {tank.depth:g} cm), weight held at {tank.weight:g} N"
+                 if abs(depth0 - tank.depth) > 1e-9 else "none")
     params = {
         "source_term": variant, "spacing_cm": l0, "dt_s": dt, "rho0_N_s2_cm4": s.rho0, "particle_weight_N": s.weight,
-        "re_density_cm": s.re_n, "re_gradient_cm": s.re_g, "re_laplacian_cm": s.re_l, "n0_density": s.n0_n, "n0_laplacian": s.n0_l,
+        "re_density_cm": s.re_n, "re_gradient_cm": s.re_g, "re_laplacian_cm": s.re_l, "re_surface_cm": s.re_s,
+        "n0_density": s.n0_n, "n0_laplacian": s.n0_l, "n0_gradient": s.n0_g, "n0_surface": s.n0_s,
         "lambda_cm2": s.lam, "beta": cfg["model.beta"], "relaxation": cfg["model.relaxation"],
-        "sound_speed_cm_s": cfg["model.sound_speed"], "n0_gradient": s.n0_g,
+        "sound_speed_cm_s": cfg["model.sound_speed"], "surface_pressure": cfg["model.surface_pressure"],
+        "gradient_model": cfg["model.gradient"], "shifting": cfg["model.shifting"],
         "surface_distribution": cfg["model.surface_distribution"], "kinematic_viscosity_cm2_s": cfg["model.kinematic_viscosity"],
         "gamma_mixed": cfg["model.gamma_mixed"], "courant": cfg["time.courant"], "pressure_solver": cfg["pressure.solver"],
         "pressure_rtol": cfg["pressure.rtol"], "max_solve_residual": max_resid, "mean_solve_iterations": float(np.mean(iters)),
-        "rest_speed_cm_s": u_rest, "average_window_s": cfg["time.average_window"], "wall_particles": int(nb[model.WALL]),
-        "dummy_particles": int(nb[model.DUMMY]), "time_predict_s": timers[0], "time_solve_s": timers[1],
-        "time_correct_s": timers[2], "collision_distance_cm": cfg["model.collision_distance"] * l0, "restitution": cfg["model.restitution"], "settings_file": cfg.path,
-        "panel_length": cfg["walls.panel_length"], "graze_depth_cm": s.graze_depth, "graze_steps": s.grazes,
-        "deepest_graze_cm": s.deepest_graze,
+        "average_window_s": cfg["time.average_window"], "time_limit_s": float(t_end), "wall_particles": int(nb[model.WALL]),
+        "dummy_particles": int(nb[model.DUMMY]), "thin_walls": ",".join(n for n, f in zip(tank.wall_names, s.thin_mask) if f) or "none",
+        "time_predict_s": timers[0], "time_solve_s": timers[1], "time_correct_s": timers[2], "list_builds": s.builds,
+        "collision_distance_cm": cfg["model.collision_distance"] * l0, "restitution": cfg["model.restitution"],
+        "settings_file": cfg.path, "panel_length": cfg["walls.panel_length"], "graze_depth_cm": s.graze_depth,
+        "graze_steps": s.grazes, "deepest_graze_cm": s.deepest_graze, "escapes": int(status == "escaped"),
+        "threads": threads, "start_state": origin,
+        "layer_pitch": l0, "held_weight": float(s.weight * s.nf), "initial_depth": depth0, "tank_difference": rows_note,
+        "rest_energy_ratio": monitor.limit, "rest_window": monitor.window, "rest_depth_cm": depth0,
+        "time_to_rest": t_rest, "final_energy_ratio": monitor.last, "final_rms_speed_cm_s": rms,
     }
     return Result(
         method="mps", variant=variant, pos0=pos0, pos=s.pos[: s.nf].copy(), weight=np.full(s.nf, s.weight),
