@@ -20,7 +20,7 @@ ROOT = __import__("pathlib").Path(__file__).resolve().parents[1]
 TANK = ROOT / "config" / "tanks" / "single.yaml"
 FLOWS = [ROOT / "config" / "tanks" / f"{t}.yaml" for t in ("flow_step50", "flow_samefloor")]
 CFG = ROOT / "config" / "methods" / "mps.yaml"
-COARSE = 100.0 / 18.0  # cm: the coarse spacing of the settings (runs.single_spacings)
+COARSE = 100.0 / 18.0  # cm: the coarse spacing of the settings (resolution dx5.56)
 FINE = 100.0 / 29.0
 VARIANTS = ("standard", "hattori", "mixed")
 
@@ -244,7 +244,7 @@ def test_failed_pressure_solve_is_reported_with_its_residual():
     """One CG iteration cannot reach rtol 1e-12: the run stops as solver_failed, naming the residual."""
     tank = load_tank(TANK)
     cfg = settings.load(CFG).with_overrides(**{"pressure.maxiter": 1, "pressure.rtol": 1e-12})
-    r = solver.solve(tank, cfg, "standard", 10.0, 0.01, cfg["runs.probes_single"], threads=1)
+    r = solver.solve(tank, cfg, "standard", 10.0, 0.01, cfg["probes.single"], threads=1)
     assert r.status == "solver_failed" and "residual" in r.message and r.steps <= 2
 
 
@@ -367,7 +367,7 @@ def test_drop_test_no_particle_crosses_any_wall(variant):
 def column_runs():
     tank = load_tank(TANK)
     cfg = settings.load(CFG).with_overrides(**{"time.average_window": 0.1})
-    return {v: solver.solve(tank, cfg, v, COARSE, 0.3, cfg["runs.probes_single"], threads=1) for v in VARIANTS}
+    return {v: solver.solve(tank, cfg, v, COARSE, 0.3, cfg["probes.single"], threads=1) for v in VARIANTS}
 
 
 @pytest.mark.parametrize("variant", VARIANTS)
@@ -395,7 +395,7 @@ def test_side_wall_load_of_the_column_is_hydrostatic(l0):
     is inside it)."""
     tank = load_tank(TANK)
     cfg = settings.load(CFG)
-    r = solver.solve(tank, cfg, "standard", l0, 0.3, cfg["runs.probes_single"], threads=1)
+    r = solver.solve(tank, cfg, "standard", l0, 0.3, cfg["probes.single"], threads=1)
     h = r.history
     t = h["hist_time"][1]
     F = np.hypot(*np.moveaxis(h["hist_panel_force"][1], -1, 0))
@@ -440,7 +440,7 @@ def test_column_comes_to_rest(variant):
     within the settings' time limit."""
     tank = load_tank(TANK)
     cfg = settings.load(CFG)
-    r = solver.solve(tank, cfg, variant, COARSE, cfg["time.single_time"], cfg["runs.probes_single"], threads=1)
+    r = solver.solve(tank, cfg, variant, COARSE, cfg["time.single_time"], cfg["probes.single"], threads=1)
     assert r.status == "converged" and r.params["time_to_rest"] <= cfg["time.single_time"]
 
 
@@ -454,7 +454,7 @@ def test_one_and_two_threads_give_the_same_run_bit_for_bit():
         pytest.skip("numba has a single thread here")
     tank = load_tank(FLOWS[0])
     cfg = settings.load(CFG)
-    runs = [solver.solve(tank, cfg, "mixed", COARSE, 0.05, cfg["runs.probes_flow"], threads=t) for t in (1, 2)]
+    runs = [solver.solve(tank, cfg, "mixed", COARSE, 0.05, cfg["probes.flow"], threads=t) for t in (1, 2)]
     assert [r.params["threads"] for r in runs] == [1, 2]
     a, b = runs
     assert np.array_equal(a.pos, b.pos) and np.array_equal(a.fields["velocity"][1], b.fields["velocity"][1])
@@ -468,7 +468,7 @@ def test_a_continued_run_matches_the_straight_run():
     may list the same neighbours in another order)."""
     tank = load_tank(TANK)
     cfg = settings.load(CFG)
-    probes = cfg["runs.probes_single"]
+    probes = cfg["probes.single"]
     dt = solver.time_step(tank, COARSE, cfg["time.courant"])
     n = 30
     whole = solver.solve(tank, cfg, "standard", COARSE, n * dt, probes, threads=1)
@@ -491,26 +491,26 @@ def test_bad_settings_name_file_and_field(tmp_path):
     with pytest.raises(SceneError, match=r"mps.yaml: field '\(top level\)'|mps.yaml: field 'model'"):
         settings.load(bad)
     with pytest.raises(SceneError, match="model.beta"):
-        settings.load(CFG, ["model.beta=1.5"])
-    with pytest.raises(SceneError, match="no field"):
-        settings.load(CFG, ["model.nope=1"])
+        settings.load(CFG, overrides=["model.beta=1.5"])
+    with pytest.raises(SceneError, match="no such setting"):
+        settings.load(CFG, overrides=["model.nope=1"])
 
 
 def test_stiff_cases_change_only_their_setting():
-    """Each stiff case overrides exactly the settings it names (large time step, small radii, no relaxation);
-    on_wall keeps the settings and asks for a particle on the floor line."""
-    from isaflow.methods.mps import outputs
+    """Each stiff case (a declared run) overrides exactly the settings it names (large time step, small radii,
+    no relaxation, a start on the floor) besides its shorter time limit."""
+    from isaflow import settings as S
 
     cfg = settings.load(CFG)
+    runs = S.read(CFG, settings.VALUES)["runs"]
     changed = {}
-    for case in outputs.STIFF_CASES:
-        new, start = outputs.stiff_settings(cfg, case)
-        changed[case] = sorted(k for k in cfg if new[k] != cfg[k])
-        assert (start == "on_wall") == (case == "on_wall")
+    for case in ("large_dt", "small_re", "no_relaxation", "on_wall"):
+        decl = runs[f"stiff_{case}"]
+        new = settings.load(CFG, decl["variant"], decl["resolution"], decl["set"])
+        changed[case] = sorted(k for k in cfg if new[k] != cfg[k] and k not in ("time.single_time", "resolution.spacing"))
     assert changed == {"large_dt": ["time.courant"], "small_re": ["model.re_density", "model.re_gradient",
                                                                   "model.re_laplacian", "model.re_surface"],
-                       "no_relaxation": ["model.relaxation"], "on_wall": []}
-    assert outputs.stiff_settings(cfg, "large_dt")[0]["time.courant"] == cfg["stiff.courant_large"] > cfg["time.courant"]
+                       "no_relaxation": ["model.relaxation"], "on_wall": ["start.on_wall_point"]}
 
 
 @pytest.mark.parametrize("begin, end, escaped", [

@@ -156,7 +156,9 @@ def contact_in_vessel(ds, x_range):
 
     With a ``contact_particle`` variable (point-particle methods) the contact
     belongs to its particle's vessel; otherwise (wall panels) to the vessel on
-    the liquid side (left) of its wall, a hair off the contact point.
+    the side of its wall the load comes from, a hair off the contact point: the
+    liquid side (left) of the wall, or its back (right) where ``contact_side``
+    is 1 (the back face of a thin wall wetted on both faces).
     """
     if "contact_particle" in ds:
         x = ds["pos"].values[ds["contact_particle"].values, 0]
@@ -164,7 +166,8 @@ def contact_in_vessel(ds, x_range):
         seg = ds["wall_segment"].values[ds["contact_wall"].values]
         e = seg[:, 2:] - seg[:, :2]
         left_nx = -e[:, 1] / np.hypot(e[:, 0], e[:, 1])
-        x = ds["contact_point"].values[:, 0] + 1e-6 * left_nx
+        side = ds["contact_side"].values if "contact_side" in ds else np.zeros(len(seg))
+        x = ds["contact_point"].values[:, 0] + 1e-6 * left_nx * (1 - 2 * side)
     return (x >= x_range[0]) & (x < x_range[1])
 
 

@@ -37,6 +37,7 @@ class Prepared:
     accept: tuple
     threads: int | None
     run_id: str
+    label: str = ""
 
 
 def _same_file(a, b):
@@ -47,7 +48,7 @@ def _same_file(a, b):
 
 
 def prepare(method, tank, variant, resolution, out, settings_path=None, overrides=(), start=None,
-            accept=("converged",), threads=None, run_id=None):
+            accept=("converged",), threads=None, run_id=None, label=""):
     """Check a run before any work; returns Prepared or raises InputError / runfile.RunFileError.
 
     tank: path of a tank file; overrides: 'key=value' strings or {key: {value, source}};
@@ -78,11 +79,12 @@ def prepare(method, tank, variant, resolution, out, settings_path=None, override
     entry = m.entry_module()
     entry.check(t, s, variant, resolution, start)
     return Prepared(method, entry, t, s, variant, resolution, start, str(out), tuple(accept), threads,
-                    run_id or Path(out).stem)
+                    run_id or Path(out).stem, label)
 
 
 def _progress(run_id, log):
-    """A progress callback printing at most every PROGRESS_EVERY s: (step, measure name, value, units)."""
+    """A progress callback printing at most every PROGRESS_EVERY s: progress(step, measure name, value, units);
+    progress.log(text) prints a method's own progress line (it keeps its own pace), with the run id."""
     last = [time.perf_counter()]
 
     def progress(step, name, value, units, force=False):
@@ -91,6 +93,7 @@ def _progress(run_id, log):
             last[0] = now
             log(f"{run_id}: step {step:>9d}  {name} = {value:.4g} {units}")
 
+    progress.log = lambda text: log(f"{run_id}: {text}")
     return progress
 
 
@@ -108,7 +111,8 @@ def write(p, result, started, finished, command=None):
     """Write the run file of a solved run (raises OSError / RunFileError)."""
     files = {"tank": p.tank.path, "settings": p.settings.path, "start": p.start}
     prov = runfile.provenance(files, command)
-    prov.update(run_id=p.run_id, resolution=p.resolution, settings_resolved=settings_text(p.settings),
+    prov.update(run_id=p.run_id, run_label=p.label or "none", resolution=p.resolution,
+                settings_resolved=settings_text(p.settings),
                 threads=result.params.get("threads", p.threads or 0))
     ds = runfile.to_dataset(result, p.tank, prov, started, finished, references=p.entry.REFERENCES)
     runfile.write(ds, p.out)
@@ -120,11 +124,12 @@ def settings_text(s):
 
 
 def run(method, tank, variant, resolution, out, settings_path=None, overrides=(), start=None,
-        accept=("converged",), threads=None, run_id=None, log=None, command=None):
+        accept=("converged",), threads=None, run_id=None, log=None, command=None, label=""):
     """Check, solve and write one run; returns the exit code (module docstring); errors as one line on stderr."""
     log = log or (lambda msg: print(msg, file=sys.stderr, flush=True))
     try:
-        p = prepare(method, tank, variant, resolution, out, settings_path, overrides, start, accept, threads, run_id)
+        p = prepare(method, tank, variant, resolution, out, settings_path, overrides, start, accept, threads, run_id,
+                    label)
     except (InputError, runfile.RunFileError) as err:
         log(f"error: {err}")
         return 2

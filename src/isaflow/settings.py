@@ -126,11 +126,13 @@ class Settings(dict):
             node[parts[-1]] = copy.deepcopy(value)
         return out
 
-    def with_overrides(self, overrides, what="override"):
-        """Copy with ``overrides`` applied (see :func:`apply`)."""
+    def with_overrides(self, overrides=(), what="override", **values):
+        """Copy with ``overrides`` applied (see :func:`apply`), then ``values`` ({dotted key: plain value},
+        e.g. ``with_overrides(**{"model.beta": 0.9})``)."""
         new = Settings(copy.deepcopy(dict(self)), dict(self.sources), self.path, self.spec, self.variant,
                        self.resolution, self.schema)
         apply(new, overrides, self.schema or {}, self.path, what)
+        apply(new, values, self.schema or {}, self.path, what)
         return new
 
     def runs(self):

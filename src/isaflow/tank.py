@@ -78,6 +78,14 @@ class Tank:
         x0, x1 = self.vessels[0][1]
         return self.weight / ((x1 - x0) * self.depth)
 
+    def escape_box(self):
+        """(4,) xmin, ymin, xmax, ymax [cm] of the region a dynamic method's particle must stay in: the walls'
+        bounding box, open upwards by the tank's own height (a splash may rise above the open top and fall
+        back; one rising higher than the tank is tall carries energy no jet of this tank has)."""
+        w = self.walls
+        lo, hi = w.reshape(-1, 2).min(0), w.reshape(-1, 2).max(0)
+        return np.array([lo[0], lo[1], hi[0], hi[1] + (hi[1] - lo[1])])
+
     @property
     def digest(self):
         """sha256 of the validated tank (canonical JSON)."""

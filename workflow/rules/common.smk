@@ -72,6 +72,17 @@ def func_code(func):
 RUNS = {name: {} for name in TANK_METHODS}
 
 
+def settings_runs(method):
+    """The runs section of a tank method's settings file (read by the one loader, refused on any error)."""
+    from isaflow import settings as _settings
+
+    m = REGISTRY[method]
+    try:
+        return _settings.read(m.settings, m.values_schema(), f"{method} settings").get("runs", {})
+    except _inputs.InputError as err:
+        refuse(err)
+
+
 def declare_runs(method, runs):
     for run_id, decl in runs.items():
         if run_id in RUNS[method]:
@@ -97,6 +108,14 @@ def run_inputs(wc):
 def runtime_runs():
     """Run files of the single-vessel runs a method adds to the error-against-run-time figure ('runtime: true')."""
     return [run_file(m, r) for m in TANK_METHODS for r, d in RUNS[m].items() if d.get("runtime")]
+
+
+def first_run(method, tank):
+    """Run file of a method's first declared compared run on a tank (declaration order)."""
+    for run, d in RUNS[method].items():
+        if d.get("compare") and d["tank"] == tank:
+            return run_file(method, run)
+    raise KeyError(f"method {method} declares no compared run on tank {tank}")
 
 
 def compare_runs():

@@ -13,7 +13,7 @@ ISA_STUDY_CFG = "config/methods/isa_study.yaml"
 try:
     _ISA_SPEC = _isa_settings.read(ISA_SETTINGS, _ISA_VALUES, "isa settings")
 except _inputs.InputError as _err:
-    refuse(_err)
+    refuse(_err)  # noqa: F821 (common.smk)
 ISA = read_config(ISA_WORKFLOW_CFG, "isa_workflow.schema.yaml")
 STUDY = read_config(ISA_STUDY_CFG, "isa_study.schema.yaml")["study"]
 for _v in [ISA["calibration"]["variant"],

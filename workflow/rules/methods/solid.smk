@@ -9,17 +9,9 @@ SOLID_CODE = code("methods/solid/kernels", "methods/solid/rotation", "methods/so
 SOLID_FIGURES = figure("solid_bar") + figure("solid_hertz")
 SOLID_REPORT_FIGURES = [f for name in ("solid_bar", "solid_hertz") for f in report_figure(name, "solid_figure", "Methods compared")]
 
-# section 4.4 pressure vessel and the elastic floor of the single tank (one-way: loads from the coarsest
-# rigid-floor run of each method; the sph/mps rules files are read after this one, so their first
-# single-vessel run names are taken from their settings here)
-_SOLID_SPH1 = _inputs.read_yaml("config/methods/sph.yaml")[1]["runs"]["single"][0]
-_SOLID_MPS1 = _inputs.read_yaml("config/methods/mps.yaml")[1]["runs"]["single_spacings"]["value"][0]
-SOLID_FLOOR_LOADS = {
-    "isa": run_file("isa", "single_coarse"),
-    "sph": "results/sph/single_wcsph_" + (f"n{_SOLID_SPH1['particles']}" if "particles" in _SOLID_SPH1
-                                          else f"dx{_SOLID_SPH1['spacing']:g}") + ".nc",
-    "mps": f"results/mps/single_standard_dx{_SOLID_MPS1:.3g}.nc",
-}
+# section 4.4 pressure vessel and the elastic floor of the single tank (one-way: loads from the first
+# compared rigid-floor run of every tank method on the single tank, first_run in common.smk)
+SOLID_FLOOR_LOADS = TANK_METHODS
 SOLID_VESSEL_RUNS = ["results/solid/vessel_pressure_load.nc", "results/solid/vessel_water_particles.nc"]
 SOLID_FLOOR_RUNS = ["results/solid/floor_uniform_uniform_load.nc"] + [
     f"results/solid/floor_{src}_oneway.nc" for src in SOLID_FLOOR_LOADS]
@@ -93,7 +85,7 @@ rule solid_floor_uniform:
 rule solid_floor_oneway:
     input:
         cfg=SOLID_CFG,
-        loads=lambda wc: SOLID_FLOOR_LOADS[wc.src],
+        loads=lambda wc: first_run(wc.src, "single"),
         code=SOLID_NEW_CODE,
     output:
         "results/solid/floor_{src}_oneway.nc",

@@ -24,7 +24,7 @@ def noise_bound(row):
 
 def dt_rows(df):
     """The time-step study's runs plus the single standard run at the same spacing (settings' Courant), by Courant."""
-    dt = df[df.case == "dt"]
+    dt = df[(df.case == "dt") & (df.run.str.startswith("dt_standard"))]
     if not len(dt):
         return dt
     same = df[(df.case == "single") & (df.source_term == "standard") & np.isclose(df.spacing_cm, dt.spacing_cm.iloc[0])]
@@ -75,7 +75,7 @@ def claims(df):
 
 def findings(df):
     """Paragraph on rest and escapes, numbers from the table."""
-    single, flows = df[df.case == "single"], df[df.case == "flow"]
+    single, flows = df[df.case == "single"], df[df.case.isin(["flow", "samefloor"])]
     out = []
     if len(single):
         at_rest = single[single.status == "converged"]
@@ -129,7 +129,7 @@ def _table(df, cols, heads):
 def fragment(df, cfg):
     """Markdown of the MPS section."""
     g = lambda x: _fmt(x)  # noqa: E731
-    single, flow, stiff = df[df.case == "single"], df[df.case == "flow"], df[df.case == "stiff"]
+    single, flow, stiff = df[df.case == "single"], df[df.case.isin(["flow", "samefloor"])], df[df.case == "stiff"]
     lines = ["## MPS with three pressure source terms", "",
              "Koshizuka & Oka's semi-implicit MPS as the public MPS-Basic code implements it (pressure equation over "
              "fluid and wall particles, dummies excluded, free-surface particles P = 0, compressibility term on the "
@@ -160,11 +160,8 @@ def fragment(df, cfg):
                                   ("message", None)],
                            ["flow run", "tank", "status", "t end s", "mass left (fraction)", "second-vessel level cm",
                             "final rms cm/s", "time to rest s", "graze steps", "why it stopped"])
-    lines += ["", "Stiff and extreme cases (standard source, single vessel, "
-              f"l0 = {cfg['stiff.spacing']:.3g} cm, {cfg['stiff.duration']:g} s): large_dt Courant "
-              f"{cfg['stiff.courant_large']:g}; small_re all radii {cfg['stiff.re_small']:g} l0; no_relaxation gamma = "
-              f"{cfg['stiff.relaxation_none']:g} (K&O 1996 literally); on_wall one particle started at "
-              f"{tuple(cfg['stiff.on_wall_point'])} cm on the floor.", ""]
+    lines += ["", "Stiff and extreme cases (standard source, single vessel): " + "; ".join(
+        f"{r.run.removeprefix('stiff_')}: {r.label}" for r in stiff.itertuples()) + ".", ""]
     lines += _table(stiff, [("run", None), ("status", None), ("rms_speed_cm_s", g), ("floor_err", g), ("message", None),
                             ("escape_depth_cm", g)],
                     ["case", "status", "rms speed cm/s", "floor err", "why it stopped", "depth behind the wall cm"])

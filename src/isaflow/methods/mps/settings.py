@@ -1,57 +1,57 @@
-"""MPS settings: config/methods/mps.yaml, validated by settings.schema.json.
+"""MPS settings: the values of config/methods/mps.yaml, read by the one loader (isaflow.settings).
 
-Every value is stored as {value, source}; :func:`load` returns the values
-flattened to ``group.key`` -> value and keeps the sources for the report.
+Every value is ``{value, source}`` under its group (``model``, ``time``, ``pressure``, ``walls``; the
+run's ``resolution.spacing`` l0, the on-wall stiff case's ``start.on_wall_point``, the pressure
+``probes``).  The variant is the source term of the pressure equation.  isaflow.settings.Settings maps
+'group.key' -> value, as the solver reads it.  Pure Python.
 """
 
-import copy
-import json
-from importlib import resources
+from pathlib import Path
+
+from ... import settings as S
+
+DEFAULT_PATH = Path(__file__).resolve().parents[4] / "config" / "methods" / "mps.yaml"
+
+# {dotted key: JSON schema of the value} of config/methods/mps.yaml
+VALUES = {
+    'model.re_density': {"type": "number", "exclusiveMinimum": 1},
+    'model.re_laplacian': {"type": "number", "exclusiveMinimum": 1},
+    'model.beta': {"type": "number", "exclusiveMinimum": 0, "maximum": 1},
+    'model.kinematic_viscosity': {"type": "number", "minimum": 0},
+    'model.gamma_mixed': {"type": "number", "minimum": 0},
+    'model.clip_negative': {"type": "boolean"},
+    'model.collision_distance': {"type": "number", "minimum": 0, "maximum": 1},
+    'model.restitution': {"type": "number", "minimum": 0, "maximum": 1},
+    'model.re_gradient': {"type": "number", "exclusiveMinimum": 1},
+    'model.relaxation': {"type": "number", "exclusiveMinimum": 0, "maximum": 1},
+    'model.sound_speed': {"type": "number", "minimum": 0},
+    'model.pressure_layers': {"type": "integer", "minimum": 1, "maximum": 6},
+    'model.dummy_layers': {"type": "integer", "minimum": 0, "maximum": 6},
+    'model.surface_distribution': {"type": "number", "minimum": 0},
+    'model.re_surface': {"type": "number", "exclusiveMinimum": 1},
+    'model.surface_pressure': {"enum": ["zero", "hydrostatic", "extrapolated"]},
+    'model.gradient': {"enum": ["min", "corrected", "symmetric"]},
+    'model.shifting': {"type": "number", "minimum": 0, "maximum": 0.5},
+    'model.list_skin': {"type": "number", "minimum": 0},
+    'model.relax_all_sources': {"type": "boolean"},
+    'time.courant': {"type": "number", "exclusiveMinimum": 0},
+    'time.sample_interval': {"type": "number", "exclusiveMinimum": 0},
+    'time.single_time': {"type": "number", "exclusiveMinimum": 0},
+    'time.flow_time': {"type": "number", "exclusiveMinimum": 0},
+    'time.average_window': {"type": "number", "exclusiveMinimum": 0},
+    'pressure.solver': {"enum": ["cg_jacobi", "scipy_cg", "amg", "direct"]},
+    'pressure.rtol': {"type": "number", "exclusiveMinimum": 0},
+    'pressure.maxiter': {"type": "integer", "minimum": 1},
+    'pressure.fail_factor': {"type": "number", "minimum": 1},
+    'walls.panel_length': {"type": "number", "exclusiveMinimum": 0},
+    'walls.graze_depth': {"type": "number", "minimum": 0},
+    'resolution.spacing': {"type": ["number", "null"], "exclusiveMinimum": 0},
+    'start.on_wall_point': {"type": ["array", "null"], "items": {"type": "number"}, "minItems": 2, "maxItems": 2},
+    'probes.single': {"type": "array", "items": {"type": "array", "items": {"type": "number"}, "minItems": 2, "maxItems": 2}},
+    'probes.flow': {"type": "array", "items": {"type": "array", "items": {"type": "number"}, "minItems": 2, "maxItems": 2}},
+}
 
 
-from isaflow import inputs
-from isaflow.inputs import InputError
-from isaflow.inputs import InputError as SceneError
-
-SCHEMA = json.loads(resources.files("isaflow.methods.mps").joinpath("settings.schema.json").read_text())
-DEFAULT_PATH = "config/methods/mps.yaml"
-
-
-class Settings(dict):
-    """{'group.key': value}; ``sources`` {'group.key': source}; ``path`` the file."""
-
-    def __init__(self, values, sources, path):
-        super().__init__(values)
-        self.sources = sources
-        self.path = path
-
-    def with_overrides(self, **kw):
-        """Copy with values replaced (keys 'group.key'); KeyError for unknown keys."""
-        new = Settings(copy.deepcopy(dict(self)), dict(self.sources), self.path)
-        for k, v in kw.items():
-            if k not in new:
-                raise KeyError(f"unknown MPS setting '{k}'")
-            new[k] = v
-        return new
-
-
-def load(path=DEFAULT_PATH, overrides=()):
-    """Read and validate the settings; overrides 'group.key=value' (YAML value).
-
-    Raises SceneError with one line naming the file and the field.
-    """
-    path = str(path)
-    _, spec = inputs.read_yaml(path, "MPS settings")
-    for item in overrides:
-        key, sep, value = item.partition("=")
-        group, _, name = key.strip().partition(".")
-        if not sep or name not in spec.get(group, {}):
-            raise SceneError(f"{path}: override '{inputs.printable(item)}': no field '{inputs.printable(key.strip())}'")
-        try:
-            spec[group][name]["value"] = inputs.parse_yaml(value)
-        except InputError as err:
-            raise SceneError(f"{path}: override '{inputs.printable(item)}': {err}") from None
-    inputs.validate(spec, SCHEMA, path)
-    values = {f"{g}.{k}": v["value"] for g, grp in spec.items() for k, v in grp.items()}
-    sources = {f"{g}.{k}": v["source"] for g, grp in spec.items() for k, v in grp.items()}
-    return Settings(values, sources, path)
+def load(path=DEFAULT_PATH, variant=None, resolution=None, overrides=()):
+    """Resolved settings (isaflow.settings.Settings, 'group.key' -> value); InputError naming file and field."""
+    return S.load(path, VALUES, variant, resolution, overrides, what="MPS settings")

@@ -21,11 +21,10 @@ import numpy as np
 from isaflow import rest
 from isaflow.contract import Result
 from isaflow.core import units
-from isaflow.core.geometry import bounding_box
 
 from . import boundary, model, pressure
 
-LOG_EVERY = 30.0  # s of wall time between progress lines
+LOG_EVERY = 20.0  # s of wall time between progress lines (a log line at least every 30 s)
 
 
 def vessels(tank):
@@ -91,7 +90,7 @@ class State:
         self.n0_l, self.lam = model.lattice_constants(cfg["model.re_laplacian"], l0)
         self.weight = tank.weight / self.nf  # N per particle
         self.rho0 = self.weight / units.G / l0**2  # N s^2 / cm^4
-        box = bounding_box(self.walls)
+        box = tank.escape_box()  # the walls' bounding box, open upwards (a splash may rise and fall back)
         pad = (layers + 1) * l0
         self.grid_box = box + np.array([-pad, -pad, pad, pad])
         self.escape_box = box

@@ -48,8 +48,9 @@ def single(paths, out):
 
 
 def flow(paths, out):
-    """Final state of each flow run with the measured second-vessel surface and the expected flat one."""
-    paths = sorted(paths, key=lambda p: -float(runfile.read(p).attrs["spacing"]))
+    """Final state of each flow run (both flow tanks) with the measured second-vessel surface and the tank's
+    level at rest (its liquid, rho g, at rest in the communicating vessels)."""
+    paths = sorted(paths, key=lambda p: (runfile.read(p).attrs["tank"], -float(runfile.read(p).attrs["spacing"])))
     fig, axes = plt.subplots(len(paths), 1, figsize=(10, 3.3 * len(paths)), squeeze=False)
     for ax, path in zip(axes[:, 0], paths):
         ds, r = runfile.read(path), row(path)
@@ -58,13 +59,14 @@ def flow(paths, out):
         fig.colorbar(sc, ax=ax, label="pressure (N/cm$^2$)")
         _walls(ax, ds)
         x0, x1 = ds["vessel_x"].values[-1]
-        for y, style, what in ((r["surface_cm"], dict(color="tab:red", lw=1), "measured surface"),
-                               (r["surface_expected_cm"], dict(color="k", ls="--", lw=1), "flat surface of the liquid held")):
-            ax.plot([x0, x1], [y, y], label=f"{what} {y:.1f} cm (slope {r['surface_slope_deg']:+.1f} deg)"
+        for y, style, what in ((r["second_surface_cm"], dict(color="tab:red", lw=1), "measured surface"),
+                               (r["second_tank_surface_cm"], dict(color="k", ls="--", lw=1),
+                                "the tank's liquid at rest")):
+            ax.plot([x0, x1], [y, y], label=f"{what} {y:.1f} cm (slope {r['second_slope_deg']:+.1f} deg)"
                     if what == "measured surface" else f"{what} {y:.1f} cm", **style)
         ax.set(aspect="equal", xlabel="x (cm)", ylabel="y (cm)",
-               title=f"{ds.sizes['particle']} particles: t = {float(ds['sim_time']):.1f} s, {ds.attrs['status']}, "
-                     f"{r['mass_left_fraction']:.1%} of the weight left in the first vessel")
+               title=f"tank {ds.attrs['tank']}, {ds.sizes['particle']} particles: t = {float(ds['sim_time']):.1f} s, "
+                     f"{ds.attrs['status']}, {r['left_fraction']:.1%} of the weight left in the first vessel")
         ax.title.set_fontsize(9)
         ax.legend(fontsize=7, loc="upper right")
     _method_title(fig, ds, "flow into the second vessel, final states")
@@ -86,13 +88,15 @@ def snapshots(path, out):
         _walls(ax, ds)
         ax.set(aspect="equal", xlabel="x (cm)", ylabel="y (cm)", title=f"{t[k]:.2f} s after the opening")
         ax.title.set_fontsize(9)
-    _method_title(fig, ds, f"flow snapshots, {ds.sizes['particle']} particles")
+    _method_title(fig, ds, f"flow snapshots, tank {ds.attrs['tank']}, {ds.sizes['particle']} particles")
     fig.tight_layout()
     save(fig, out)
 
 
 def all_figures(single_runs, flow_runs, outputs):
-    """outputs: [png, pdf] of single(single_runs), flow(flow_runs), snapshots(finest flow run), in that order."""
+    """outputs: [png, pdf] of single(single_runs), flow(flow_runs), snapshots(the finest flow run on the
+    step tank, flow_step50), in that order."""
     single(single_runs, outputs[0:2])
     flow(flow_runs, outputs[2:4])
-    snapshots(flow_runs[-1], outputs[4:6])
+    step = [p for p in flow_runs if runfile.read(p).attrs["tank"] == "flow_step50"] or list(flow_runs)
+    snapshots(max(step, key=lambda p: runfile.read(p).sizes["particle"]), outputs[4:6])

@@ -46,28 +46,34 @@ def fragment(df):
            "10 cm wall panels.  The weakly compressible column at rest is short of the tank's 72.5 cm by "
            "g H^2 / (2 c0^2) and of its side load rho g H^2 / 2 = 3,262.5 N by (2/3) g H / c0^2 (0.20 %).",
            "", "### Single vessel", "",
-           "| variant | particles | spacing (cm) | outcome | escaped | t (s) | time to rest (s) | final rms speed (cm/s) "
-           "| side load vs 3,262.5 N | surface (cm) | side error (measured level) | per-panel RMS |",
+           "Errors against the tank's theory (3,262.5 N per side wall, surface 72.5 cm) and against the run's own "
+           "weight and depth (isaflow.metrics; the surface is the top particle centres + dy/2).", "",
+           "| variant | particles | spacing (cm) | outcome | t (s) | time to rest (s) | final rms speed (cm/s) "
+           "| surface (cm) | side err tank | side err own | floor err tank | per-panel RMS tank |",
            "|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in df[df.case == "single"].sort_values(["variant", "spacing_cm"], ascending=[True, False]).itertuples():
-        out.append(f"| {r.variant} | {r.particles} | {r.spacing_cm:.3g} | {r.status} | {'yes' if r.escaped else 'no'} | "
-                   f"{r.sim_time_s:.2f} | {_fmt(getattr(r, 'time_to_rest_s', np.nan), '.2f')} | "
-                   f"{r.rms_speed_cm_s:.3g} | {_fmt(getattr(r, 'side_err_tank', np.nan), '+.2%')} | "
-                   f"{_fmt(getattr(r, 'surface_cm', np.nan), '.2f')} | {_fmt(getattr(r, 'side_err', np.nan), '+.2%')} | "
-                   f"{_fmt(getattr(r, 'contact_rms', np.nan))} |")
-    out += ["", "### Flow into the second vessel", "",
+        out.append(f"| {r.variant} | {r.particles} | {r.spacing_cm:.3g} | {r.status} | {r.sim_time_s:.2f} | "
+                   f"{_fmt(r.time_to_rest_s, '.2f')} | {r.rms_speed_cm_s:.3g} | {_fmt(r.surface_cm, '.2f')} | "
+                   f"{_fmt(r.side_err_tank, '+.2%')} | {_fmt(r.side_err_own, '+.2%')} | "
+                   f"{_fmt(r.floor_err_tank, '+.2%')} | {_fmt(r.contact_rms_tank)} |")
+    out += ["", "### Flows into the second vessel", "",
             "Flows continue the single run's state and clock (t below); they run until at rest or 40 s after the "
-            "opening.", "",
-            "| run | particles | outcome | t (s) | flow time (s) | final rms speed (cm/s) | particles left | "
-            "weight left | surface (cm) | flat surface of the weight held (cm) | slope (deg) |",
-            "|---|---|---|---|---|---|---|---|---|---|---|"]
-    for r in df[df.case == "flow"].sort_values(["run"]).itertuples():
-        out.append(f"| {r.run} | {r.particles} | {r.status} | {r.sim_time_s:.1f} | {r.run_time_s:.1f} | "
-                   f"{r.rms_speed_cm_s:.3g} | {r.particles_left} | {r.mass_left_fraction:.1%} | {r.surface_cm:.2f} | "
-                   f"{r.surface_expected_cm:.2f} | {r.surface_slope_deg:.2g} |")
+            "opening (flow time).  Second-vessel surface against the tank's level at rest (step: -13.75 cm, the "
+            "first vessel empties; same floor: 24.17 cm in both vessels).", "",
+            "| run | tank | particles | outcome | t (s) | flow time (s) | final rms speed (cm/s) | particles left | "
+            "weight left | first surface (cm) | second surface (cm) | tank level (cm) | slope (deg) | side err tank "
+            "| side err own |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in df[df.case.isin(["flow", "samefloor"])].sort_values(["tank", "particles"]).itertuples():
+        out.append(f"| {r.run} | {r.tank} | {r.particles} | {r.status} | {r.sim_time_s:.1f} | {r.run_time_s:.1f} | "
+                   f"{r.rms_speed_cm_s:.3g} | {r.particles_left} | {r.left_fraction:.1%} | "
+                   f"{_fmt(r.first_surface_cm, '.2f')} | {_fmt(r.second_surface_cm, '.2f')} | "
+                   f"{r.second_tank_surface_cm:.2f} | {_fmt(r.second_slope_deg, '.2g')} | "
+                   f"{_fmt(r.second_side_err_tank, '+.1%')} | {_fmt(r.second_side_err_own, '+.1%')} |")
     out += ["", "### Stability cases", "", "| case | particles | outcome | t (s) | rms speed (cm/s) |", "|---|---|---|---|---|"]
     for r in df[df.case == "stab"].itertuples():
-        out.append(f"| {r.stability_case} | {r.particles} | {r.status} | {r.sim_time_s:.2f} | {r.rms_speed_cm_s:.3g} |")
+        out.append(f"| {r.stability_case}: {r.stability_label} | {r.particles} | {r.status} | {r.sim_time_s:.2f} | "
+                   f"{r.rms_speed_cm_s:.3g} |")
     out += ["", "Figures: `figures/sph_single.png` (particles coloured by pressure, per-panel loads against "
             "hydrostatics), `figures/sph_flow.png` (final flow states and surfaces), `figures/sph_flow_snapshots.png`.", ""]
     return "\n".join(out)

@@ -1,25 +1,17 @@
-"""SPH settings: config/methods/sph.yaml, validated by SCHEMA (unknown keys rejected).
+"""SPH settings: the values of config/methods/sph.yaml, read by the one loader (isaflow.settings).
 
-Every physical setting is ``{value: ..., source: "page text: ..." | "inferred: ..."
-| "literature: ..."}``.  A variant is a named set of overrides with its own
-label; runs may override further (stability cases).  Bad settings raise
-inputs.InputError naming the file and the field.
+Every value is ``{value, source}``; the physical settings sit under ``settings.<name>``, the resolution
+(a target particle count or a spacing, and the on-wall stability start) under ``resolution.<name>``.
+Variants (names and labels in the method registry) and resolutions change the values they list.  Bad
+settings raise inputs.InputError naming the file and the field.  Pure Python.
 """
 
 from pathlib import Path
 
-
-from ... import inputs
+from ... import settings as S
 from ...inputs import InputError as SceneError
 
 DEFAULT_PATH = Path(__file__).resolve().parents[4] / "config" / "methods" / "sph.yaml"
-
-
-def _setting(value_schema):
-    return {"type": "object", "additionalProperties": False, "required": ["value", "source"],
-            "properties": {"value": value_schema,
-                           "source": {"type": "string", "pattern": "^(page text|inferred|literature|issue text): .+"}}}
-
 
 _POS = {"type": "number", "exclusiveMinimum": 0}
 _NONNEG = {"type": "number", "minimum": 0}
@@ -44,49 +36,39 @@ SETTINGS = {
     "panel_length": _POS,        # cm
     "snapshot_times": {"type": "array", "items": _NONNEG},
 }
-_OVERRIDES = {"type": "object", "additionalProperties": False,
-              "properties": {k: _setting(v) for k, v in SETTINGS.items()}}
-_RESOLUTION = {"type": "object", "additionalProperties": False,
-               "properties": {"particles": {"type": "integer", "minimum": 4}, "spacing": _POS,
-                              "source": {"type": "string"}},
-               "oneOf": [{"required": ["particles"]}, {"required": ["spacing"]}]}
-SCHEMA = {
-    "type": "object", "additionalProperties": False, "required": ["settings", "variants", "runs"],
-    "properties": {
-        "settings": {**_OVERRIDES, "required": list(SETTINGS)},
-        "variants": {"type": "object", "minProperties": 1, "additionalProperties": {
-            "type": "object", "additionalProperties": False, "required": ["label", "set"],
-            "properties": {"label": {"type": "string"}, "set": _OVERRIDES}}},
-        "runs": {"type": "object", "additionalProperties": False, "required": ["single", "flow", "stability"],
-                 "properties": {
-                     "single": {"type": "array", "items": _RESOLUTION},
-                     "flow": {"type": "array", "items": _RESOLUTION},
-                     "stability": {"type": "object", "additionalProperties": {
-                         "type": "object", "additionalProperties": False, "required": ["label", "resolution"],
-                         "properties": {"label": {"type": "string"}, "resolution": _RESOLUTION,
-                                        "set": _OVERRIDES, "on_wall": {"type": "boolean"}}}},
-                 }},
-    },
-}
+VALUES = {**{f"settings.{k}": v for k, v in SETTINGS.items()},
+          "resolution.particles": {"type": ["integer", "null"], "minimum": 4},
+          "resolution.spacing": {"type": ["number", "null"], "exclusiveMinimum": 0},
+          "resolution.on_wall": {"type": "boolean"}}
 
 
 def load(path=DEFAULT_PATH):
-    """The validated settings file as a dict (SceneError naming file and field)."""
-    return inputs.load(path, SCHEMA, "SPH settings")[1]
+    """The validated settings file as written (InputError naming the file and the field)."""
+    return S.read(path, VALUES, "SPH settings")
 
 
-def resolve(spec, variant, overrides=None):
-    """{name: value} of a variant's settings (defaults, then the variant's, then overrides).
-
-    overrides: {name: value} (plain values) or {name: {value, source}}.
-    """
+def resolve(spec, variant, overrides=None, path=DEFAULT_PATH):
+    """{name: value} of the physical settings of a variant (then overrides {name: value or {value, source}})."""
     if variant not in spec["variants"]:
         raise SceneError(f"SPH settings: field 'variants': no variant '{variant}' "
                          f"(choose from {', '.join(spec['variants'])})")
-    out = {k: v["value"] for k, v in spec["settings"].items()}
-    out.update({k: v["value"] for k, v in spec["variants"][variant]["set"].items()})
-    for k, v in (overrides or {}).items():
-        if k not in SETTINGS:
-            raise SceneError(f"SPH settings: override field '{k}': unknown (choose from {', '.join(SETTINGS)})")
-        out[k] = v["value"] if isinstance(v, dict) else v
-    return out
+    extra = {f"settings.{k}": v for k, v in (overrides or {}).items()}
+    for k in extra:
+        if k not in VALUES:
+            raise SceneError(f"SPH settings: override field '{k[9:]}': unknown (choose from {', '.join(SETTINGS)})")
+    return physics(S.load(path, VALUES, variant, overrides=extra, spec=spec))
+
+
+def physics(settings):
+    """{name: value} of the ``settings.*`` values of a resolved isaflow.settings.Settings."""
+    return settings.tree("settings")
+
+
+def resolution(settings):
+    """{'particles': N} or {'spacing': cm} of a resolved Settings (InputError if neither or both)."""
+    r = settings.tree("resolution")
+    given = {k: r[k] for k in ("particles", "spacing") if r.get(k) is not None}
+    if len(given) != 1:
+        raise SceneError(f"{settings.path}: field 'resolution': give exactly one of particles and spacing "
+                         f"(resolution '{settings.resolution}')")
+    return given

@@ -155,7 +155,7 @@ def warm_up(threads=1):
                                                       {"name": "r", "from": [4, 0], "to": [4, 4]}],
                             "liquid": {"weight": 1.0, "depth": 2.0}}, "")
     for variant in ("summation", "continuity"):
-        s = {k: v["value"] for k, v in S.load()["settings"].items()}
+        s = S.resolve(S.load(), "wcsph")
         s.update(density=variant, chunk_time=0.001)
         _run(tank, s, {"spacing": 1.0}, None, False, 0.002, lambda *a: None, threads)
 
@@ -173,7 +173,7 @@ def solve(tank, variant="wcsph", resolution=None, overrides=None, start=None, on
     vessels); threads: numba threads of the pair passes (results do not depend
     on it; recorded in params['threads']).
     """
-    s = S.resolve(S.load(settings_path), variant, overrides)
+    s = S.resolve(S.load(settings_path), variant, overrides, settings_path)
     res = _run(tank, s, resolution or {"particles": 180}, start, on_wall, t_max, log, set_threads(threads))
     res.variant = variant
     return res
@@ -220,10 +220,9 @@ def _run(tank, s, resolution, start, on_wall, t_max, log, threads=1):
     rho = np.concatenate([st["rho"], np.full(nw, st["rho_ref"])])
     p = np.zeros(nf + nw)
     walls = tank.walls
-    # the vessels are open at the top: a splash may rise above the walls and fall back in, by at most the
-    # largest free fall max_drop (a particle faster than sqrt(2 g max_drop) breaks the Mach 0.1 design)
+    # the vessels are open at the top: a splash may rise above the walls and fall back in (Tank.escape_box)
     wall_box = bounding_box(walls)
-    box = wall_box + [0.0, 0.0, 0.0, s["max_drop"]]
+    box = tank.escape_box()
     rc = 2 * st["h"] + par[K.SKIN]
     # the cell grid depends on the tank and the lattice only, so a continuation builds the same lists
     lo, hi = np.minimum(wall_box[:2], st["wpos"].min(0)) - rc, np.maximum(wall_box[2:], st["wpos"].max(0)) + rc
@@ -303,7 +302,7 @@ def _run(tank, s, resolution, start, on_wall, t_max, log, threads=1):
             message = (f"time limit {t_max:g} s reached at t = {t:.4g} s (step {steps}), not at rest: e = "
                        f"{monitor.last:.3g}, rms speed {rms:.3g} cm/s")
         now = time.perf_counter()
-        if now - last_log > 30.0:
+        if now - last_log > 20.0:
             log(f"sph: t = {t:.3f} s ({done_total * dt:.3f} / {t_max:g} s of this run), step {steps}, rms speed "
                 f"{rms:.3g} cm/s, {nf} particles, {(now - started) / max(done_total, 1) / nf * 1e9:.0f} ns/particle-step")
             last_log = now

@@ -1,0 +1,88 @@
+"""MPS as a tank method: what isaflow.run calls (check, solve, warm_up, REFERENCES).
+
+A run is a tank, the MPS settings of one source term (the variant) and spacing (the resolution), and
+optionally a start file (an MPS run whose final state, clock and step count this run continues).  The
+time limit is ``time.single_time`` in a single vessel and ``time.flow_time`` in a tank of vessels; a run
+stops earlier once at rest (isaflow.rest).  Units: cm, N, s.
+"""
+
+from pathlib import Path
+
+import numpy as np
+
+from ... import runfile
+from ...inputs import InputError
+from . import boundary, solver
+
+REFERENCES = ("Koshizuka & Oka (1996), Nucl. Sci. Eng. 123, 421; MPS-Basic (github.com/MPS-Basic/MPS-Basic); "
+              "Hattori, Seta, Shibata & Koshizuka, 'A new derivation of pressure Poisson equation in MPS'; "
+              "Tanaka & Masunaga (2010), J. Comput. Phys. 229, 4279")
+SNAPSHOTS = 6  # evenly spaced position snapshots of a run in a tank of vessels
+
+
+def _flow(tank):
+    return len(tank.spec.get("vessels", [])) > 1
+
+
+def check(tank, settings, variant, resolution, start=None):
+    """Every check that can refuse the run: a spacing, and a start file that is an MPS run of that spacing."""
+    l0 = settings["resolution.spacing"]
+    if l0 is None:
+        raise InputError(f"{settings.path}: field 'resolutions.{resolution}': no resolution.spacing")
+    if start is not None:
+        with runfile.open_run(start) as ds:
+            if ds.attrs.get("method") != "mps":
+                raise InputError(f"--start: '{start}' is a run of method '{ds.attrs.get('method')}', not an MPS run")
+            if ds.attrs.get("status") in ("escaped", "nonfinite", "solver_failed"):
+                raise InputError(f"--start: '{start}' holds no valid state (status {ds.attrs['status']})")
+            if not np.isclose(float(ds.attrs.get("spacing", np.nan)), l0, rtol=1e-9):
+                raise InputError(f"--start: '{start}' has spacing {ds.attrs.get('spacing')} cm, this run asks for "
+                                 f"{l0:.6g} cm")
+
+
+def start_state(path):
+    """solver.solve's start dict of a run file: final positions and velocities, step count, time, the chain's
+    initial depth."""
+    ds = runfile.read(path)
+    return dict(pos=ds["pos"].values, vel=ds["velocity"].values, steps=int(ds["steps"]), sim_time=float(ds["sim_time"]),
+                initial_depth=float(ds.attrs["initial_depth"]),
+                origin=f"final state of {Path(path).name} ({ds.attrs['status']}, t = {float(ds['sim_time']):.3f} s)")
+
+
+def on_wall_start(tank, l0, point):
+    """The liquid block at rest with the particle nearest ``point`` (x, y cm) moved onto it."""
+    xr, floor = solver.first_vessel(tank)
+    fluid = boundary.liquid_block(xr, floor, tank.depth, l0)
+    k = int(np.argmin(np.hypot(*(fluid - np.asarray(point) - [0, l0 / 2]).T)))
+    fluid[k] = point
+    return dict(pos=fluid, vel=np.zeros_like(fluid), steps=0, sim_time=0.0)
+
+
+def warm_up(threads=None):
+    """Compile (or load from numba's cache) every kernel a run times: a few steps of a small block."""
+    from ...tank import Tank
+    from . import settings as S
+
+    tank = Tank("warm-up", {"name": "box", "walls": [{"name": "l", "from": [0, 20], "to": [0, 0]},
+                                                      {"name": "f", "from": [0, 0], "to": [20, 0]},
+                                                      {"name": "r", "from": [20, 0], "to": [20, 20]}],
+                            "liquid": {"weight": 10.0, "depth": 10.0}}, "")
+    for variant in ("standard", "hattori", "mixed"):
+        cfg = S.load(variant=variant, resolution=None, overrides={"resolution.spacing": 2.0})
+        solver.solve(tank, cfg, variant, 2.0, 3e-3, np.array([[10.0, 5.0]]), log=lambda msg: None, threads=threads)
+
+
+def solve(tank, settings, variant, resolution, start=None, progress=None, threads=None):
+    """Run MPS on the tank (from start's final state if given) -> contract.Result."""
+    l0 = float(settings["resolution.spacing"])
+    flow = _flow(tank)
+    t_end = settings["time.flow_time"] if flow else settings["time.single_time"]
+    probes = settings["probes.flow"] if flow else settings["probes.single"]
+    st = start_state(start) if start is not None else None
+    if st is None and settings["start.on_wall_point"] is not None:
+        st = on_wall_start(tank, l0, settings["start.on_wall_point"])
+    log = progress.log if progress is not None else (lambda msg: None)
+    res = solver.solve(tank, settings, variant, l0, t_end, probes, start=st, snapshots=SNAPSHOTS if flow else 0,
+                       log=log, threads=threads)
+    res.spacing = l0
+    return res

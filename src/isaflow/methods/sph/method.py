@@ -1,0 +1,47 @@
+"""WCSPH as a tank method: what isaflow.run calls (check, solve, warm_up, REFERENCES).
+
+A run is a tank, the SPH settings of one variant and resolution (config/methods/sph.yaml) and
+optionally a start file (an SPH run whose final state, clock and step count this run continues).
+Units: cm, N, s.
+"""
+
+from ... import runfile
+from ...inputs import InputError
+from . import settings as S
+from . import solver
+
+REFERENCES = ("Marko (2017), Computation 5, 33 (section 2); Monaghan (1992), Annu. Rev. Astron. Astrophys. 30, 543; "
+              "Monaghan (1994), J. Comput. Phys. 110, 399; Adami, Hu & Adams (2012), J. Comput. Phys. 231, 7057; "
+              "Molteni & Colagrossi (2009), Comput. Phys. Commun. 180, 861")
+START_VARS = ("pos", "velocity", "density", "weight")
+
+
+def check(tank, settings, variant, resolution, start=None):
+    """Every check that can refuse the run: one resolution, and a start file that is an SPH run with its state."""
+    S.resolution(settings)
+    if start is not None:
+        with runfile.open_run(start) as ds:
+            if ds.attrs.get("method") != "sph":
+                raise InputError(f"--start: '{start}' is a run of method '{ds.attrs.get('method')}', not an SPH run")
+            missing = [v for v in START_VARS if v not in ds.variables]
+            if missing or "cell_dx" not in ds.attrs:
+                raise InputError(f"--start: '{start}' holds no SPH state ({', '.join(missing) or 'cell_dx'} missing)")
+            if ds.attrs.get("status") in ("escaped", "nonfinite"):
+                raise InputError(f"--start: '{start}' holds no valid state (status {ds.attrs['status']})")
+
+
+def warm_up(threads=None):
+    """Compile (or load from numba's cache) the kernels a run times."""
+    solver.warm_up(threads or 1)
+
+
+def solve(tank, settings, variant, resolution, start=None, progress=None, threads=None):
+    """Run SPH on the tank (from start's final state if given) -> contract.Result."""
+    s = S.physics(settings)
+    start_ds = runfile.read(start) if start is not None else None
+    log = progress.log if progress is not None else (lambda msg: None)
+    res = solver._run(tank, s, S.resolution(settings), start_ds, bool(settings["resolution.on_wall"]), None, log,
+                      solver.set_threads(threads or 1))
+    res.variant = variant
+    res.spacing = float((res.params["cell_dx"] * res.params["cell_dy"]) ** 0.5)
+    return res
