@@ -18,7 +18,7 @@ paper's figures, used only where a paper's own level is compared.
 - ``reference="level"``: as "own" with the top-centre level as the surface
   (the paper's reading; ISA's claims of its own level only).
 Errors: ``floor_err`` (computed floor total - theory) / theory; ``side_err``
-mean over the side walls of (computed - theory) / theory; ``contact_rms`` RMS
+(computed - theory) / theory of the wetted side walls' loads together; ``contact_rms`` RMS
 over wetted contacts of (computed - theory) / (gamma h a) (units of one floor
 contact load, a = panel_length); ``side_height_err`` height of the side
 resultant minus h / 3 [cm].
@@ -126,7 +126,7 @@ def contact_loads(ds, vessel=None, reference="own"):
     th = theory.contact_theory(walls, cw, cp, gamma, level, v["wall_in"])
     out = dict(level=level, depth=h, level_max=float(pos[v["inside"], 1].max()) if v["inside"].any() else np.nan,
                weight=weight, gamma=gamma)
-    side_err, side_h_err, implied = [], [], []
+    side_load, side_theory, side_h_err, implied = [], [], [], []
     for w, name in enumerate(str(n) for n in ds["wall"].values):
         if not v["wall_in"][w]:
             continue
@@ -138,10 +138,12 @@ def contact_loads(ds, vessel=None, reference="own"):
         if v["horizontal"][w] and np.isclose(walls[w, 1], v["floor_y"]):
             out["floor_err"] = (total - th_total) / th_total if th_total > 0 else np.nan
         elif not v["horizontal"][w] and th_total > 0:
-            side_err.append((total - th_total) / th_total)
+            side_load.append(total)
+            side_theory.append(th_total)
             side_h_err.append(theory.resultant_height(cp[on, 1], mag[on]) - v["floor_y"] - h / 3)
             implied.append(theory.implied_level(total, weight, v["width"]) + v["floor_y"])
-    out["side_err"] = float(np.mean(side_err)) if side_err else np.nan
+    # over the wetted side walls together: a dividing wall wetted a few cm deep weighs by its load, not equally
+    out["side_err"] = (sum(side_load) - sum(side_theory)) / sum(side_theory) if side_theory else np.nan
     out["side_height_err"] = float(np.mean(side_h_err)) if side_h_err else np.nan
     out["level_implied"] = float(np.mean(implied)) if implied else np.nan
     wet = np.isfinite(th)

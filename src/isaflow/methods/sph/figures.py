@@ -14,6 +14,8 @@ def _method_title(fig, ds, what):
     """Suptitle naming the method, the variant (its registry label, wrapped) and what the figure shows."""
     label = textwrap.fill(f"variant {ds.attrs['variant']}: {ds.attrs['variant_label']}", 90)
     fig.suptitle(f"Weakly compressible SPH, {what}\n{label}", fontsize=9)
+    lines = 2 + label.count("\n")
+    fig.tight_layout(rect=(0, 0, 1, 1 - 0.012 * lines * 12 / fig.get_figheight()))
 
 
 def single(paths, out):
@@ -43,7 +45,6 @@ def single(paths, out):
     b.title.set_fontsize(9)
     b.legend(fontsize=7)
     _method_title(fig, ds, "single vessel, W = 9 kN")
-    fig.tight_layout()
     save(fig, out)
 
 
@@ -70,7 +71,6 @@ def flow(paths, out):
         ax.title.set_fontsize(9)
         ax.legend(fontsize=7, loc="upper right")
     _method_title(fig, ds, "flow into the second vessel, final states")
-    fig.tight_layout()
     save(fig, out)
 
 
@@ -89,7 +89,6 @@ def snapshots(path, out):
         ax.set(aspect="equal", xlabel="x (cm)", ylabel="y (cm)", title=f"{t[k]:.2f} s after the opening")
         ax.title.set_fontsize(9)
     _method_title(fig, ds, f"flow snapshots, tank {ds.attrs['tank']}, {ds.sizes['particle']} particles")
-    fig.tight_layout()
     save(fig, out)
 
 
