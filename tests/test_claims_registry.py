@@ -201,25 +201,18 @@ def _smk_list(path, name):
 
 
 def existing_runs():
-    """Every run id the workflow defines today, as <method>:<id> (from the config and rule files)."""
-    cfg = yaml.safe_load((ROOT / "config/config.yaml").read_text())
-    runs = {f"isa:{r}" for r in cfg["runs"]} | {"isa:calibration", "isa:error_vs_runtime", "isa:stability_map"}
-    sph = yaml.safe_load((ROOT / "config/methods/sph.yaml").read_text())
-    res = {case: [f"n{r['particles']}" if "particles" in r else f"dx{r['spacing']:g}" for r in sph["runs"][case]]
-           for case in ("single", "flow")}
-    runs |= {f"sph:single_wcsph_{r}" for r in res["single"]} | {f"sph:flow_wcsph_{r}" for r in res["flow"]}
-    runs |= {f"sph:single_{v}_{r}" for v in sph["variants"] if v != "wcsph" for r in res["single"][:-1]}
-    runs |= {f"sph:stab_{c}" for c in sph["runs"]["stability"]}
-    mps = yaml.safe_load((ROOT / "config/methods/mps.yaml").read_text())
-    variants = _smk_list("workflow/rules/methods/mps.smk", "MPS_VARIANTS")
-    for case in ("single", "flow"):
-        runs |= {f"mps:{case}_{v}_dx{l0:.3g}" for v in variants for l0 in mps["runs"][f"{case}_spacings"]["value"]}
-    runs |= {f"mps:stiff_{c}" for c in _smk_list("workflow/rules/methods/mps.smk", "MPS_STIFF")}
-    runs |= {f"mps:dt_standard_c{c:g}" for c in mps["dt_study"]["courants"]["value"]}
+    """Every run id the workflow defines today, as <method>:<id>: the runs declared in every tank method's
+    settings file, ISA's planned groups, the solid runs (its rule file) and the 1D sweep."""
+    from isaflow import methods, settings as S
+
+    runs = set()
+    for name, m in methods.tank_methods().items():
+        runs |= {f"{name}:{r}" for r in S.read(ROOT / m.settings, m.values_schema()).get("runs", {})}
+    runs |= {"isa:calibration", "isa:error_vs_runtime", "isa:stability_map"}
     cases = _smk_list("workflow/rules/methods/solid.smk", "SOLID_CASES")
     runs |= {f"solid:{c}_{v}" for c in cases for v in ("paper", "hooke")}
     runs |= {"solid:vessel_pressure_load", "solid:vessel_water_particles", "solid:floor_uniform_uniform_load"}
-    runs |= {f"solid:floor_{m}_oneway" for m in ("isa", "sph", "mps")}
+    runs |= {f"solid:floor_{m}_oneway" for m in methods.tank_methods()}
     return runs | {"sph1d:sweep"}
 
 

@@ -27,10 +27,11 @@ from importlib import resources
 from pathlib import Path
 
 from .inputs import InputError, load as load_yaml
+from .methods import papers
 
 SCHEMA = json.loads(resources.files("isaflow").joinpath("claims.schema.json").read_text())
-PAPERS = ("papadopoulos2016", "marko2017", "hattori", "merino_alonso2020")
-PREFIX = {"papadopoulos2016": "pap", "marko2017": "mar", "hattori": "hat", "merino_alonso2020": "mer"}
+PAPERS = tuple(papers())  # the paper ids of the method registry, the paper replicated first
+PREFIX = {p: p[:3] for p in PAPERS}  # claim ids start with it: pap-, mar-, hat-, mer-
 KINDS = ("method result", "paper arithmetic", "holds by construction", "input rule", "paper inconsistency",
          "project check")
 PAPER_KINDS = KINDS[:-1]  # the kinds counted in a paper's tally
