@@ -76,7 +76,7 @@ def test_laplacian_exact_for_quadratics_on_the_lattice(re):
     assert np.allclose(lap[inner], 8.0, rtol=1e-10)
 
 
-@pytest.mark.parametrize("mode", sorted(operators.GRADIENTS))
+@pytest.mark.parametrize("mode", sorted(set(operators.GRADIENTS) - {"cmps"}))
 def test_gradient_and_divergence_exact_for_linear_fields(mode):
     """Gradient of 2 x - 3 y + 101 is (2, -3) and the divergence of (2 x, -5 y) is -3 away from the edge:
     sum r r^T / r^2 w = n0 / d I and sum r / r^2 w = 0 on the square lattice (tolerance: round-off)."""
@@ -117,6 +117,75 @@ def test_corrected_gradient_exact_at_the_free_edge_and_on_disorder():
     normal = np.tile([0.0, 1.0], (len(pos), 1))
     out = model.surface_values(pos, p, kind, np.ones(len(pos), np.bool_), normal, start, nbr, dist, 2.1, n0, 1.0)
     assert np.allclose(out, 3.0, rtol=1e-10)
+
+
+def test_cmps_gradient_conserves_momentum_but_loses_the_linear_part_on_the_lattice():
+    """CMPS (Khayyer & Gotoh 2008), sum [(p_i + p_j) - (p^_i + p^_j)] r_ij / r^2 w: the pair terms are
+    antisymmetric, so the pressure forces of a closed set of particles add up to zero (round-off) on a disordered
+    arrangement, and every pair repels (both shifted pressures are >= 0).  Its price, measured here: on the lattice
+    the shifted pressures p - p^ of a linear field are the same at every interior particle, so the interior
+    gradient of 2 x - 3 y is zero, where K&O's form gives (2, -3); only the disorder-dependent repulsion remains to
+    hold the liquid up (the single-vessel runs: side loads +53 % to +110 %, config/methods/mps.yaml)."""
+    pos = lattice(l0=2.0)
+    n0, _ = model.lattice_constants(2.1, 2.0)
+    start, nbr, dist = lists(pos, 2.1 * 2.0)
+    kind = np.zeros(len(pos), np.int64)
+    p = 2 * pos[:, 0] - 3 * pos[:, 1] + 101.0
+    g = model.gradient(pos, p, kind, start, nbr, dist, 4.2, n0, operators.GRADIENTS["cmps"])
+    inner = interior(pos, 2 * 4.2)
+    assert np.abs(g[inner]).max() < 1e-10
+    rng = np.random.default_rng(5)
+    pos = lattice(n=11) + rng.uniform(-0.2, 0.2, (121, 2))
+    start, nbr, dist = lists(pos, 2.1)
+    n0, _ = model.lattice_constants(2.1)
+    p = rng.uniform(0, 10, len(pos))
+    g = model.gradient(pos, p, np.zeros(len(pos), np.int64), start, nbr, dist, 2.1, n0, operators.GRADIENTS["cmps"])
+    assert np.abs(g.sum(0)).max() < 1e-10 * np.abs(g).sum()
+
+
+def test_higher_order_laplacian_and_source():
+    """Khayyer & Gotoh's higher-order operators as implemented (2D): the HL Laplacian 1/n0 sum (f_j - f_i) 3 r_e / r^3
+    (2010) of x^2 + 3 y^2 on the lattice is 8 times 1/n0 sum x^2 3 r_e / r^3 / 2 (the lattice constant of the
+    singular weight: 2.13 at r_e = 2.1, 1.86 at 3.1 -- not 1: the model is not exact on the lattice, its pressure
+    equation asks for a larger Laplacian than the standard one); the HS divergence -1/n0 Dn/Dt (2009) of
+    (2 x, -5 y) is -3 times 1/n0 sum x^2 r_e / r^3 (1.42 at 2.1, 1.24 at 3.1).  HS is 0 for a uniform velocity."""
+    for re in (2.1, 3.1):
+        pos = lattice(n=21)
+        n0, lam = model.lattice_constants(re)
+        start, nbr, dist = lists(pos, re)
+        kind = np.zeros(len(pos), np.int64)
+        inner = interior(pos, re + 0.5)
+        k = int(np.ceil(re))
+        g = np.arange(-k, k + 1.0)
+        X, Y = np.meshgrid(g, g)
+        r = np.hypot(X, Y).ravel()
+        x2 = (X.ravel() ** 2)[(r > 0) & (r < re)]
+        r = r[(r > 0) & (r < re)]
+        c_hl = (x2 * 3 * re / r**3).sum() / n0 / 2
+        c_hs = (x2 * re / r**3).sum() / n0
+        f = pos[:, 0] ** 2 + 3 * pos[:, 1] ** 2 + 5.0
+        none = np.zeros(len(pos), np.bool_)
+        row, indptr, indices, data, rhs = model.assemble(kind, none, np.zeros(len(pos)), np.zeros(len(pos)), start, nbr,
+                                                         dist, re, n0, lam, 0.0, 1)
+        A = pressure.csr(indptr, indices, data)
+        lap = -(A @ f[row >= 0]) / n0  # rows: sum 3 r_e / r^3 (f_i - f_j) = -n0 <lap f>
+        assert np.allclose(lap[row[inner]], 8.0 * c_hl, rtol=1e-10)
+        vel = np.column_stack([2 * pos[:, 0], -5 * pos[:, 1]])
+        div = model.divergence_hs(pos, vel, start, nbr, dist, re, n0)
+        assert np.allclose(div[inner], -3.0 * c_hs, rtol=1e-10)
+        assert np.allclose(model.divergence_hs(pos, np.ones_like(pos), start, nbr, dist, re, n0), 0.0, atol=1e-12)
+        assert (c_hl, c_hs) == pytest.approx({2.1: (2.126, 1.417), 3.1: (1.857, 1.238)}[re], abs=1e-3)
+
+
+def test_error_compensating_source():
+    """ECS (Khayyer & Gotoh 2011): zero where the number density is n0 and steady; positive pressure (negative
+    right-hand side of lap P = b) where the liquid is compressed and being compressed; the alpha and beta weights."""
+    n0, rho, dt = 10.0, 2.0, 0.01
+    out = model.ecs_term(np.array([10.0, 10.2, 10.2, 9.9]), np.array([10.0, 10.1, 10.2, 9.9]), n0, rho, dt)
+    assert out[0] == 0.0 and out[2] == 0.0 and out[3] == 0.0  # steady: (Dn/Dt)^k = 0 gives alpha and beta terms 0
+    rate = 0.1 / dt
+    expect = -rho / (n0 * dt) * (0.2 / n0) * rate - abs(dt / n0 * rate) * rho / (n0 * dt**2) * 0.2
+    assert out[1] == pytest.approx(expect) and out[1] < 0.0
 
 
 # --- the seed's checkable statement ---------------------------------------------
@@ -432,9 +501,21 @@ def test_mass_momentum_and_recorded_variant(column_runs, tmp_path):
 
 @pytest.mark.parametrize("variant", VARIANTS)
 @pytest.mark.xfail(strict=True, reason="no MPS source term comes to rest with the literature's practices: single "
-                                       "vessel, l0 = 5.56 cm, 3 s: kinetic energy / (W h) 3.8e-3 (standard), 3.1e-3 "
-                                       "(hattori), 1.5e-3 (mixed) against the rest limit 1e-5 (rms 23, 21, 14 cm/s); "
-                                       "l0 = 3.45 cm: 2.6e-3, 2.6e-3, 1.5e-3")
+                                       "vessel, l0 = 5.56 cm, 3 s: kinetic energy / (W h) 3.0e-3 (standard), 3.4e-3 "
+                                       "(hattori), 1.4e-3 (mixed) against the rest limit 1e-5 (rms 21, 22, 14 cm/s); "
+                                       "l0 = 3.45 cm: 2.6e-3, 2.6e-3, 1.5e-3.  Named options measured the same way "
+                                       "(standard, hattori, mixed at 3 s, l0 = 5.56 / 3.45 cm): cmps gradient (Khayyer "
+                                       "& Gotoh 2008) 2.7e-3, 2.9e-3, escaped at 0.78 s / 3.1e-3, 3.6e-3, escaped at "
+                                       "0.25 s, side load +53 to +156 %; ecs source (K&G 2011) 3.5e-3, 2.9e-3, 1.5e-3 / "
+                                       "2.8e-3, 2.9e-3, 1.5e-3; hl Laplacian (K&G 2010) 2.5e-3, 2.2e-3, 2.6e-3; hs "
+                                       "divergence (K&G 2009) 3.0e-3, 2.3e-3, 2.3e-3; hs+ecs+hl 2.3e-3, 2.0e-3, "
+                                       "2.7e-3 / 1.9e-3, 2.1e-3, 1.8e-3; corrected gradient 1.1e-3, 1.1e-3, 4.2e-4, "
+                                       "with ecs the same, with hs+ecs+hl 8.1e-4, 1.5e-3, 5.9e-4; corrected + shifting "
+                                       "0.02 (Lind et al. 2012 form) 5.3e-4, 5.5e-4, 2.6e-4 at 8 s; symmetric gradient "
+                                       "1.9e-4, 2.5e-4, 4.1e-5 (2.6e-5, 2.8e-5, 4.0e-6 at 8 s, mixed side load -16 %), "
+                                       "with ecs 2.2e-5, 4.9e-5, 7.5e-6 at 8 s / 3.4e-5, 2.4e-5 and mixed at rest from "
+                                       "5.9 s at 8 s (side load +17, +6.6, -6.9 %), with hl or hs+ecs+hl 1.7-3.9e-5 "
+                                       "(standard, hattori) at 8 s, mixed side load -32 %")
 def test_column_comes_to_rest(variant):
     """The column started at rest is at rest by isaflow.rest (kinetic energy / (W h) below 1e-5 for 1.2 s)
     within the settings' time limit."""

@@ -13,14 +13,18 @@ from numba import njit, prange
 
 from isaflow.core.geometry import crossed_wall, segment_closest
 
-from .operators import (DIM, DUMMY, FLUID, GRADIENTS, JIT, PAR, WALL, distances, divergence, gradient,  # noqa: F401
-                        lattice_constants, laplacian, neighbour_list, number_density, offsets, probe_pressure,
+from .operators import (DIM, DUMMY, FLUID, GRADIENTS, JIT, PAR, WALL, distances, divergence, divergence_hs,  # noqa: F401
+                        gradient, lattice_constants, laplacian, neighbour_list, number_density, offsets, probe_pressure,
                         weight)
 
 # source terms of the pressure equation (settings name -> id)
 SOURCES = {"standard": 0, "hattori": 1, "mixed": 2}
 # free-surface pressure conditions (settings name -> id)
 SURFACE = {"zero": 0, "hydrostatic": 1, "extrapolated": 2}
+# Laplacian of the pressure equation (settings name -> id)
+LAPLACIANS = {"mps": 0, "hl": 1}
+# divergence of the source terms (settings name -> id)
+DIVERGENCES = {"mps": 0, "hs": 1}
 
 
 @njit(**JIT)
@@ -49,6 +53,23 @@ def source_term_all(n_star, div_star, n0, rho0, dt, source, gamma, relax, relax_
     scale = relax if relax_all and source != 0 else 1.0
     for i in prange(n):
         out[i] = scale * source_term(n_star[i], div_star[i], n0, rho0, dt, source, gamma, relax)
+    return out
+
+
+@njit(**PAR)
+def ecs_term(n_now, n_prev, n0, rho0, dt):
+    """(N,) error-compensating source (ECS) of Khayyer & Gotoh 2011 (J. Comput. Phys. 230, 3093), added to the
+    source term [N / cm^4]: -rho0 / (n0 dt) alpha (Dn/Dt)^k - beta rho0 / (n0 dt^2) (n^k - n0) with
+    alpha = |n^k - n0| / n0, beta = |dt / n0 (Dn/Dt)^k| and (Dn/Dt)^k = (n^k - n^{k-1}) / dt, n^k the number
+    density at the start of the step and n^{k-1} at the start of the previous one (signs: positive pressure
+    where the liquid is compressed or being compressed, as the standard source)."""
+    n = n_now.shape[0]
+    out = np.empty(n)
+    for i in prange(n):
+        rate = (n_now[i] - n_prev[i]) / dt
+        alpha = abs(n_now[i] - n0) / n0
+        beta = abs(dt / n0 * rate)
+        out[i] = -rho0 / (n0 * dt) * alpha * rate - beta * rho0 / (n0 * dt * dt) * (n_now[i] - n0)
     return out
 
 
@@ -183,7 +204,7 @@ def unknown_rows(kind, dirichlet):
 
 
 @njit(**PAR)
-def assemble(kind, dirichlet, p_dir, b, start, nbr, dist, re, n0, lam, diag_extra):
+def assemble(kind, dirichlet, p_dir, b, start, nbr, dist, re, n0, lam, diag_extra, lap_mode=0):
     """Pressure equation of the non-Dirichlet fluid and wall particles as CSR.
 
     Row of unknown i: diag_extra P_i + sum_j w_ij (P_i - P_j) = -(lambda n0 / 2d) b_i over fluid and wall
@@ -191,7 +212,9 @@ def assemble(kind, dirichlet, p_dir, b, start, nbr, dist, re, n0, lam, diag_extr
     the MPS Laplacian times -(lambda n0 / 2d) plus the compressibility term (MPS-Basic's
     PressurePoissonEquation scaled by rho0 lambda n0 / 2d).  Symmetric; positive definite when
     diag_extra > 0 or every cluster touches a Dirichlet particle.  Row i's entries: the diagonal, then
-    its neighbours in list order.  Returns (row (N,), indptr, indices, data, rhs)."""
+    its neighbours in list order.  lap_mode (LAPLACIANS) 1: the higher-order Laplacian of Khayyer & Gotoh
+    2010 (Appl. Ocean Res. 32, 124), <lap P>_i = 1/n0 sum_j (P_j - P_i) 3 r_e / r^3 (2D), i.e. the weight
+    3 r_e / r^3 and the right-hand side -n0 b_i.  Returns (row (N,), indptr, indices, data, rhs)."""
     n = kind.shape[0]
     row, nu = unknown_rows(kind, dirichlet)
     count = np.zeros(nu + 1, np.int64)
@@ -208,7 +231,7 @@ def assemble(kind, dirichlet, p_dir, b, start, nbr, dist, re, n0, lam, diag_extr
     indices = np.empty(count[nu], np.int32)
     data = np.empty(count[nu])
     rhs = np.empty(nu)
-    c0 = -lam * n0 / (2.0 * DIM)
+    c0 = -lam * n0 / (2.0 * DIM) if lap_mode == 0 else -n0
     for i in prange(n):
         r = row[i]
         if r < 0:
@@ -222,7 +245,7 @@ def assemble(kind, dirichlet, p_dir, b, start, nbr, dist, re, n0, lam, diag_extr
             j = nbr[k]
             if kind[j] == DUMMY or dist[k] >= re:
                 continue
-            wt = weight(dist[k], re)
+            wt = weight(dist[k], re) if lap_mode == 0 else 3.0 * re / max(dist[k], 1e-6 * re) ** 3
             diag += wt
             if row[j] >= 0:
                 indices[q] = row[j]

@@ -245,6 +245,27 @@ def divergence(pos, vel, start, nbr, dist, re, n0):
 
 
 @njit(**PAR)
+def divergence_hs(pos, vel, start, nbr, dist, re, n0):
+    """(N,) divergence as the higher-order source term of Khayyer & Gotoh 2009 (Appl. Ocean Res. 31, 111):
+    -(1/n0) Dn/Dt with the analytic rate of the number density, Dn/Dt = -sum_j r_e / r^3 (r_ij . u_ij) [1/s]
+    (all neighbours within re; wall particles' velocity is theirs, 0)."""
+    n = pos.shape[0]
+    out = np.zeros(n)
+    for i in prange(n):
+        s = 0.0
+        for k in range(start[i], start[i + 1]):
+            if dist[k] >= re:
+                continue
+            j = nbr[k]
+            r = max(dist[k], 1e-6 * re)
+            dx = pos[j, 0] - pos[i, 0]
+            dy = pos[j, 1] - pos[i, 1]
+            s += ((vel[j, 0] - vel[i, 0]) * dx + (vel[j, 1] - vel[i, 1]) * dy) * re / (r * r * r)
+        out[i] = s / n0
+    return out
+
+
+@njit(**PAR)
 def laplacian(f, kind, start, nbr, dist, re, n0, lam):
     """(N, C) MPS Laplacian of f (N, C) at the fluid particles over fluid and wall neighbours (0 elsewhere)."""
     n = f.shape[0]
@@ -265,7 +286,7 @@ def laplacian(f, kind, start, nbr, dist, re, n0, lam):
     return out
 
 
-GRADIENTS = {"min": 0, "corrected": 1, "symmetric": 2}
+GRADIENTS = {"min": 0, "corrected": 1, "symmetric": 2, "cmps": 3}
 
 
 @njit(**PAR)
@@ -274,7 +295,9 @@ def gradient(pos, p, kind, start, nbr, dist, re, n0, mode):
     neighbours (not dummies).  mode (GRADIENTS): 0 K&O 1996, sum (p_j - p^_i), p^_i the minimum of p_i and
     its neighbours' (MPS-Basic's calPressureGradient); 1 the same with the corrective matrix
     C_i = (d/n0 sum_j w r_ij r_ij^T / r^2)^-1 (Khayyer & Gotoh 2011; the plain sum where det C_i^-1 < 0.01);
-    2 sum (p_i + p_j) (pairwise antisymmetric: momentum-conserving).
+    2 sum (p_i + p_j) (pairwise antisymmetric: momentum-conserving); 3 CMPS (Khayyer & Gotoh 2008, Coastal
+    Eng. J. 50, 179), sum [(p_i + p_j) - (p^_i + p^_j)]: momentum-conserving and, both shifted pressures being
+    >= 0, repulsive for every pair.
     """
     n = pos.shape[0]
     pmin = p.copy()
@@ -307,8 +330,10 @@ def gradient(pos, p, kind, start, nbr, dist, re, n0, mode):
             r2 = dist[k] * dist[k]
             if mode <= 1:
                 q = (p[j] - pmin[i]) / r2 * wt
-            else:
+            elif mode == 2:
                 q = (p[j] + p[i]) / r2 * wt
+            else:
+                q = ((p[j] - pmin[j]) + (p[i] - pmin[i])) / r2 * wt
             gx += q * dx
             gy += q * dy
             mxx += dx * dx / r2 * wt

@@ -100,6 +100,9 @@ class State:
             self.walls, self.bnd, cfg["walls.panel_length"])
         self.surface_mode = model.SURFACE[cfg["model.surface_pressure"]]
         self.grad_mode = model.GRADIENTS[cfg["model.gradient"]]
+        self.lap_mode = model.LAPLACIANS[cfg["model.pressure_laplacian"]]
+        self.div_mode = model.DIVERGENCES[cfg["model.divergence"]]
+        self.n_prev = None  # number density at the start of the previous step (ECS)
         self.builds = 0
         self.start = self.nbr = self.list_pos = None
         self.surf = np.zeros(n, bool)
@@ -133,11 +136,17 @@ def step(s, dt, source, cfg, timers=None):
     if s.start is None or not s.list_valid(s.pos):
         s.neighbours(s.pos)
     nu = cfg["model.kinematic_viscosity"]
-    if nu > 0:
+    ecs = cfg["model.ecs"]
+    if nu > 0 or ecs:
         dist = model.distances(s.pos, s.start, s.nbr)
+    if nu > 0:
         lap = model.laplacian(s.vel, s.kind, s.start, s.nbr, dist, s.re_l, s.n0_l, s.lam)
     else:
         lap = np.zeros_like(s.vel)
+    if ecs:
+        n_now = model.number_density(s.start, s.nbr, dist, s.re_n)
+        b_ecs = model.ecs_term(n_now, n_now if s.n_prev is None else s.n_prev, s.n0_n, s.rho0, dt)
+        s.n_prev = n_now
     ps, vs = model.explicit(s.pos, s.vel, s.kind, lap, dt, 0.0, -units.G, nu)
     if not s.list_valid(ps):
         s.neighbours(ps)
@@ -148,11 +157,16 @@ def step(s, dt, source, cfg, timers=None):
             s.neighbours(ps)
     dist = model.distances(ps, s.start, s.nbr)
     n_star = model.number_density(s.start, s.nbr, dist, s.re_n)
-    div = model.divergence(ps, vs, s.start, s.nbr, dist, s.re_g, s.n0_g)
+    if s.div_mode == 1:
+        div = model.divergence_hs(ps, vs, s.start, s.nbr, dist, s.re_g, s.n0_g)
+    else:
+        div = model.divergence(ps, vs, s.start, s.nbr, dist, s.re_g, s.n0_g)
     dist_thr = cfg["model.surface_distribution"] * s.l0
     surf, normal = model.surface(ps, s.kind, s.start, s.nbr, dist, s.re_s, s.n0_s, cfg["model.beta"], dist_thr, s.rmax)
     b = model.source_term_all(n_star, div, s.n0_n, s.rho0, dt, model.SOURCES[source], cfg["model.gamma_mixed"],
                               cfg["model.relaxation"], cfg["model.relax_all_sources"])
+    if ecs:
+        b = b + b_ecs
     p_dir = np.zeros(len(ps))
     if s.surface_mode == 1:
         p_dir[surf] = s.rho0 * units.G * 0.5 * s.l0 * np.maximum(normal[surf, 1], 0.0)
@@ -161,7 +175,7 @@ def step(s, dt, source, cfg, timers=None):
     sound = cfg["model.sound_speed"]
     extra = s.lam * s.n0_l / (2.0 * model.DIM * sound**2 * dt**2) if sound > 0 else 0.0
     row, indptr, indices, data, rhs = model.assemble(s.kind, surf, p_dir, b, s.start, s.nbr, dist, s.re_l, s.n0_l,
-                                                     s.lam, extra)
+                                                     s.lam, extra, s.lap_mode)
     t1 = time.perf_counter()
     unk = row >= 0
     x0 = np.zeros(int(unk.sum()))
@@ -351,6 +365,8 @@ def _solve(tank, cfg, variant, l0, t_end, probes, start, snapshots, log, threads
         "lambda_cm2": s.lam, "beta": cfg["model.beta"], "relaxation": cfg["model.relaxation"],
         "sound_speed_cm_s": cfg["model.sound_speed"], "surface_pressure": cfg["model.surface_pressure"],
         "gradient_model": cfg["model.gradient"], "shifting": cfg["model.shifting"],
+        "pressure_laplacian": cfg["model.pressure_laplacian"], "divergence_model": cfg["model.divergence"],
+        "ecs": int(cfg["model.ecs"]),
         "surface_distribution": cfg["model.surface_distribution"], "kinematic_viscosity_cm2_s": cfg["model.kinematic_viscosity"],
         "gamma_mixed": cfg["model.gamma_mixed"], "courant": cfg["time.courant"], "pressure_solver": cfg["pressure.solver"],
         "pressure_rtol": cfg["pressure.rtol"], "max_solve_residual": max_resid, "mean_solve_iterations": float(np.mean(iters)),
