@@ -142,3 +142,26 @@ def report_figure(name, caption, category, subcategory=None):
     """figure(name) with the PNG marked for the Snakemake report."""
     png, pdf = figure(name)
     return [report_file(png, caption, category, subcategory), pdf]
+
+
+# the claims (claims.smk)
+CLAIM_PAPERS = list(_methods.papers())
+# run files outside the tank methods' runs, by '<method>:<run id>' (the solid and 1D methods register theirs)
+OTHER_RUN_FILES = {}
+# groups of runs, by '<method>:<group>' (ISA's study groups, calibration)
+RUN_GROUPS = {}
+
+
+def claim_runs(wc=None):
+    """{'<method>:<run>': path or [paths]} of every run any claim may read."""
+    out = {f"{m}:{r}": run_file(m, r) for m in TANK_METHODS for r in RUNS[m]}
+    out.update(OTHER_RUN_FILES)
+    out.update(RUN_GROUPS)
+    return out
+
+
+def claim_inputs(wc):
+    files = []
+    for v in claim_runs().values():
+        files += v if isinstance(v, list) else [v]
+    return sorted(set(files))

@@ -31,6 +31,12 @@ for _sid in STUDY_RUNS:
         STUDY_RUNS[_sid]["runtime"] = True  # single-vessel points of the methods' error-against-run-time figure
 declare_runs("isa", {**ISA_RUNS, **STUDY_RUNS, **CAL_RUNS})
 STUDY_META = _isa_plan.meta(STUDY_RUNS)
+# groups of runs the claims read (claims.smk)
+RUN_GROUPS.update({"isa:error_vs_runtime": _isa_plan.run_files(STUDY_RUNS, "error_runtime"),
+                   "isa:stability_map": _isa_plan.run_files(STUDY_RUNS, "stability_map"),
+                   "isa:cases": _isa_plan.run_files(STUDY_RUNS, "cases"),
+                   "isa:fire_tuning": _isa_plan.run_files(STUDY_RUNS, "fire_tuning"),
+                   "isa:calibration": [run_file("isa", r) for r in CAL_RUNS]})
 CAL_FILES = [run_file("isa", r) for r in CAL_RUNS]
 FIGS = ISA["figures"]
 FLOW = ISA["flow"]

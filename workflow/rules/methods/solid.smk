@@ -154,3 +154,7 @@ rule solid_claims:
         "logs/solid/claims.log",
     script:
         "../../scripts/call.py"
+
+
+# the solid runs the claims read (claims.smk): 'solid:<case>_<variant>'
+OTHER_RUN_FILES.update({f"solid:{os.path.splitext(os.path.basename(f))[0]}": f for f in SOLID_RUNS + SOLID_NEW_RUNS})

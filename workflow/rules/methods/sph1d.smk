@@ -70,3 +70,7 @@ rule sph1d_report:
         "logs/sph1d/report.log",
     script:
         "../../scripts/call.py"
+
+
+# the sweep the claims read (claims.smk)
+OTHER_RUN_FILES["sph1d:sweep"] = "results/sph1d/sweep.nc"

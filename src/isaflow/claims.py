@@ -1,0 +1,184 @@
+"""Every claim's verdict, computed from run outputs: the one place a verdict is written.
+
+The claims are the registry (config/claims/<paper>.yaml, isaflow.claims_registry): quote, kind,
+the quantity, the tolerance with its derivation and source, the runs.  What each claim measures is a
+function of the run outputs, kept with the method it measures: every method package may define a
+module ``claims`` with ``MEASURES = {claim id: function(ctx, entry) -> Measurement}``.  A measure
+returns numbers and whether the tolerance's test passed (reading the tolerance from the entry, never
+holding one of its own); :func:`verdict` turns that into the verdict:
+
+- ``not testable here``: the registry says so (its reason), or a run the claim needs is missing;
+- ``reproduced only after calibrating <input>``: passed, but an input the claim rests on was chosen
+  to match it (``calibrated_against`` in the registry's inputs);
+- ``reproduced`` / ``not reproduced``: the test passed / failed.
+
+Units: cm, N, s.
+"""
+
+import importlib
+from dataclasses import dataclass
+from pathlib import Path
+
+import pandas as pd
+
+from . import claims_registry, methods, runfile
+
+VERDICTS = ("reproduced", "reproduced only after calibrating", "not reproduced", "not testable here")
+COLUMNS = ["id", "paper", "section", "kind", "half", "claim", "measured", "tolerance", "verdict", "evidence", "why",
+           "margin", "sensitivity"]
+
+
+@dataclass
+class Measurement:
+    """What a claim's measure found: the numbers (text with units), whether the tolerance's test passed
+    (None: the runs cannot test it; ``measured`` says why), and where to look."""
+
+    measured: str
+    passed: bool | None
+    evidence: str = ""
+    why: str = ""  # the explanation of a failure
+    margin: str = ""  # where the verdict would flip (the threshold a referee would look at)
+    sensitivity: str = ""  # the verdict across the inferred inputs' ranges
+
+
+class Context:
+    """Run outputs a measure reads: run files by '<method>:<run id>' and tables by path, each read once.
+
+    runs: {'<method>:<run id>': path}; tables: {name: path}.  A missing run raises Missing (the claim is
+    then 'not testable here', naming the run).
+    """
+
+    def __init__(self, runs=None, tables=None):
+        self.paths = dict(runs or {})
+        self.table_paths = dict(tables or {})
+        self._cache = {}
+
+    def run(self, key):
+        """The run file of '<method>:<run id>' (xarray Dataset)."""
+        if key not in self._cache:
+            path = self.paths.get(key)
+            if not isinstance(path, str) or not Path(path).is_file():
+                raise Missing(key)
+            self._cache[key] = runfile.read(path)
+        return self._cache[key]
+
+    def group(self, key):
+        """{run id: Dataset} of a group of runs '<method>:<group>' (e.g. a study's error-against-run-time runs)."""
+        paths = self.paths.get(key)
+        if not isinstance(paths, (list, tuple)) or not all(Path(p).is_file() for p in paths):
+            raise Missing(key)
+        return {Path(p).stem: self.run_path(p) for p in paths}
+
+    def run_path(self, path):
+        if path not in self._cache:
+            self._cache[path] = runfile.read(path)
+        return self._cache[path]
+
+    def has(self, key):
+        path = self.paths.get(key)
+        return isinstance(path, str) and Path(path).is_file()
+
+    def table(self, name):
+        if ("table", name) not in self._cache:
+            path = self.table_paths.get(name)
+            if path is None or not Path(path).is_file():
+                raise Missing(name)
+            self._cache["table", name] = pd.read_csv(path)
+        return self._cache["table", name]
+
+
+class Missing(KeyError):
+    """A run or table a measure needs does not exist."""
+
+
+def measures():
+    """{claim id: measure function} of every method package's ``claims`` module (ids must be unique)."""
+    out = {}
+    for name in methods.PACKAGES:
+        try:
+            module = importlib.import_module(f"isaflow.methods.{name}.claims")
+        except ModuleNotFoundError as err:
+            if err.name != f"isaflow.methods.{name}.claims":
+                raise
+            continue
+        for cid, fn in getattr(module, "MEASURES", {}).items():
+            if cid in out:
+                raise ValueError(f"claim '{cid}' is measured twice (methods.{name}.claims)")
+            out[cid] = fn
+    return out
+
+
+def calibrated_inputs(entry, inputs):
+    """Names of the inputs this claim rests on that were calibrated against it (registry 'calibrated_against')."""
+    return [i for i in entry.get("inferred_inputs", []) if entry["id"] in inputs.get(i, {}).get("calibrated_against", [])]
+
+
+def verdict(entry, m, inputs):
+    """The verdict of one claim from its Measurement (module docstring)."""
+    if not entry.get("testable") or m is None or m.passed is None:
+        return "not testable here"
+    if not m.passed:
+        return "not reproduced"
+    cal = calibrated_inputs(entry, inputs)
+    return f"reproduced only after calibrating {', '.join(cal)}" if cal else "reproduced"
+
+
+def tolerance_text(entry):
+    """One line of the tolerance: its test and its source."""
+    t = entry.get("tolerance")
+    if not t:
+        return ""
+    return f"{t.get('test', '')} ({t.get('source', '')})"
+
+
+def judge(ctx, claims=None, inputs=None, found=None):
+    """DataFrame (COLUMNS) of every claim's measurement and verdict.  inputs: {input id: input} of the
+    registry (default: every file's 'inputs')."""
+    claims = claims_registry.load() if claims is None else claims
+    if inputs is None:
+        inputs = {i["id"]: i for lst in claims_registry.inputs().values() for i in lst}
+    found = measures() if found is None else found
+    rows = []
+    for e in claims:
+        m = None
+        if not e.get("testable"):
+            m = Measurement(f"not testable: {e.get('why_not', '')}", None)
+        elif e["id"] not in found:
+            m = Measurement("no measure implemented for this claim", None)
+        else:
+            try:
+                m = found[e["id"]](ctx, e)
+            except Missing as err:
+                m = Measurement(f"needs {err.args[0]}, which this workflow did not make", None)
+        rows.append(dict(id=e["id"], paper=e["paper"], section=e["section"], kind=e["kind"], half=e.get("half", ""),
+                         claim=e["quote"], measured=m.measured, tolerance=tolerance_text(e),
+                         verdict=verdict(e, m, inputs), evidence=m.evidence, why=m.why, margin=m.margin,
+                         sensitivity=m.sensitivity))
+    return pd.DataFrame(rows, columns=COLUMNS)
+
+
+def verdict_class(v):
+    """The verdict's class (one of VERDICTS) of a verdict string."""
+    return next((k for k in VERDICTS if str(v).startswith(k)), "other")
+
+
+def counts(df):
+    """DataFrame: claims per paper and kind, by verdict class (project checks apart)."""
+    d = df.assign(verdict_class=df["verdict"].map(verdict_class))
+    t = d.groupby(["paper", "kind", "verdict_class"]).size().unstack("verdict_class", fill_value=0)
+    return t.reindex(columns=[v for v in VERDICTS if v in t.columns]).reset_index()
+
+
+def write(outputs, registry, runs=None, tables=None, run_files=(), registry_files=()):
+    """The claims rule: results/claims/<paper>.csv for every paper (outputs, in the registry's paper order)
+    and the counts by kind (the last output).  runs: {'<method>:<run>': path or [paths]}; tables: {name: path};
+    run_files, registry_files: the same files as the rule's inputs (what it depends on)."""
+    inputs = {i["id"]: i for lst in claims_registry.inputs(registry).values() for i in lst}
+    df = judge(Context(runs, tables), claims_registry.load(registry), inputs)
+    *papers, summary = outputs
+    for out in papers:
+        paper = Path(out).stem
+        Path(out).parent.mkdir(parents=True, exist_ok=True)
+        df[df["paper"] == paper].to_csv(out, index=False)
+    counts(df).to_csv(summary, index=False)
+    return df

@@ -1,0 +1,20 @@
+# Every claim of every paper judged from the run outputs (isaflow.claims): the registry
+# (config/claims/<paper>.yaml) says what each claim measures, with its tolerance and the runs it needs;
+# the methods' claims modules measure; results/claims/<paper>.csv and the counts by kind feed the report.
+rule claims:
+    input:
+        run_files=claim_inputs,
+        registry_files=sorted(glob.glob("config/claims/*.yaml")),
+        code=code("claims", *[f"methods.{m}.claims" for m in _methods.PACKAGES
+                              if os.path.exists(f"src/isaflow/methods/{m}/claims.py")]),
+    output:
+        [f"results/claims/registry/{p}.csv" for p in CLAIM_PAPERS] + ["results/claims/registry/counts.csv"],
+    params:
+        func="claims.write",
+        kw=lambda wc: {"registry": "config/claims", "runs": claim_runs()},
+    log:
+        "logs/claims.log",
+    conda:
+        "../envs/isaflow.yaml"
+    script:
+        "../scripts/call.py"
