@@ -1,27 +1,33 @@
 """Tanks (config/tanks/*.yaml): the walls, vessels and liquid every method shares.
 
 A tank file is validated against ``tank.schema.json`` and its geometry is
-checked (:func:`check_walls`); errors name the file and the field.  The
-tank's liquid (weight W per unit thickness and depth h in the first vessel)
-fixes the hydrostatic theory every method is judged against (theory.py):
-rho g = W / (B h), B the first vessel's width.  Units: cm, N.  Pure Python
-plus NumPy for the geometry.
+checked (:func:`check_walls`, :func:`check_geometry`); errors name the file
+and the field.  The tank's liquid (weight W per unit thickness and depth h in
+the first vessel) fixes the hydrostatic theory every method is judged against
+(theory.py): rho g = W / (B h), B the first vessel's width.  Units: cm, N.
+The checks are pure Python (the workflow checks tanks while it is parsed);
+the arrays a solver needs come from NumPy, imported when asked for.
 """
 
 import hashlib
 import json
+import math
 from dataclasses import dataclass
 from importlib import resources
 from pathlib import Path
-
-import numpy as np
 
 from . import inputs
 from .inputs import InputError
 
 SCHEMA = json.loads(resources.files("isaflow").joinpath("tank.schema.json").read_text())
 MAX_COORD = 1e7  # cm: largest accepted |coordinate| of a wall (100 km)
+TOL = 1e-9  # cm: two wall ends closer than this are one point
 TANK_DIR = Path("config") / "tanks"
+
+
+def _segments(spec):
+    """[(x0, y0, x1, y1)] of a tank mapping's walls (floats)."""
+    return [tuple(float(c) for c in w["from"] + w["to"]) for w in spec["walls"]]
 
 
 @dataclass
@@ -39,7 +45,9 @@ class Tank:
     @property
     def walls(self):
         """(W, 4) float64 wall segments x0, y0, x1, y1 [cm], oriented with the liquid on their left."""
-        return np.array([w["from"] + w["to"] for w in self.spec["walls"]], float)
+        import numpy as np
+
+        return np.array(_segments(self.spec), float)
 
     @property
     def wall_names(self):
@@ -51,8 +59,8 @@ class Tank:
         named = [(v["name"], tuple(float(c) for c in v["x"])) for v in self.spec.get("vessels", [])]
         if named:
             return named
-        w = self.walls
-        return [("vessel", (float(w[:, [0, 2]].min()), float(w[:, [0, 2]].max())))]
+        xs = [c for s in _segments(self.spec) for c in (s[0], s[2])]
+        return [("vessel", (min(xs), max(xs)))]
 
     @property
     def weight(self):
@@ -67,10 +75,8 @@ class Tank:
     def floor_y(self, vessel=0):
         """y [cm] of a vessel's floor: the lowest horizontal wall over its x range."""
         x0, x1 = self.vessels[vessel][1]
-        w = self.walls
-        horiz = np.isclose(w[:, 1], w[:, 3])
-        over = np.minimum(w[:, [0, 2]].max(1), x1) - np.maximum(w[:, [0, 2]].min(1), x0) > 1e-9
-        return float(w[horiz & over, 1].min())
+        return min(s[1] for s in _segments(self.spec) if abs(s[1] - s[3]) <= TOL
+                   and min(max(s[0], s[2]), x1) - max(min(s[0], s[2]), x0) > TOL)
 
     @property
     def rho_g(self):
@@ -82,6 +88,8 @@ class Tank:
         """(4,) xmin, ymin, xmax, ymax [cm] of the region a dynamic method's particle must stay in: the walls'
         bounding box, open upwards by the tank's own height (a splash may rise above the open top and fall
         back; one rising higher than the tank is tall carries energy no jet of this tank has)."""
+        import numpy as np
+
         w = self.walls
         lo, hi = w.reshape(-1, 2).min(0), w.reshape(-1, 2).max(0)
         return np.array([lo[0], lo[1], hi[0], hi[1] + (hi[1] - lo[1])])
@@ -98,13 +106,14 @@ class Tank:
 
 
 def check_walls(path, spec):
-    """Wall segments finite, of non-zero length, uniquely named, within MAX_COORD cm; vessels ordered."""
-    walls = np.array([w["from"] + w["to"] for w in spec["walls"]], float)
+    """Wall segments finite, of non-zero length, uniquely named, within MAX_COORD cm; vessels ordered.
+    Returns the segments [(x0, y0, x1, y1)]."""
+    walls = _segments(spec)
     names = [w["name"] for w in spec["walls"]]
-    if not np.isfinite(walls).all() or (np.abs(walls) > MAX_COORD).any():
+    if not all(math.isfinite(c) and abs(c) <= MAX_COORD for s in walls for c in s):
         raise InputError(f"{path}: field 'walls': coordinates must be finite and within +-{MAX_COORD:g} cm")
-    for name, w in zip(names, walls):
-        if np.hypot(w[2] - w[0], w[3] - w[1]) == 0:
+    for name, s in zip(names, walls):
+        if math.hypot(s[2] - s[0], s[3] - s[1]) == 0:
             raise InputError(f"{path}: field 'walls' ({name}): segment has zero length")
     if len(set(names)) != len(names):
         raise InputError(f"{path}: field 'walls': wall names must be unique")
@@ -114,41 +123,51 @@ def check_walls(path, spec):
     return walls
 
 
-def _chain(walls, tol=1e-9):
-    """Walls (indices) of the outline: the chain of walls joined end to start, head to tail, that runs through
-    the lowest horizontal wall; returned in traversal order (None if the walls do not join into one chain)."""
-    floors = [k for k, w in enumerate(walls) if abs(w[1] - w[3]) <= tol]
+def _same(p, q):
+    return abs(p[0] - q[0]) <= TOL and abs(p[1] - q[1]) <= TOL
+
+
+def _horizontal(s):
+    return abs(s[1] - s[3]) <= TOL
+
+
+def _chain(walls):
+    """Indices of the outline: the chain of walls joined end to start, head to tail, that runs through the
+    lowest horizontal wall; in traversal order (None if no wall is horizontal)."""
+    floors = [k for k, s in enumerate(walls) if _horizontal(s)]
     if not floors:
         return None
-    start = min(floors, key=lambda k: walls[k, 1])
-    order = [start]
-    while True:  # walk back: a wall whose end is this one's start
-        prev = [k for k, w in enumerate(walls) if k not in order and np.allclose(w[2:], walls[order[0], :2], atol=tol)]
+    order = [min(floors, key=lambda k: walls[k][1])]
+    while True:  # walk back: the one wall whose end is this one's start
+        prev = [k for k, s in enumerate(walls) if k not in order and _same(s[2:], walls[order[0]][:2])]
         if len(prev) != 1:
             break
         order.insert(0, prev[0])
     while True:  # and forward
-        nxt = [k for k, w in enumerate(walls) if k not in order and np.allclose(w[:2], walls[order[-1], 2:], atol=tol)]
+        nxt = [k for k, s in enumerate(walls) if k not in order and _same(s[:2], walls[order[-1]][2:])]
         if len(nxt) != 1:
             break
         order.append(nxt[0])
     return order
 
 
-def _cross(a, b, tol=1e-9):
+def _cross(a, b):
     """True if segments a, b (x0, y0, x1, y1) intersect other than at a shared end point."""
-    p, r = a[:2], a[2:] - a[:2]
-    q, t = b[:2], b[2:] - b[:2]
-    den = r[0] * t[1] - r[1] * t[0]
-    if abs(den) <= tol * np.hypot(*r) * np.hypot(*t):  # parallel: overlapping collinear segments cross
-        if abs((q - p)[0] * r[1] - (q - p)[1] * r[0]) > tol * np.hypot(*r) ** 2:
+    px, py, rx, ry = a[0], a[1], a[2] - a[0], a[3] - a[1]
+    qx, qy, tx, ty = b[0], b[1], b[2] - b[0], b[3] - b[1]
+    den = rx * ty - ry * tx
+    lr, lt = math.hypot(rx, ry), math.hypot(tx, ty)
+    wx, wy = qx - px, qy - py
+    if abs(den) <= TOL * lr * lt:  # parallel: overlapping collinear segments cross
+        if abs(wx * ry - wy * rx) > TOL * lr * lr:
             return False
-        s0, s1 = sorted(((q - p) @ r / (r @ r), (q + t - p) @ r / (r @ r)))
-        return min(s1, 1.0) - max(s0, 0.0) > tol
-    u = ((q - p)[0] * t[1] - (q - p)[1] * t[0]) / den
-    v = ((q - p)[0] * r[1] - (q - p)[1] * r[0]) / den
-    inside = -tol <= u <= 1 + tol and -tol <= v <= 1 + tol
-    ends = (abs(u) <= tol or abs(u - 1) <= tol) and (abs(v) <= tol or abs(v - 1) <= tol)
+        rr = rx * rx + ry * ry
+        s0, s1 = sorted(((wx * rx + wy * ry) / rr, ((wx + tx) * rx + (wy + ty) * ry) / rr))
+        return min(s1, 1.0) - max(s0, 0.0) > TOL
+    u = (wx * ty - wy * tx) / den
+    v = (wx * ry - wy * rx) / den
+    inside = -TOL <= u <= 1 + TOL and -TOL <= v <= 1 + TOL
+    ends = (abs(u) <= TOL or abs(u - 1) <= TOL) and (abs(v) <= TOL or abs(v - 1) <= TOL)
     return inside and not ends
 
 
@@ -157,56 +176,59 @@ def check_geometry(path, spec, walls):
     the right side: the liquid on every wall's left), no crossing walls, every vessel inside the outline on a
     floor, the liquid's top below the outline's wall tops.  InputError naming the file and field otherwise."""
     names = [w["name"] for w in spec["walls"]]
-    order = _chain(walls)
     where = f"{path}: field 'walls'"
+    order = _chain(walls)
     if order is None:
         raise InputError(f"{where}: no horizontal wall: a tank needs a floor")
-    outline = walls[order]
-    if not (outline[0, 1] > outline[0, 3] and outline[-1, 3] > outline[-1, 1]):
+    first, last = walls[order[0]], walls[order[-1]]
+    if not (first[1] > first[3] and last[3] > last[1]):
         raise InputError(f"{where}: the walls joined to the floor do not run down one side and up the other "
                          f"({names[order[0]]} ... {names[order[-1]]}): the tank is not closed below its top, or a "
                          f"wall is reversed (walls are oriented with the liquid on their left)")
     for k in order:
-        w = walls[k]
-        if abs(w[1] - w[3]) <= 1e-9 and w[2] < w[0]:
+        if _horizontal(walls[k]) and walls[k][2] < walls[k][0]:
             raise InputError(f"{where} ({names[k]}): a floor must run left to right (the liquid on its left)")
     for i in range(len(walls)):
         for j in range(i + 1, len(walls)):
             if _cross(walls[i], walls[j]):
                 raise InputError(f"{where}: walls '{names[i]}' and '{names[j]}' cross")
-    x_lo, x_hi = outline[0, 0], outline[-1, 2]
-    top = min(outline[0, 1], outline[-1, 3])
-    others = [k for k in range(len(walls)) if k not in order]
-    for k in others:
-        w = walls[k]
-        if min(w[0], w[2]) < x_lo - 1e-9 or max(w[0], w[2]) > x_hi + 1e-9:
+    x_lo, x_hi = first[0], last[2]
+    top = min(first[1], last[3])
+    for k in range(len(walls)):
+        s = walls[k]
+        if k not in order and (min(s[0], s[2]) < x_lo - TOL or max(s[0], s[2]) > x_hi + TOL):
             raise InputError(f"{where} ({names[k]}): a wall outside the tank's outline [{x_lo:g}, {x_hi:g}] cm")
     vessels = spec.get("vessels") or [{"name": "(whole tank)", "x": [x_lo, x_hi]}]
     floor_y = None
-    for n, v in enumerate(vessels):
+    for v in vessels:
         x0, x1 = v["x"]
-        if x0 < x_lo - 1e-9 or x1 > x_hi + 1e-9:
+        if x0 < x_lo - TOL or x1 > x_hi + TOL:
             raise InputError(f"{path}: field 'vessels' ({v['name']}): [{x0:g}, {x1:g}] cm lies outside the walls "
                              f"[{x_lo:g}, {x_hi:g}] cm")
-        under = [w for w in outline if abs(w[1] - w[3]) <= 1e-9 and min(w[0], w[2]) <= x1 and max(w[0], w[2]) >= x0]
+        under = [walls[k] for k in order if _horizontal(walls[k]) and min(walls[k][0], walls[k][2]) <= x1
+                 and max(walls[k][0], walls[k][2]) >= x0]
         if not under:
             raise InputError(f"{path}: field 'vessels' ({v['name']}): no floor under [{x0:g}, {x1:g}] cm")
-        if n == 0:
-            floor_y = min(w[1] for w in under)
+        if floor_y is None:
+            floor_y = min(s[1] for s in under)
     for a, b in zip(vessels, vessels[1:]):
-        if b["x"][0] < a["x"][1] - 1e-9:
+        if b["x"][0] < a["x"][1] - TOL:
             raise InputError(f"{path}: field 'vessels' ({b['name']}): overlaps '{a['name']}'")
     depth = float(spec["liquid"]["depth"])
-    if floor_y + depth > top + 1e-9:
+    if floor_y + depth > top + TOL:
         raise InputError(f"{path}: field 'liquid.depth': {depth:g} cm above the first floor (y = {floor_y:g} cm) "
                          f"reaches over the wall tops (y = {top:g} cm)")
 
 
 def check_positions(path, field, pos, walls):
-    """Refuse positions that are non-finite or outside the walls' bounding box (NaN counts as outside)."""
+    """Refuse positions that are non-finite or outside the walls' bounding box (NaN counts as outside);
+    pos (N, 2) array [cm], walls (W, 4) segments [cm]."""
+    import numpy as np
+
     if not np.isfinite(pos).all():
         raise InputError(f"{path}: field '{field}': positions must be finite")
-    lo, hi = walls.reshape(-1, 2).min(0), walls.reshape(-1, 2).max(0)
+    ends = np.asarray(walls, float).reshape(-1, 2)
+    lo, hi = ends.min(0), ends.max(0)
     out = ~((pos >= lo) & (pos <= hi)).all(1)  # NaN counts as outside
     if out.any():
         x, y = pos[np.argmax(out)]
