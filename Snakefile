@@ -28,3 +28,7 @@ rule all:
     input:
         lambda wc: TARGETS["targets"],
     default_target: True
+
+
+# every tank, settings file and declared run checked before any job starts (common.smk)
+check_inputs()

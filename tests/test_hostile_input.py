@@ -241,7 +241,8 @@ RESOURCE_CASES = {
                                                {"name": "right", "from": [11000, 0], "to": [11000, 6000]}]),
                                     ("particles.lattice.center_x", 5500.0), ("solver.max_steps", 10**15),
                                     ("solver.history", {"snapshots": 10**6})], "'solver.history.snapshots'"),
-    "grid_of_1e15_cells": ([("forces.pair.l_u", 1e-6), ("forces.pair.r_u", 1e-3)], "'forces.pair.l_u'"),
+    "grid_of_1e15_cells": ([("forces.pair.l_u", 1e-6), ("forces.pair.r_u", 1e-3), ("solver.du", 1e-7)],
+                           "'forces.pair.l_u'"),
 }
 
 

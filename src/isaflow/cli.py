@@ -12,11 +12,12 @@ unless ISAFLOW_DEBUG=1.
 """
 
 import argparse
+import math
 import os
 import signal
 import sys
 
-from . import inputs, methods
+from . import inputs, methods, preflight
 from . import run as runs
 
 OUTCOMES = ("converged", "cycle", "step_limit", "escaped", "nonfinite", "solver_failed")
@@ -31,7 +32,8 @@ def _error(msg):
 
 
 def declared(method, run_id, settings_path=None):
-    """(tank path, variant, resolution, overrides, start path, accept) of a run declared in a settings file."""
+    """(tank path, variant, resolution, overrides, start path, accept, stability, max_hours) of a run declared
+    in a settings file."""
     from . import settings as S
     from . import tank as T
 
@@ -43,7 +45,7 @@ def declared(method, run_id, settings_path=None):
                                 f"(choose from {', '.join(spec.get('runs', {}))})")
     start = f"results/runs/{method}/{decl['start']}.nc" if decl.get("start") else None
     return (T.path_of(decl["tank"]), decl["variant"], decl["resolution"], decl.get("set", {}), start,
-            tuple(decl.get("accept", ["converged"])))
+            tuple(decl.get("accept", ["converged"])), decl.get("stability", False), decl.get("max_hours"))
 
 
 def main(argv=None):
@@ -60,6 +62,11 @@ def main(argv=None):
     r.add_argument("--set", action="append", default=[], metavar="KEY=VALUE", help="override a setting")
     r.add_argument("--accept", help=f"comma-separated outcomes that count as success (default converged; "
                                     f"{', '.join(OUTCOMES)})")
+    r.add_argument("--stability-case", action="store_true",
+                   help="a stability case: settings outside the method's literature ranges are run, and it may "
+                        "accept escaped / nonfinite / solver_failed outcomes")
+    r.add_argument("--max-hours", type=float, help="this run's CPU-hour budget, for a deliberate long run "
+                                                   "(default: config/limits.yaml cpu_hours)")
     r.add_argument("--threads", type=int, help="threads of the compiled loops (default: numba's)")
     r.add_argument("-o", "--out", required=True)
     args = ap.parse_args(argv)
@@ -72,8 +79,12 @@ def main(argv=None):
     signal.signal(signal.SIGTERM, _interrupted)
     try:
         overrides, accept = list(args.set), ("converged",)
+        stability, max_hours = args.stability_case, args.max_hours
         if args.run:
-            tank, variant, resolution, decl_set, start, accept = declared(args.method, args.run, args.settings)
+            tank, variant, resolution, decl_set, start, accept, decl_stab, decl_hours = declared(
+                args.method, args.run, args.settings)
+            stability = stability or decl_stab
+            max_hours = max_hours if max_hours is not None else decl_hours
             overrides = {**decl_set, **dict(runs.settings._parse(o, "--set", "override") for o in overrides)}
             start = args.start or start
         else:
@@ -88,11 +99,19 @@ def main(argv=None):
             if bad:
                 _error(f"argument --accept: unknown outcome '{inputs.printable(bad[0])}' (choose from {', '.join(OUTCOMES)})")
                 return 2
+        unstable = [a for a in accept if a in preflight.UNSTABLE]
+        if unstable and not stability:
+            _error(f"argument --accept: outcome '{unstable[0]}' may be accepted only by a stability case "
+                   f"(add --stability-case)")
+            return 2
+        if max_hours is not None and not (math.isfinite(max_hours) and max_hours > 0):
+            _error("argument --max-hours: must be a finite positive number of hours")
+            return 2
         if args.threads is not None and not 1 <= args.threads <= 64:
             _error("argument --threads: must be between 1 and 64")
             return 2
         return runs.run(args.method, tank, variant, resolution, args.out, args.settings, overrides, start, accept,
-                        args.threads, args.run)
+                        args.threads, args.run, stability=stability, max_hours=max_hours)
     except inputs.InputError as err:
         _error(err)
         return 2

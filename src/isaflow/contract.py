@@ -48,8 +48,10 @@ class Result:
     """Outcome of one run of any method (arrays in cm, N, s).
 
     history / fields map a run-file variable name to (dims, array, units,
-    long_name); history dims are ("record",) (per record) or ("sample", ...)
-    (per diagnostic sample), fields dims start with "particle".
+    long_name[, attrs]); history dims are ("record",) (per record) or
+    ("sample", ...) (per diagnostic sample), fields dims start with
+    "particle".  A run file holds no NaN: a variable whose values may be
+    missing says why in attrs {"missing": "..."} (runfile.finite).
     """
 
     method: str  # registry name, e.g. "isa", "sph", "mps"

@@ -12,6 +12,7 @@ control characters or lone surrogates or longer than MAX_STRING.
 """
 
 import math
+import re
 from pathlib import Path
 
 import jsonschema
@@ -41,6 +42,12 @@ class _StrictLoader(yaml.SafeLoader):
                 raise InputError(f"duplicate key '{key}' (line {key_node.start_mark.line + 1})")
             seen.add(key)
         return super().construct_mapping(node, deep=deep)
+
+
+# YAML 1.2 reads 1e-12 and 1E6 as numbers; PyYAML (YAML 1.1) needs a dot ('1.0e-12') and reads them as
+# strings, which a user typing `--set time.courant=1e-12` would not expect
+_StrictLoader.add_implicit_resolver(
+    "tag:yaml.org,2002:float", re.compile(r"^[-+]?[0-9][0-9_]*[eE][-+]?[0-9]+$"), list("-+0123456789"))
 
 
 def _check_events(text):

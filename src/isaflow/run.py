@@ -16,7 +16,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from . import methods, runfile, settings, tank as tanks
+from . import methods, preflight, runfile, settings, tank as tanks
 from .inputs import InputError, printable
 
 PROGRESS_EVERY = 20.0  # s of wall time between progress lines (a log line at least every 30 s)
@@ -38,6 +38,7 @@ class Prepared:
     threads: int | None
     run_id: str
     label: str = ""
+    stability: bool = False
 
 
 def _same_file(a, b):
@@ -47,12 +48,19 @@ def _same_file(a, b):
         return False
 
 
+def _start_particles(start):
+    with runfile.open_run(start) as ds:
+        return int(ds["pos"].shape[0]) if "pos" in ds.variables else None
+
+
 def prepare(method, tank, variant, resolution, out, settings_path=None, overrides=(), start=None,
-            accept=("converged",), threads=None, run_id=None, label=""):
+            accept=("converged",), threads=None, run_id=None, label="", stability=False, max_hours=None):
     """Check a run before any work; returns Prepared or raises InputError / runfile.RunFileError.
 
     tank: path of a tank file; overrides: 'key=value' strings or {key: {value, source}};
-    start: path of the run file of the same method to continue, or None.
+    start: path of the run file of the same method to continue, or None; stability: a declared
+    stability case (literature ranges not enforced, unstable outcomes may be accepted); max_hours: this
+    run's own CPU-hour budget (config/limits.yaml's otherwise).
     """
     try:
         m = methods.get(method)
@@ -76,10 +84,12 @@ def prepare(method, tank, variant, resolution, out, settings_path=None, override
     for what, src in {"the tank": tank, "the settings": path, "the start file": start}.items():
         if src and _same_file(src, out):
             raise runfile.RunFileError(f"{out}: the output would overwrite {what} ('{src}'); choose another path")
+    preflight.check(method, t, s, accept, stability, max_hours,
+                    _start_particles(start) if start is not None else None)
     entry = m.entry_module()
     entry.check(t, s, variant, resolution, start)
     return Prepared(method, entry, t, s, variant, resolution, start, str(out), tuple(accept), threads,
-                    run_id or Path(out).stem, label)
+                    run_id or Path(out).stem, label, stability)
 
 
 def _progress(run_id, log):
@@ -112,6 +122,7 @@ def write(p, result, started, finished, command=None):
     files = {"tank": p.tank.path, "settings": p.settings.path, "start": p.start}
     prov = runfile.provenance(files, command)
     prov.update(run_id=p.run_id, run_label=p.label or "none", resolution=p.resolution,
+                stability_case=int(p.stability),
                 settings_resolved=settings_text(p.settings),
                 threads=result.params.get("threads", p.threads or 0))
     ds = runfile.to_dataset(result, p.tank, prov, started, finished, references=p.entry.REFERENCES)
@@ -124,12 +135,13 @@ def settings_text(s):
 
 
 def run(method, tank, variant, resolution, out, settings_path=None, overrides=(), start=None,
-        accept=("converged",), threads=None, run_id=None, log=None, command=None, label=""):
+        accept=("converged",), threads=None, run_id=None, log=None, command=None, label="", stability=False,
+        max_hours=None):
     """Check, solve and write one run; returns the exit code (module docstring); errors as one line on stderr."""
     log = log or (lambda msg: print(msg, file=sys.stderr, flush=True))
     try:
         p = prepare(method, tank, variant, resolution, out, settings_path, overrides, start, accept, threads, run_id,
-                    label)
+                    label, stability, max_hours)
     except (InputError, runfile.RunFileError) as err:
         log(f"error: {err}")
         return 2

@@ -110,8 +110,8 @@ def to_dataset(result, tank, prov, started, finished, spacing=None, references="
     }
     if np.isfinite(r.sim_time):
         data["sim_time"] = _var((), r.sim_time, "s", "physical time simulated")
-    for name, (dims, arr, units, long_name) in {**r.fields, **r.history}.items():
-        data[name] = _var(dims, arr, units, long_name)
+    for name, (dims, arr, units, long_name, *extra) in {**r.fields, **r.history}.items():
+        data[name] = _var(dims, arr, units, long_name, **(extra[0] if extra else {}))
     coords = {"xy": ["x", "y"], "wall": tank.wall_names, "end": ["x0", "y0", "x1", "y1"]}
     if vessels:
         coords["vessel"] = [v["name"] for v in vessels]
@@ -225,6 +225,31 @@ def _remove_stale(path):
                 pass
 
 
+FILL = 9.969209968386869e36  # netCDF's default fill value of doubles: CF marks missing values with it
+
+
+def finite(ds, path):
+    """ds ready to write without NaN or infinity: a variable whose values may be missing says why in its
+    'missing' attribute and is written with a _FillValue (CF; read back as NaN); any other non-finite value
+    is refused (RunFileError), except in a run whose status is 'nonfinite' (its values are missing because
+    the run blew up: marked so); non-finite global attributes (not applicable, e.g. the time to rest of a run
+    that never came to rest) are left out."""
+    ds = ds.copy()
+    ds.attrs = {k: v for k, v in ds.attrs.items()
+                if not (isinstance(v, (float, np.floating)) and not np.isfinite(v))}
+    for name, var in ds.variables.items():
+        if var.dtype.kind != "f":
+            continue
+        bad = ~np.isfinite(var.values)
+        if bad.any() and "missing" not in var.attrs and ds.attrs.get("status") == "nonfinite":
+            var.attrs["missing"] = "non-finite when the run stopped (status nonfinite)"
+        if bad.any() and "missing" not in var.attrs:
+            raise RunFileError(f"{path}: variable '{name}' holds {int(bad.sum())} non-finite value(s); a run file never "
+                               f"holds NaN (a variable whose values may be missing says why in attrs['missing'])")
+        var.encoding["_FillValue"] = FILL if bad.any() else None
+    return ds
+
+
 def write(ds, path):
     """Write ds to path: a temporary file .NAME.partial-PID marked incomplete, marked
     complete once written, then renamed over path (which must be a regular
@@ -235,7 +260,7 @@ def write(ds, path):
     check_output(path)
     _remove_stale(path)
     tmp = _partial_name(path, os.getpid())
-    ds = ds.copy()
+    ds = finite(ds, path)
     ds.attrs["isaflow_complete"] = "no"
     try:
         ds.to_netcdf(tmp, engine="netcdf4")

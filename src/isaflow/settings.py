@@ -79,6 +79,8 @@ RUN_SCHEMA = {
         "compare": {"type": "boolean"},  # the run enters the methods' comparison
         "threads": {"type": "integer", "minimum": 1, "maximum": 64},
         "note": {"type": "string", "maxLength": 2000},
+        "stability": {"type": "boolean"},  # a stability case: literature ranges not enforced, may fail
+        "max_hours": {"type": "number", "exclusiveMinimum": 0},  # its own CPU-hour budget (a long run)
     },
 }
 

@@ -87,12 +87,12 @@ class Tank:
     def escape_box(self):
         """(4,) xmin, ymin, xmax, ymax [cm] of the region a dynamic method's particle must stay in: the walls'
         bounding box, open upwards by the tank's own height (a splash may rise above the open top and fall
-        back; one rising higher than the tank is tall carries energy no jet of this tank has)."""
-        import numpy as np
-
-        w = self.walls
-        lo, hi = w.reshape(-1, 2).min(0), w.reshape(-1, 2).max(0)
-        return np.array([lo[0], lo[1], hi[0], hi[1] + (hi[1] - lo[1])])
+        back; one rising higher than the tank is tall carries energy no jet of this tank has).  A tuple (pure
+        Python: the workflow's checks use it while it is parsed)."""
+        segs = _segments(self.spec)
+        xs = [c for s in segs for c in (s[0], s[2])]
+        ys = [c for s in segs for c in (s[1], s[3])]
+        return (min(xs), min(ys), max(xs), max(ys) + (max(ys) - min(ys)))
 
     @property
     def digest(self):

@@ -165,3 +165,27 @@ def claim_inputs(wc):
     for v in claim_runs().values():
         files += v if isinstance(v, list) else [v]
     return sorted(set(files))
+
+
+def check_inputs():
+    """Every input checked before any job starts (the Snakefile calls this after every rules file declared
+    its runs): the comparison's tanks; every declared run of every tank method (tank, variant, resolution,
+    overrides, start run, outcomes, plausibility, cost: isaflow.preflight); the settings of the methods
+    without tanks (their checks' validate).  The first error stops the workflow with one line."""
+    from isaflow import preflight as _preflight
+    from isaflow import tank as _tank
+
+    d = _preflight.Declarations()
+    try:
+        for name in config["compare"]["tanks"]:
+            try:
+                d.tank(name)
+            except _inputs.InputError as err:
+                raise _inputs.InputError(f"config/config.yaml: field 'compare.tanks': {err}") from None
+        for method in TANK_METHODS:
+            d.check(method, RUNS[method])
+        for m in REGISTRY.values():
+            if not m.tank:
+                m.checks_module().validate(m.settings)
+    except _inputs.InputError as err:
+        refuse(err)

@@ -19,5 +19,6 @@ command = ["snakemake", f"rule run: {wc.method}/{wc.run}", "->", snakemake.outpu
 code = run.run(wc.method, snakemake.input.tank, decl["variant"], decl["resolution"], snakemake.output[0],  # noqa: F821
                settings_path=snakemake.input.settings, overrides=decl.get("set", {}),  # noqa: F821
                start=snakemake.input.get("start"), accept=decl.get("accept", ["converged"]),  # noqa: F821
-               threads=snakemake.threads, run_id=wc.run, command=command, label=decl.get("label", ""))  # noqa: F821
+               threads=snakemake.threads, run_id=wc.run, command=command, label=decl.get("label", ""),  # noqa: F821
+               stability=decl.get("stability", False), max_hours=decl.get("max_hours"))
 sys.exit(code)

@@ -12,7 +12,9 @@ module provides ``check(tank, settings, variant, resolution, start)``,
 ``solve(tank, settings, variant, resolution, start=None, progress=None,
 threads=None) -> contract.Result``, ``warm_up(threads)`` and
 ``REFERENCES``; its ``values`` (``module:attribute``) is the schema of its
-settings file (isaflow.settings).
+settings file (isaflow.settings); its ``checks`` module (pure Python, read
+while the workflow is parsed) ``plausible(tank, settings, stability)`` and
+``cost(tank, settings, particles) -> isaflow.budget.Cost``.
 """
 
 import importlib
@@ -40,6 +42,8 @@ class Method:
     variants: dict = field(default_factory=dict)  # name -> Variant
     tank: bool = False  # runs on the shared tanks through isaflow.run
     entry: str = ""  # module with check / solve / warm_up / REFERENCES (tank methods)
+    checks: str = ""  # pure-Python checks: plausible(tank, settings, stability) and cost(...) (tank methods);
+    # the module whose validate(settings path) checks the settings file (the others)
     values: str = ""  # "module:attribute" of the settings values schema (tank methods)
     settings: str = ""  # default settings file, relative to the project root
     report: str = ""  # the method's report fragment, results/report/NN_name.md
@@ -48,6 +52,9 @@ class Method:
 
     def entry_module(self):
         return importlib.import_module(self.entry)
+
+    def checks_module(self):
+        return importlib.import_module(self.checks)
 
     def values_schema(self):
         module, attr = self.values.split(":")

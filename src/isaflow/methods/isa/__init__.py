@@ -21,6 +21,7 @@ METHOD = Method(
     paper_label="Papadopoulos, Koutitas & Lazaridis (2016), the paper replicated",
     tank=True,
     entry="isaflow.methods.isa.method",
+    checks="isaflow.methods.isa.checks",
     values="isaflow.methods.isa.settings:VALUES",
     settings="config/methods/isa.yaml",
     report="results/report/10_isa.md",

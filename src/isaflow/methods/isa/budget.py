@@ -5,44 +5,21 @@ f_ref, dt_max, skin) are not finite and positive; :func:`check_count` and
 :func:`check_memory` estimate the run's memory (particles, neighbour pairs,
 cell grid, history records, snapshots, chunk buffer) and refuse, with the
 estimate, a run that cannot fit the memory available.  The limit is the
-machine's available memory (/proc/meminfo MemAvailable) or, if set, the
-environment variable ISAFLOW_MEMORY_LIMIT_MB.
+machine's (isaflow.budget.memory_limit).
 """
 
 import math
-import os
 
 import numpy as np
 
+from ...budget import gb as _gb
+from ...budget import memory_limit
 from ...inputs import InputError
+from .checks import BYTES_PER_PARTICLE, BYTES_PER_RECORD, particle_count  # noqa: F401 (particle_count: scene)
 from .settings import settings
 
-BYTES_PER_PARTICLE = 640  # solver + compiled loop + contacts + the run file's copy (measured order, rounded up)
 BYTES_PER_PAIR = 12  # int32 neighbour entry with its doubling growth
-BYTES_PER_RECORD = 4 * 56  # hist_fmax/lo/hi/step records held as Python lists, then arrays
 MAX_GRID_CELLS = 10**9  # cells of the neighbour grid (int32 cell starts)
-
-
-def memory_limit():
-    """Bytes a run may use: ISAFLOW_MEMORY_LIMIT_MB if set, else MemAvailable, else 8 GB."""
-    env = os.environ.get("ISAFLOW_MEMORY_LIMIT_MB")
-    if env:
-        try:
-            return float(env) * 2**20
-        except ValueError:
-            raise InputError(f"environment variable ISAFLOW_MEMORY_LIMIT_MB: '{env}' is not a number") from None
-    try:
-        with open("/proc/meminfo") as f:
-            for line in f:
-                if line.startswith("MemAvailable:"):
-                    return float(line.split()[1]) * 1024
-    except OSError:
-        pass
-    return 8.0 * 2**30
-
-
-def _gb(b):
-    return f"{b / 2**30:.3g} GB"
 
 
 def check_settings(scene):
@@ -55,16 +32,6 @@ def check_settings(scene):
             raise InputError(f"{scene.path}: field '{field}': the derived value {value!r} is not a finite positive "
                              f"number (over- or underflow); choose less extreme numbers")
     return s
-
-
-def particle_count(part):
-    """Particles a lattice or points block will create, without creating them."""
-    if "points" in part:
-        return len(part["points"])
-    lat = part["lattice"]
-    rows, lengths = lat["rows"], lat["row_lengths"]
-    full, rest = divmod(rows, len(lengths))
-    return full * sum(lengths) + sum(lengths[:rest])
 
 
 def _refuse(scene, field, need, limit, what):

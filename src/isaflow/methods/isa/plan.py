@@ -61,7 +61,7 @@ def plan(study, spec):
         if sid in out:
             raise ValueError(f"study run '{sid}' is planned twice")
         out[sid] = dict(tank=tank, variant=variant, resolution=resolution, set=sets, accept=acc,
-                        meta=dict(variant=variant, **meta))
+                        stability=True, meta=dict(variant=variant, **meta))
 
     er = study["error_runtime"]
     for block in er["blocks"]:

@@ -174,7 +174,7 @@ def stability_row(sid, ds, m):
     row = _base_row(sid, ds)
     kb = a["wall_r_u"] / a["wall_l_u"]
     w = float(ds["weight"].values.max())
-    lat_a = float(a["spacing"])
+    lat_a = float(a.get("spacing", np.nan))  # absent: no lattice spacing (coincident particles)
     pos = ds["pos"].values
     finite = bool(np.isfinite(pos).all())
     row.update(variant_label=a["variant_label"], message=a["status_message"], max_steps=int(a["max_steps"]), k_wall=kb,

@@ -19,6 +19,7 @@ METHOD = Method(
     paper_label="Hattori et al., MPS pressure Poisson source term",
     tank=True,
     entry="isaflow.methods.mps.method",
+    checks="isaflow.methods.mps.checks",
     values="isaflow.methods.mps.settings:VALUES",
     settings="config/methods/mps.yaml",
     report="results/report/55_mps.md",

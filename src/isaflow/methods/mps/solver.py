@@ -90,7 +90,7 @@ class State:
         self.n0_l, self.lam = model.lattice_constants(cfg["model.re_laplacian"], l0)
         self.weight = tank.weight / self.nf  # N per particle
         self.rho0 = self.weight / units.G / l0**2  # N s^2 / cm^4
-        box = tank.escape_box()  # the walls' bounding box, open upwards (a splash may rise and fall back)
+        box = np.asarray(tank.escape_box(), float)  # the walls' bounding box, open upwards (a splash may rise and fall back)
         pad = (layers + 1) * l0
         self.grid_box = box + np.array([-pad, -pad, pad, pad])
         self.escape_box = box
@@ -337,7 +337,8 @@ def _solve(tank, cfg, variant, l0, t_end, probes, start, snapshots, log, threads
     hist = {
         "hist_time": (("sample",), times, "s", "time of sample"),
         "hist_panel_force": (("sample", "contact", "xy"), panels, "N", "force of each wall panel on the liquid"),
-        "hist_probe_pressure": (("sample", "probe"), np.array(rec["probe"]).reshape(len(times), -1), "N cm-2", "pressure at fixed probe"),
+        "hist_probe_pressure": (("sample", "probe"), np.array(rec["probe"]).reshape(len(times), -1), "N cm-2", "pressure at fixed probe",
+                                {"missing": "no liquid particle within the probe's radius (a dry probe)"}),
         "hist_rms_speed": (("sample",), np.array(rec["rms"]), "cm s-1", "rms speed of the liquid particles"),
         "hist_max_speed": (("sample",), np.array(rec["vmax"]), "cm s-1", "largest liquid particle speed"),
         "hist_energy_ratio": (("sample",), np.array(rec["energy"]), "1", "kinetic energy / (W h), isaflow.rest"),

@@ -30,6 +30,7 @@ METHOD = Method(
     marker="D",
     paper_label="Marko et al. (2017), SPH liquid and Hooke's-law solid particles",
     settings="config/methods/solid.yaml",
+    checks="isaflow.methods.solid.settings",
     report="results/report/65_solid.md",
     claims="results/claims/solid.csv",
     timing="results/timing/65_solid.md",

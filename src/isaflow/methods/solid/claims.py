@@ -214,7 +214,7 @@ def floor_rows(cfg, runs):
     for (case, var), ds in sorted(floors.items()):
         w, wu, wa = (_h(ds, k) for k in ("w_centre", "w_centre_uniform", "w_centre_actual"))
         src = ds.attrs.get("load_method", "uniform") if var == "oneway" else "uniform W/span"
-        extra = (f"; deflection / depth {w / ds.attrs['depth_cm'] * 100:.2f} %" if var == "oneway" else "")
+        extra = (f"; deflection / depth {w / ds.attrs['depth_cm'] * 100:.2f} %" if "depth_cm" in ds.attrs else "")
         parts.append(f"{src}: {w * 10:.3f} mm ({(w / wu - 1) * 100:+.1f} % vs uniform, {(w / wa - 1) * 100:+.1f} % vs "
                      f"its loads; theory with its loads {(wa / wu - 1) * 100:+.1f} % vs uniform{extra})")
         ok.append(abs(w / wa - 1) < FLOOR_TOL)

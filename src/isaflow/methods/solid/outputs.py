@@ -38,6 +38,8 @@ def to_dataset(r, config_path, started, finished):
         "residual": var((), r.residual, r.residual_units, f"final {r.residual_name}"),
         "sim_time": var((), r.sim_time, "s", "physical time simulated"),
     }
+    if not np.isfinite(r.residual):  # a fixed-length run (the vessel with water) has no stop test
+        data["residual"].attrs["missing"] = "not applicable: the run has no stop test"
     for name, (dims, arr, units, long_name) in {**r.fields, **r.history}.items():
         data[name] = var(dims, arr, units, long_name)
     ds = xr.Dataset(data, coords={"xy": ["x", "y"], "stress_component": ["xx", "yy", "zz", "yx", "zy", "zx"],

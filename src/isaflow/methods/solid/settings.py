@@ -36,8 +36,18 @@ VALUES = {f"{sec}.{k}": v for sec, fields in SECTIONS.items() for k, v in fields
 
 
 def load(path):
-    """{section: {key: value}} of a settings file, values as written (sources dropped)."""
-    return S.load(path, VALUES, what="solid settings").tree()
+    """{section: {key: value}} of a settings file, values as written (sources dropped); plausibility and the
+    cost of every case checked (checks.check)."""
+    from .checks import check
+
+    s = S.load(path, VALUES, what="solid settings").tree()
+    check(s, str(path))
+    return s
+
+
+def validate(path):
+    """The workflow's parse-time check of a settings file (load: schema, plausibility, cost)."""
+    load(path)
 
 
 def load_with_sources(path):

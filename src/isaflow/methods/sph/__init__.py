@@ -28,6 +28,7 @@ METHOD = Method(
     paper_label="Marko et al. (2017), SPH liquid and Hooke's-law solid particles",
     tank=True,
     entry="isaflow.methods.sph.method",
+    checks="isaflow.methods.sph.checks",
     values="isaflow.methods.sph.settings:VALUES",
     settings="config/methods/sph.yaml",
     report="results/report/50_sph.md",

@@ -222,7 +222,7 @@ def _run(tank, s, resolution, start, on_wall, t_max, log, threads=1):
     walls = tank.walls
     # the vessels are open at the top: a splash may rise above the walls and fall back in (Tank.escape_box)
     wall_box = bounding_box(walls)
-    box = tank.escape_box()
+    box = np.asarray(tank.escape_box(), float)
     rc = 2 * st["h"] + par[K.SKIN]
     # the cell grid depends on the tank and the lattice only, so a continuation builds the same lists
     lo, hi = np.minimum(wall_box[:2], st["wpos"].min(0)) - rc, np.maximum(wall_box[2:], st["wpos"].max(0)) + rc

@@ -31,6 +31,7 @@ METHOD = Method(
     marker="v",
     paper_label="Merino-Alonso et al. (2020), truncated SPH hydrostatics (abstract only)",
     settings="config/methods/sph1d.yaml",
+    checks="isaflow.methods.sph1d.settings",
     report="results/report/60_sph1d.md",
     claims="results/claims/sph1d.csv",
     timing="results/timing/60_sph1d.md",

@@ -6,13 +6,14 @@ isaflow.inputs.InputError with one line naming the file and the field.
 
 from pathlib import Path
 
-import numpy as np
-
-from isaflow.core.smoothing import NAMES
 from isaflow import settings as S
 from isaflow.inputs import InputError as SceneError
 
-from .system import FLOORS, GRADIENT_FORMS
+from .checks import check
+
+KERNELS = ("cubic_spline", "wendland_c2", "wendland_c4", "wendland_c6")  # core.smoothing.NAMES (tested equal)
+GRADIENT_FORMS = ("symmetric", "plain")  # system.GRADIENT_FORMS (tested equal)
+FLOORS = ("mirror_hydrostatic", "mirror_equal", "truncated")  # system.FLOORS (tested equal)
 
 
 _POS = {"type": "number", "exclusiveMinimum": 0}
@@ -20,7 +21,7 @@ _POS = {"type": "number", "exclusiveMinimum": 0}
 # every variant of its 'variants' section
 VALUES = {
     "column.height": _POS, "column.rho_g": _POS,
-    "kernels": {"type": "array", "minItems": 1, "uniqueItems": True, "items": {"enum": list(NAMES)}},
+    "kernels": {"type": "array", "minItems": 1, "uniqueItems": True, "items": {"enum": list(KERNELS)}},
     "ratio": {"type": "object", "additionalProperties": False, "required": ["start", "stop", "step"],
               "properties": {"start": {"type": "number", "exclusiveMinimum": 0.5}, "stop": _POS, "step": _POS}},
     "n": {"type": "array", "minItems": 2, "items": {"type": "integer", "minimum": 8}},
@@ -33,6 +34,18 @@ VALUES = {
 
 def load(path):
     """{name: value} of a settings file; adds 'ratios' (array of h/dx) and 'path'."""
+    import numpy as np
+
+    s = validate(path)
+    r = s["ratio"]
+    s["ratios"] = np.round(np.arange(r["start"], r["stop"] + 0.5 * r["step"], r["step"]), 10)
+    s["n"] = sorted(s["n"])
+    s["path"] = str(path)
+    return s
+
+
+def validate(path):
+    """{name: value} of a settings file, checked (schema, variants, checks.check); pure Python."""
     path = Path(path)
     spec = S.read(path, VALUES, "1D SPH settings")
     if not spec.get("variants"):
@@ -45,10 +58,8 @@ def load(path):
     del s["gradient"], s["floor"]
     r = s["ratio"]
     if r["stop"] < r["start"]:
-        raise SceneError(f"{path}: ratio.value.stop: must be >= start")
+        raise SceneError(f"{path}: field 'ratio': stop must be >= start")
     if len(s["n"]) < s["classify"]["window"]:
-        raise SceneError(f"{path}: n.value: needs at least classify.window = {s['classify']['window']} values")
-    s["ratios"] = np.round(np.arange(r["start"], r["stop"] + 0.5 * r["step"], r["step"]), 10)
-    s["n"] = sorted(s["n"])
-    s["path"] = str(path)
+        raise SceneError(f"{path}: field 'n': needs at least classify.window = {s['classify']['window']} values")
+    check(s, str(path))
     return s

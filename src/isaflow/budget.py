@@ -1,0 +1,95 @@
+"""What a run will cost, checked before anything large is allocated: one place for every method.
+
+Each method estimates a run from its settings alone (:class:`Cost`: particles,
+steps, memory, and the setting each number comes from); :func:`check` refuses
+a run whose memory exceeds what the machine has (:func:`memory_limit`) or
+whose time, particles x steps x the method's measured cost per particle-step,
+exceeds the CPU-hour budget of ``config/limits.yaml`` (or the run's own
+``max_hours``).  The message names the file and the setting and gives the
+numbers.  Pure Python: the workflow checks every declared run while it is
+parsed.  Units: bytes, s, hours.
+"""
+
+import math
+import os
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from .inputs import InputError
+
+LIMITS = Path("config") / "limits.yaml"
+LIMIT_VALUES = {"cpu_hours": {"type": "number", "exclusiveMinimum": 0}}
+DEFAULT_MEMORY = 8.0 * 2**30  # bytes, when neither the environment nor /proc/meminfo says
+
+
+@dataclass
+class Cost:
+    """A run's estimate.  particles: the most held at once; steps: the steps (or solves) it may take;
+    bytes: its peak memory; ns_per_particle_step: the method's measured step cost [ns];
+    fields: {'particles' | 'steps' | 'bytes': the setting the number comes from}; detail: how the
+    steps follow from the settings, e.g. 't = 5 s / dt = 3.1e-4 s'."""
+
+    particles: float
+    steps: float
+    bytes: float
+    ns_per_particle_step: float
+    fields: dict = field(default_factory=dict)
+    detail: str = ""
+
+    @property
+    def hours(self):
+        return self.particles * self.steps * self.ns_per_particle_step * 1e-9 / 3600.0
+
+
+def memory_limit():
+    """Bytes a run may use: ISAFLOW_MEMORY_LIMIT_MB if set, else MemAvailable, else 8 GB."""
+    env = os.environ.get("ISAFLOW_MEMORY_LIMIT_MB")
+    if env:
+        try:
+            value = float(env) * 2**20
+        except ValueError:
+            value = float("nan")
+        if not (math.isfinite(value) and value > 0):
+            raise InputError(f"environment variable ISAFLOW_MEMORY_LIMIT_MB: '{env[:40]}' is not a positive number")
+        return value
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    return float(line.split()[1]) * 1024
+    except OSError:
+        pass
+    return DEFAULT_MEMORY
+
+
+def cpu_hours(path=LIMITS):
+    """The CPU-hour budget of a run (config/limits.yaml, read by the one settings loader)."""
+    from . import settings
+
+    return float(settings.load(path, LIMIT_VALUES, what="resource limits")["cpu_hours"])
+
+
+def gb(b):
+    return f"{b / 2**30:.3g} GB"
+
+
+def check(path, cost, max_hours=None):
+    """Refuse (InputError naming path and the setting) a run whose memory or time exceeds the limits.
+
+    max_hours: the run's own CPU-hour limit (a deliberate long run), else config/limits.yaml's."""
+    numbers = (cost.particles, cost.steps, cost.bytes)
+    if not all(math.isfinite(x) and x >= 0 for x in numbers):
+        raise InputError(f"{path}: field '{cost.fields.get('steps', 'resolution')}': the run's size is not a finite "
+                         f"number ({cost.particles:.3g} particles, {cost.steps:.3g} steps); choose less extreme values")
+    limit = memory_limit()
+    if cost.bytes > limit:
+        raise InputError(f"{path}: field '{cost.fields.get('bytes', 'resolution')}': the run needs about "
+                         f"{gb(cost.bytes)} of memory ({cost.particles:.3g} particles, {cost.steps:.3g} steps, {cost.detail}); "
+                         f"{gb(limit)} available")
+    budget = cpu_hours() if max_hours is None else float(max_hours)
+    if cost.hours > budget:
+        raise InputError(f"{path}: field '{cost.fields.get('steps', 'resolution')}': the run needs about "
+                         f"{cost.particles * cost.steps:.3g} particle-steps ({cost.particles:.3g} particles x "
+                         f"{cost.steps:.3g} steps, {cost.detail}), about {cost.hours:.3g} CPU-hours at "
+                         f"{cost.ns_per_particle_step:g} ns per particle-step; the budget is {budget:g} h "
+                         f"(config/limits.yaml cpu_hours, or the run's max_hours for a deliberate long run)")

@@ -1,0 +1,48 @@
+"""What makes an ISA run plausible, and what it will cost, from its settings alone (pure Python).
+
+The scene checks (isa.scene: particles inside the walls, derived stiffness
+and step numbers finite, memory of the built lattice) run when the run is
+prepared; these run while the workflow is parsed too.  :func:`plausible`
+refuses a step du longer than half the pair range (a particle could step past
+its neighbour's whole repulsion); :func:`cost` estimates particles, steps
+(max_steps) and memory for isaflow.budget.  Units: cm, N, bytes.
+"""
+
+from ... import budget
+from ...plausible import within
+
+NS_PER_PARTICLE_STEP = 20.0  # fastest measured relax step (benchmarks/), rounded down
+BYTES_PER_PARTICLE = 640  # solver + compiled loop + contacts + the run file's copy (measured order, rounded up)
+BYTES_PER_RECORD = 4 * 56  # hist_fmax/lo/hi/step records held as Python lists, then arrays
+DU = "a step moves a particle by du; longer than half the pair range l_pu it can carry a particle through its " \
+     "neighbour's whole repulsion (the paper: du = 0.01 cm against l_pu = 7.07 cm)"
+
+
+def particle_count(part):
+    """Particles a lattice or points block will create, without creating them."""
+    if part.get("points"):
+        return len(part["points"])
+    lat = part["lattice"]
+    rows, lengths = lat["rows"], lat["row_lengths"]
+    full, rest = divmod(rows, len(lengths))
+    return full * sum(lengths) + sum(lengths[:rest])
+
+
+def plausible(tank, s, stability=False):
+    """Refuse implausible settings (InputError naming the file and the setting, with the reason)."""
+    within(s.path, "solver.du", s["solver.du"], None, s["forces.pair.l_u"] / 2, DU, stability=stability)
+
+
+def cost(tank, s, particles=None):
+    """budget.Cost of a run: the lattice or points (or a start file's `particles`), max_steps steps."""
+    n = particle_count(s.tree("particles")) if particles is None else particles
+    steps = s["solver.max_steps"]
+    hist = s["solver.history"] or {}
+    records = steps / hist["every"] if hist.get("every") else 0
+    snaps = hist.get("snapshots", 0) * n * 32
+    nbytes = n * BYTES_PER_PARTICLE + records * BYTES_PER_RECORD + snaps
+    big = max((n * BYTES_PER_PARTICLE, "particles"), (records * BYTES_PER_RECORD, "solver.history.every"),
+              (snaps, "solver.history.snapshots"))
+    return budget.Cost(n, steps, nbytes, NS_PER_PARTICLE_STEP,
+                       {"particles": "particles", "steps": "solver.max_steps", "bytes": big[1]},
+                       f"max_steps = {steps:.3g}")

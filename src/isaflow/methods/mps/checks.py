@@ -1,0 +1,95 @@
+"""What makes an MPS run plausible, and what it will cost, from its settings alone (pure Python).
+
+:func:`plausible` refuses settings no MPS run can use (isaflow.plausible):
+interaction radii outside the range of the MPS literature, a Courant number
+over the explicit limit, a viscous step over the diffusion limit, a liquid
+with fewer than two particles across.  :func:`cost` estimates particles
+(liquid + wall + dummy), steps (t / dt) and memory for isaflow.budget.
+Units: cm, s, bytes; radii in spacings l0.
+"""
+
+import math
+
+from ... import budget
+from ...core.units import G
+from ...plausible import finite, require, within
+
+NS_PER_PARTICLE_STEP = 2000.0  # measured 26 ms per step at about 5,000 particles (5.2 us), rounded down
+BYTES_PER_PARTICLE = 2000  # state, number densities, the pressure system's vectors (order, rounded up)
+BYTES_PER_PAIR = 40  # neighbour list entry + two sparse-matrix entries (value, column) per listed pair
+RADIUS = (2.0, 4.0, "MPS interaction radii are 2.0-4.0 l0 (Koshizuka & Oka 1996: 2.1 l0 for the number density "
+                    "and gradient, 4.0 l0 for the Laplacian; MPS-Basic 2.1 and 3.1 l0); below 2 l0 a lattice "
+                    "particle sees only its nearest neighbours")
+COURANT = (None, 0.5, "the explicit step moves a particle at the free-fall speed by courant x l0; MPS codes run "
+                      "at 0.1-0.2 (Koshizuka & Oka 1996, MPS-Basic 0.2), the time-step study here up to 0.4")
+DIFFUSION = (None, 0.25, "the explicit viscous step is stable for nu dt / l0^2 <= 1 / (2 d) = 0.25 in 2D")
+BETA = (0.8, 0.99, "the free-surface threshold n* < beta n0: 0.97 in Koshizuka & Oka 1996 and MPS-Basic, "
+                   "0.8-0.99 in the MPS literature")
+RADII = ("model.re_density", "model.re_gradient", "model.re_laplacian", "model.re_surface")
+
+
+def first_vessel(tank):
+    """((x0, x1) cm, floor y cm) of the tank's first vessel: the highest +x horizontal wall spanning it
+    (solver.first_vessel, in Python)."""
+    x0, x1 = tank.vessels[0][1]
+    floors = [w["from"][1] for w in tank.spec["walls"]
+              if abs(w["from"][1] - w["to"][1]) <= 1e-9 and w["to"][0] > w["from"][0]
+              and min(w["to"][0], x1) - max(w["from"][0], x0) > 0]
+    return (x0, x1), max(floors)
+
+
+def time_step(tank, l0, courant):
+    """dt [s] = courant l0 / sqrt(2 g H), H = liquid top minus the lowest wall point (solver.time_step)."""
+    _, floor = first_vessel(tank)
+    low = min(min(w["from"][1], w["to"][1]) for w in tank.spec["walls"])
+    return courant * l0 / math.sqrt(2.0 * G * (floor + tank.depth - low))
+
+
+def _flow(tank):
+    return len(tank.spec.get("vessels", [])) > 1
+
+
+def plausible(tank, s, stability=False):
+    """Refuse implausible settings (InputError naming the file and the setting, with the reason)."""
+    path, l0 = s.path, s["resolution.spacing"]
+    require(l0 is not None, path, f"resolutions.{s.resolution}", "no resolution.spacing")
+    (x0, x1), _ = first_vessel(tank)
+    nx, ny = int((x1 - x0) / l0), round(tank.depth / l0)
+    require(nx >= 2 and ny >= 2, path, "resolution.spacing",
+            f"the liquid ({x1 - x0:g} cm wide, {tank.depth:g} cm deep) would be {nx} x {ny} particles of "
+            f"l0 = {l0:g} cm; a liquid needs at least 2 across its width and its depth")
+    for key in RADII:
+        within(path, key, s[key], *RADIUS, stability=stability)
+    within(path, "time.courant", s["time.courant"], *COURANT, stability=stability)
+    within(path, "model.beta", s["model.beta"], *BETA, stability=stability)
+    dt = time_step(tank, l0, s["time.courant"])
+    finite(path, "time.courant", dt, "time step dt [s]")
+    within(path, "model.kinematic_viscosity", s["model.kinematic_viscosity"] * dt / l0**2, *DIFFUSION,
+           stability=stability)
+    t_key = "time.flow_time" if _flow(tank) else "time.single_time"
+    require(s["time.average_window"] <= s[t_key], path, "time.average_window",
+            f"{s['time.average_window']:g} s is longer than the run ({t_key} = {s[t_key]:g} s)")
+
+
+def cost(tank, s, particles=None):
+    """budget.Cost of a run: the liquid block (or a start file's `particles`), pressure and dummy wall
+    layers, t / dt steps."""
+    l0 = s["resolution.spacing"]
+    (x0, x1), _ = first_vessel(tank)
+    liquid = (x1 - x0) / l0 * tank.depth / l0 if particles is None else particles
+    perimeter = sum(math.hypot(w["to"][0] - w["from"][0], w["to"][1] - w["from"][1]) for w in tank.spec["walls"])
+    wall = 2 * perimeter / l0 * (s["model.pressure_layers"] + s["model.dummy_layers"])
+    n = liquid + wall
+    t_key = "time.flow_time" if _flow(tank) else "time.single_time"
+    dt = time_step(tank, l0, s["time.courant"])
+    steps = s[t_key] / dt
+    reach = max(s[k] for k in RADII) + s["model.list_skin"]
+    records = s[t_key] / s["time.sample_interval"]
+    nbytes = n * (BYTES_PER_PARTICLE + BYTES_PER_PAIR * math.pi * reach**2) + records * 400
+    steps_field = "time.courant" if s["time.courant"] < COURANT[1] / 50 else \
+        "resolution.spacing" if n > 1e6 else t_key
+    wide = max(RADII, key=lambda k: s[k])
+    fields = {"particles": "resolution.spacing", "steps": steps_field,
+              "bytes": (wide if s[wide] > 2 * RADIUS[1] else "resolution.spacing") if records * 400 <= nbytes / 2 else
+              "time.sample_interval" if s["time.sample_interval"] < dt else t_key}
+    return budget.Cost(n, steps, nbytes, NS_PER_PARTICLE_STEP, fields, f"t = {s[t_key]:g} s / dt = {dt:.3g} s")

@@ -1,0 +1,89 @@
+"""What makes the solid method's settings plausible, and what its cases will cost (pure Python).
+
+:func:`check` (called by settings.load, so by every run and while the
+workflow is parsed) refuses materials no solid has, a tolerance below
+double-precision round-off, a Hertz disk pressed through its plate, a vessel
+time step over the lattice's step rule (eq. 26, dx / (4 c)), and any case
+whose particles x steps exceed the budget (isaflow.budget).  Units: the
+settings file's (GPa, kg/m^3, mm, um, ns), converted here to cm, N, s.
+"""
+
+import math
+
+from ... import budget
+from ...core.units import KG, PA
+from ...plausible import finite, require
+
+NS_PER_PARTICLE_STEP = 10.0  # a lower bound of the dynamic-relaxation step (3-D links, numba)
+BYTES_PER_PARTICLE = 3000  # state, links (26 neighbours in 3-D) and their forces (order, rounded up)
+UM, MM, NS = 1e-4, 0.1, 1e-9  # cm, cm, s
+E_MAX_GPA = 1220.0  # diamond, the stiffest solid
+RHO_RANGE = (1.0, 22600.0)  # kg/m^3: aerogels to osmium, the densest element
+TOL_MIN = 1e-14  # relative residual: below it the forces are round-off of double precision
+
+
+def wave_speed(mat):
+    """c = sqrt(E / rho) [cm/s] of the material section."""
+    return math.sqrt(mat["E_GPa"] * 1e9 * PA / (mat["rho_kg_m3"] * KG / 1e6))
+
+
+def plausible(s, path):
+    """Refuse implausible settings ({section: {key: value}}; InputError naming the file and the setting)."""
+    mat = s["material"]
+    require(mat["E_GPa"] <= E_MAX_GPA, path, "material.E_GPa",
+            f"{mat['E_GPa']:g} GPa is stiffer than diamond ({E_MAX_GPA:g} GPa), the stiffest solid")
+    require(RHO_RANGE[0] <= mat["rho_kg_m3"] <= RHO_RANGE[1], path, "material.rho_kg_m3",
+            f"{mat['rho_kg_m3']:g} kg/m^3 is outside {RHO_RANGE[0]:g}-{RHO_RANGE[1]:g} kg/m^3 (aerogels to "
+            f"osmium, the densest element)")
+    finite(path, "material", wave_speed(mat), "wave speed sqrt(E / rho) [cm/s]")
+    require(s["solver"]["tol"] >= TOL_MIN, path, "solver.tol",
+            f"{s['solver']['tol']:g} is below {TOL_MIN:g}, the round-off of the forces in double precision; the "
+            f"relaxation could never reach it")
+    h = s["hertz"]
+    thick = h["plate"][1] * h["dx_um"]
+    deepest = max(h["depths_um"])
+    require(deepest < thick, path, "hertz.depths_um",
+            f"{deepest:g} um presses the disk through the {thick:g} um plate ({h['plate'][1]} particles of "
+            f"{h['dx_um']:g} um)")
+    require(deepest < h["radius_mm"] * 1000, path, "hertz.depths_um",
+            f"{deepest:g} um is deeper than the disk's radius {h['radius_mm']:g} mm")
+    v = s["vessel"]
+    rule = v["dx_mm"] * MM / (4 * wave_speed(mat))
+    require(v["dt_ns"] * NS <= rule, path, "vessel.dt_ns",
+            f"{v['dt_ns']:g} ns exceeds the step rule dx / (4 c) = {rule / NS:.4g} ns (marko2017 eq. 26)")
+    require(v["water_h_over_dx"] >= 1.0, path, "vessel.water_h_over_dx",
+            f"{v['water_h_over_dx']:g}: below 1 the water's kernel (support 2h) sees too few neighbours "
+            f"(Monaghan 1992: h ~ 1.2-1.3 dx)")
+
+
+def costs(s):
+    """{case: budget.Cost} of every case of the settings."""
+    steps_hooke = s["solver"]["max_steps"]
+    b, sh, h, v, f = s["bar"], s["shear"], s["hertz"], s["vessel"], s["floor"]
+    n_bar = math.prod(b["particles"])
+    n_shear = sh["particles"][0] * (sh["particles"][1] + 2 * sh["grip_layers"]) * sh["particles"][2]
+    n_hertz = h["plate"][0] * h["plate"][1]
+    n_vessel = math.pi * ((v["water_radius_particles"] + v["ring_particles"] + 1) ** 2)
+    n_floor = (f["span_cm"] / f["dx_cm"] + 1) * f["layers"]
+    history = v["history_us"] * 1e-6 / (v["dt_ns"] * NS)
+
+    def cost(n, steps, field_n, field_steps, detail):
+        return budget.Cost(n, steps, n * BYTES_PER_PARTICLE, NS_PER_PARTICLE_STEP,
+                           {"particles": field_n, "steps": field_steps, "bytes": field_n}, detail)
+
+    return {
+        "bar": cost(n_bar, 2 * steps_hooke, "bar.particles", "solver.max_steps", "two loads x max_steps"),
+        "shear": cost(n_shear, steps_hooke, "shear.particles", "solver.max_steps", "max_steps"),
+        "hertz": cost(n_hertz, len(h["depths_um"]) * steps_hooke + len(h["paper_dt_ns"]) * h["dt_check_steps"],
+                      "hertz.plate", "solver.max_steps", "depths x max_steps + the paper's dt checks"),
+        "vessel": cost(n_vessel, steps_hooke + history + v["steps"], "vessel.water_radius_particles",
+                       "vessel.history_us", f"settling + history {v['history_us']:g} us / dt {v['dt_ns']:g} ns"),
+        "floor": cost(n_floor, f["max_steps"], "floor.dx_cm", "floor.max_steps", "max_steps"),
+    }
+
+
+def check(s, path):
+    """plausible() and the cost of every case against the budget."""
+    plausible(s, path)
+    for c in costs(s).values():
+        budget.check(path, c)

@@ -1,0 +1,80 @@
+"""The checks of a run that need no numerics, made before any work and while the workflow is parsed.
+
+:func:`check` takes a run's tank, resolved settings and outcomes: unstable
+outcomes (escaped, non-finite, solver failure) may be accepted only by a
+declared stability case; the method's ``checks`` module refuses implausible
+settings and estimates the cost that isaflow.budget holds against the
+machine and the CPU-hour budget.  :class:`Declarations` checks every run a
+method's settings file (or a study plan) declares: its tank, variant,
+resolution, overrides, start run and the same checks, each error one line
+naming the file, the run and the setting.  Pure Python (yaml, jsonschema).
+"""
+
+from . import budget, inputs, methods, settings
+from . import tank as tanks
+from .inputs import InputError
+
+UNSTABLE = ("escaped", "nonfinite", "solver_failed")  # outcomes only a stability case may accept
+WORKFLOW_KEYS = ("meta", "runtime")  # keys the workflow adds to a declaration (not part of RUN_SCHEMA)
+
+
+def check(method, tank, s, accept=("converged",), stability=False, max_hours=None, particles=None):
+    """Refuse (InputError) a run whose outcomes, settings or cost are not allowed.  tank: tank.Tank; s: resolved
+    settings.Settings; particles: a start file's count (None: the resolution's)."""
+    unstable = [a for a in accept if a in UNSTABLE]
+    if unstable and not stability:
+        raise InputError(f"accept: outcome '{unstable[0]}' may be accepted only by a declared stability case "
+                         f"(stability: true / --stability-case); any other run that ends so fails")
+    checks = methods.get(method).checks_module()
+    checks.plausible(tank, s, stability)  # first: it refuses derived numbers that over- or underflow
+    budget.check(s.path, checks.cost(tank, s, particles), max_hours)
+
+
+class Declarations:
+    """Checks the declared runs of the tank methods, reading each tank and settings file once."""
+
+    def __init__(self):
+        self._tanks, self._specs = {}, {}
+
+    def tank(self, name):
+        if name not in self._tanks:
+            self._tanks[name] = tanks.load(tanks.path_of(name))
+        return self._tanks[name]
+
+    def spec(self, method):
+        if method not in self._specs:
+            m = methods.get(method)
+            self._specs[method] = settings.read(m.settings, m.values_schema(), f"{method} settings")
+        return self._specs[method]
+
+    def check(self, method, runs):
+        """Check {run id: declaration} of one method (InputError naming the file, the run and the field)."""
+        m = methods.get(method)
+        path, spec = m.settings, self.spec(method)
+        for run_id, decl in runs.items():
+            try:
+                self._check_run(method, m, path, spec, runs, run_id, decl)
+            except InputError as err:
+                raise InputError(err if f"runs.{run_id}" in str(err) else f"{err} (run '{run_id}')") from None
+
+    def _check_run(self, method, m, path, spec, runs, run_id, decl):
+        where = f"{path}: field 'runs.{run_id}"
+        plain = {k: v for k, v in decl.items() if k not in WORKFLOW_KEYS}
+        inputs.validate(plain, settings.RUN_SCHEMA, f"{path}: run '{run_id}'")
+        if decl["variant"] not in m.variants:
+            raise InputError(f"{where}.variant': method {method} has no variant "
+                             f"'{inputs.printable(decl['variant'])}' (choose from {', '.join(m.variants)})")
+        if decl.get("start") and decl["start"] not in runs:
+            raise InputError(f"{where}.start': no declared {method} run '{inputs.printable(decl['start'])}'")
+        try:
+            tank = self.tank(decl["tank"])
+        except InputError as err:
+            raise InputError(f"{where}.tank': {err}") from None
+        s = settings.load(path, m.values_schema(), decl["variant"], decl["resolution"], decl.get("set", {}),
+                          spec=spec)
+        accept = decl.get("accept", ["converged"])
+        unstable = [a for a in accept if a in UNSTABLE]
+        if unstable and not decl.get("stability"):
+            raise InputError(f"{where}.accept': outcome '{unstable[0]}' may be accepted only by a stability "
+                             f"case (stability: true); any other run that ends so fails its job")
+        check(method, tank, s, accept, decl.get("stability", False), decl.get("max_hours"))
