@@ -116,7 +116,13 @@ class State:
         self.builds += 1
         self.list_pos = pos.copy()
         self.start, self.nbr = model.neighbour_list(pos, self.kind, self.grid_box, self.rmax + self.skin, self.tw, self.tside,
-                                                    self.thin)
+                                                    self.thin[:0])
+
+    def distances(self, pos):
+        """(M,) distance of every list entry at pos, inf where the pair does not see each other across a thin
+        wall at pos (the lists hold every pair in range; visibility is that of the positions the operators
+        use, so a particle that grazes a thin wall's line between list builds sees, and is seen, as it is now)."""
+        return model.visible_distances(pos, self.start, self.nbr, self.tw, self.tside, self.thin, self.rmax + self.skin)
 
     def list_valid(self, pos):
         """The lists still hold every pair closer than rmax at pos (nobody moved more than skin / 2)."""
@@ -138,7 +144,7 @@ def step(s, dt, source, cfg, timers=None):
     nu = cfg["model.kinematic_viscosity"]
     ecs = cfg["model.ecs"]
     if nu > 0 or ecs:
-        dist = model.distances(s.pos, s.start, s.nbr)
+        dist = s.distances(s.pos)
     if nu > 0:
         lap = model.laplacian(s.vel, s.kind, s.start, s.nbr, dist, s.re_l, s.n0_l, s.lam)
     else:
@@ -152,10 +158,10 @@ def step(s, dt, source, cfg, timers=None):
         s.neighbours(ps)
     coll = cfg["model.collision_distance"] * s.l0
     if coll > 0.0:
-        ps, vs = model.collide(ps, vs, s.kind, s.start, s.nbr, coll, cfg["model.restitution"])
+        ps, vs = model.collide(ps, vs, s.kind, s.start, s.nbr, s.distances(ps), coll, cfg["model.restitution"])
         if not s.list_valid(ps):
             s.neighbours(ps)
-    dist = model.distances(ps, s.start, s.nbr)
+    dist = s.distances(ps)
     n_star = model.number_density(s.start, s.nbr, dist, s.re_n)
     if s.div_mode == 1:
         div = model.divergence_hs(ps, vs, s.start, s.nbr, dist, s.re_g, s.n0_g)
@@ -203,7 +209,7 @@ def step(s, dt, source, cfg, timers=None):
     if c > 0.0:
         if not s.list_valid(pos):
             s.neighbours(pos)
-        d2 = model.distances(pos, s.start, s.nbr)
+        d2 = s.distances(pos)
         pos = pos + model.shift(pos, s.kind, surf, normal, s.start, s.nbr, d2, s.re_n, s.n0_n, c, s.l0)
     bad, graze = model.check(pos_old, pos, vel, s.kind, s.walls, s.escape_box, s.graze_depth)
     s.pos, s.vel, s.p = pos, vel, p
