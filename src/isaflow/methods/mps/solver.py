@@ -112,7 +112,9 @@ class State:
         """Neighbour lists at pos, radius rmax + skin (start, nbr); reused until a particle has moved more
         than skin / 2 from where it was at the build (list_valid), so every pair closer than rmax is in them.
         The rows' order depends on the positions at the build, so a continued run (which builds its own
-        lists) matches the run it continues to round-off, not bit for bit."""
+        lists) matches the run it continues to round-off, not bit for bit.  The lists hold every pair in range
+        whatever the thin walls between them (no thin wall passed): which pairs see each other is decided at
+        the positions the operators use (distances)."""
         self.builds += 1
         self.list_pos = pos.copy()
         self.start, self.nbr = model.neighbour_list(pos, self.kind, self.grid_box, self.rmax + self.skin, self.tw, self.tside,
