@@ -361,16 +361,17 @@ def test_wall_particles_and_panels(path):
 
 
 def test_no_particle_sees_across_a_thin_wall():
-    """Liquid in either vessel beside right1: no list links particles on opposite sides across the wall's
-    segment, a face's particles are seen only from its side, and the lists are symmetric (dummy particles,
-    which have no row, aside)."""
+    """Liquid in either vessel beside right1: no pair at a finite distance (State.distances, what every
+    operator uses) links particles on opposite sides across the wall's segment, a face's particles are seen
+    only from its side, and the pairs are symmetric (dummy particles, which have no row, aside)."""
     tank = load_tank(FLOWS[1])
     l0 = COARSE
     left = boundary.liquid_block((100 - 4 * l0, 100.0), 30.0, 4 * l0, l0)
     right = left + [4 * l0, 0.0]
     s = solver.State(tank, settings.load(CFG), l0, np.concatenate([left, right]), np.zeros((2 * len(left), 2)))
     s.neighbours(s.pos)
-    pairs = {(i, int(j)) for i in range(len(s.pos)) for j in s.nbr[s.start[i]:s.start[i + 1]]}
+    d = s.distances(s.pos)
+    pairs = {(i, int(s.nbr[k])) for i in range(len(s.pos)) for k in range(s.start[i], s.start[i + 1]) if np.isfinite(d[k])}
     assert all((j, i) in pairs for i, j in pairs if s.kind[j] != model.DUMMY)  # dummies have no rows
     side = np.where(s.pos[:, 0] < 100.0, 1, -1)
     eff = np.where(s.tw >= 0, s.tside, side)
@@ -379,6 +380,30 @@ def test_no_particle_sees_across_a_thin_wall():
         if eff[i] != eff[j]:  # opposite sides: only around the wall's lower end, never through it
             assert s.tw[i] < 0 and s.tw[j] < 0
             assert not operators.segments_cross(*s.pos[i], *s.pos[j], seg)
+
+
+def test_thin_wall_visibility_is_that_of_the_current_positions():
+    """A liquid particle that grazes right1's line between two list builds (it moves less than the lists'
+    skin) sees, and is seen by, the particles of the side it is now on and no longer those of the side it
+    left: visibility is evaluated at the positions the operators use, not at the lists' build (stale lists
+    once hid a pair 0.02 l0 apart from the collision model at the wall's lower end, whose pressure spike,
+    570 N/cm2, threw a particle over the left wall of samefloor_standard_dx5.56)."""
+    tank = load_tank(FLOWS[1])
+    l0 = COARSE
+    left = np.array([[100.0 - 0.6 * l0, 40.0]])
+    right = np.array([[100.0 + 0.1 * l0, 40.0]])
+    s = solver.State(tank, settings.load(CFG), l0, np.concatenate([left, right]), np.zeros((2, 2)))
+    s.neighbours(s.pos)
+    row = slice(s.start[1], s.start[2])
+    assert not np.isfinite(s.distances(s.pos)[row][s.nbr[row] == 0]).any()  # across the wall at the build
+    moved = s.pos.copy()
+    moved[1, 0] = 100.0 - 0.1 * l0  # across the line, within the skin: the lists are kept
+    assert s.list_valid(moved)
+    d = s.distances(moved)
+    assert np.isfinite(d[row][s.nbr[row] == 0]).all()
+    face = s.nbr[row][s.tw[s.nbr[row]] >= 0]
+    seen = np.isfinite(d[row][s.tw[s.nbr[row]] >= 0])
+    assert seen.any() and np.all(s.tside[face[seen]] == 1) and np.all(s.tside[face[~seen]] == -1)
 
 
 def drop(tank, wall, side, variant, l0, rows=4):
@@ -524,6 +549,33 @@ def test_column_comes_to_rest(variant):
     cfg = settings.load(CFG)
     r = solver.solve(tank, cfg, variant, COARSE, cfg["time.single_time"], cfg["probes.single"], threads=1)
     assert r.status == "converged" and r.params["time_to_rest"] <= cfg["time.single_time"]
+
+
+@pytest.mark.xfail(strict=True, reason="no literature practice tried removes every escape of the 12 flows (3 source "
+                                       "terms x l0 = 5.56, 3.45 cm x flow_step50, flow_samefloor, each continuing its "
+                                       "3 s single run; 8 s flows).  Cause: the dividing wall's lower end (right1 at "
+                                       "(100, 20) cm): its wall particles are free-surface particles (P = 0) in 94-100 % "
+                                       "of the steps with liquid within l0 of them (samefloor_standard_dx3.45), so "
+                                       "liquid is drawn round the end, grazes the wall's line (< l0/2, allowed), changes "
+                                       "side, and the sudden neighbourhood gives P = 500-830 N/cm2 (90 at the floor of "
+                                       "the full vessel) that throws a particle at 450-650 cm/s over the left wall.  "
+                                       "Escapes (flow at s): defaults before this branch: samefloor standard 5.56 (4.9), "
+                                       "samefloor hattori 5.56 (6.2), samefloor standard 3.45 (5.2); with the thin-wall "
+                                       "visibility at the operators' positions (now the default): samefloor standard 3.45 "
+                                       "(4.3), flow_step50 hattori 3.45 (0.52: a jet tip at 842 cm/s through right2's "
+                                       "corner); with it and the Courant condition on the largest speed (time."
+                                       "velocity_courant 0.2): samefloor standard 5.56 (7.8) and 3.45 (4.0); wall "
+                                       "particles never free surface: 9 of 12 runs escaped (singles too)")
+def test_every_flow_runs_without_an_escape():
+    """The flow of the source term and spacing that escapes first with the defaults (hattori, l0 = 3.45 cm,
+    flow_step50, continuing its single run) runs its first second without a particle escaping."""
+    cfg = settings.load(CFG, variant="hattori", resolution="dx3.45")  # the run's spacing as the settings state it
+    l0 = cfg["resolution.spacing"]
+    single = solver.solve(load_tank(TANK), cfg, "hattori", l0, cfg["time.single_time"], cfg["probes.single"], threads=1)
+    start = dict(pos=single.pos, vel=single.fields["velocity"][1], steps=single.steps, sim_time=single.sim_time,
+                 initial_depth=single.params["initial_depth"])
+    r = solver.solve(load_tank(FLOWS[0]), cfg, "hattori", l0, 1.0, cfg["probes.flow"], start=start, threads=1)
+    assert r.status != "escaped", r.message
 
 
 # --- threads and continuations ------------------------------------------------------

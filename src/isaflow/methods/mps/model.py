@@ -15,7 +15,7 @@ from isaflow.core.geometry import crossed_wall, segment_closest
 
 from .operators import (DIM, DUMMY, FLUID, GRADIENTS, JIT, PAR, WALL, distances, divergence, divergence_hs,  # noqa: F401
                         gradient, lattice_constants, laplacian, neighbour_list, number_density, offsets, probe_pressure,
-                        weight)
+                        visible_distances, weight)
 
 # source terms of the pressure equation (settings name -> id)
 SOURCES = {"standard": 0, "hattori": 1, "mixed": 2}
@@ -88,13 +88,14 @@ def explicit(pos, vel, kind, lap, dt, gx, gy, nu):
 
 
 @njit(**PAR)
-def collide(ps, vs, kind, start, nbr, cdist, restitution):
+def collide(ps, vs, kind, start, nbr, dist, cdist, restitution):
     """Collision model of MPS-Basic (MPS::collision) as a gather: every fluid particle closer than ``cdist``
     [cm] to a listed neighbour (any kind; wall and dummy particles immovable) takes, for each such pair,
     the impulse that removes (1 + e) of the approaching normal relative velocity (equal masses share it)
     and half (fluid-fluid) or all (fluid-wall) of the push back to ``cdist``, all pairs computed from the
     state before the collision (MPS-Basic updates pair by pair in sequence; here every pair's exchange is
-    the same from both ends, so momentum is conserved and the order does not matter).
+    the same from both ends, so momentum is conserved and the order does not matter).  dist (M,) the list
+    entries' distances at ps (inf: the pair does not see each other across a thin wall).
     Returns (U, V) after the collision."""
     n = ps.shape[0]
     po = ps.copy()
@@ -104,11 +105,11 @@ def collide(ps, vs, kind, start, nbr, cdist, restitution):
             continue
         for k in range(start[i], start[i + 1]):
             j = nbr[k]
-            dx = ps[j, 0] - ps[i, 0]
-            dy = ps[j, 1] - ps[i, 1]
-            r = np.sqrt(dx * dx + dy * dy)
+            r = dist[k]
             if r >= cdist or r == 0.0:
                 continue
+            dx = ps[j, 0] - ps[i, 0]
+            dy = ps[j, 1] - ps[i, 1]
             ex = dx / r
             ey = dy / r
             mass = 0.5 if kind[j] == FLUID else 1.0  # 1 / (1/m_i + 1/m_j), unit fluid masses

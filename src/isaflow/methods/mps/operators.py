@@ -209,6 +209,25 @@ def distances(pos, start, nbr):
     return d
 
 
+@njit(**PAR)
+def visible_distances(pos, start, nbr, tw, tside, thin, reach):
+    """(M,) distance [cm] of every list entry at positions pos, inf for a pair that does not see each other
+    across the thin walls thin (T, 4) at pos (visible; reach [cm]: the lists' radius).  Every operator skips
+    a pair at r >= its radius, so visibility is that of the positions the operators are evaluated at, not
+    of the lists' build (a particle that grazes a thin wall's line changes side between builds)."""
+    n = pos.shape[0]
+    near = near_thin(pos, thin, reach)
+    d = np.empty(nbr.shape[0])
+    for i in prange(n):
+        for k in range(start[i], start[i + 1]):
+            j = nbr[k]
+            if visible(i, j, pos, tw, tside, near, thin):
+                d[k] = np.hypot(pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1])
+            else:
+                d[k] = np.inf
+    return d
+
+
 # --- operators (gathers over the lists) ---------------------------------------------------------------------
 
 

@@ -38,6 +38,7 @@ VALUES = {
     'model.list_skin': {"type": "number", "minimum": 0},
     'model.relax_all_sources': {"type": "boolean"},
     'time.courant': {"type": "number", "exclusiveMinimum": 0},
+    'time.velocity_courant': {"type": "number", "minimum": 0},
     'time.sample_interval': {"type": "number", "exclusiveMinimum": 0},
     'time.single_time': {"type": "number", "exclusiveMinimum": 0},
     'time.flow_time': {"type": "number", "exclusiveMinimum": 0},

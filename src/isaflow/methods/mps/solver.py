@@ -112,11 +112,19 @@ class State:
         """Neighbour lists at pos, radius rmax + skin (start, nbr); reused until a particle has moved more
         than skin / 2 from where it was at the build (list_valid), so every pair closer than rmax is in them.
         The rows' order depends on the positions at the build, so a continued run (which builds its own
-        lists) matches the run it continues to round-off, not bit for bit."""
+        lists) matches the run it continues to round-off, not bit for bit.  The lists hold every pair in range
+        whatever the thin walls between them (no thin wall passed): which pairs see each other is decided at
+        the positions the operators use (distances)."""
         self.builds += 1
         self.list_pos = pos.copy()
         self.start, self.nbr = model.neighbour_list(pos, self.kind, self.grid_box, self.rmax + self.skin, self.tw, self.tside,
-                                                    self.thin)
+                                                    self.thin[:0])
+
+    def distances(self, pos):
+        """(M,) distance of every list entry at pos, inf where the pair does not see each other across a thin
+        wall at pos (the lists hold every pair in range; visibility is that of the positions the operators
+        use, so a particle that grazes a thin wall's line between list builds sees, and is seen, as it is now)."""
+        return model.visible_distances(pos, self.start, self.nbr, self.tw, self.tside, self.thin, self.rmax + self.skin)
 
     def list_valid(self, pos):
         """The lists still hold every pair closer than rmax at pos (nobody moved more than skin / 2)."""
@@ -138,7 +146,7 @@ def step(s, dt, source, cfg, timers=None):
     nu = cfg["model.kinematic_viscosity"]
     ecs = cfg["model.ecs"]
     if nu > 0 or ecs:
-        dist = model.distances(s.pos, s.start, s.nbr)
+        dist = s.distances(s.pos)
     if nu > 0:
         lap = model.laplacian(s.vel, s.kind, s.start, s.nbr, dist, s.re_l, s.n0_l, s.lam)
     else:
@@ -152,10 +160,10 @@ def step(s, dt, source, cfg, timers=None):
         s.neighbours(ps)
     coll = cfg["model.collision_distance"] * s.l0
     if coll > 0.0:
-        ps, vs = model.collide(ps, vs, s.kind, s.start, s.nbr, coll, cfg["model.restitution"])
+        ps, vs = model.collide(ps, vs, s.kind, s.start, s.nbr, s.distances(ps), coll, cfg["model.restitution"])
         if not s.list_valid(ps):
             s.neighbours(ps)
-    dist = model.distances(ps, s.start, s.nbr)
+    dist = s.distances(ps)
     n_star = model.number_density(s.start, s.nbr, dist, s.re_n)
     if s.div_mode == 1:
         div = model.divergence_hs(ps, vs, s.start, s.nbr, dist, s.re_g, s.n0_g)
@@ -203,7 +211,7 @@ def step(s, dt, source, cfg, timers=None):
     if c > 0.0:
         if not s.list_valid(pos):
             s.neighbours(pos)
-        d2 = model.distances(pos, s.start, s.nbr)
+        d2 = s.distances(pos)
         pos = pos + model.shift(pos, s.kind, surf, normal, s.start, s.nbr, d2, s.re_n, s.n0_n, c, s.l0)
     bad, graze = model.check(pos_old, pos, vel, s.kind, s.walls, s.escape_box, s.graze_depth)
     s.pos, s.vel, s.p = pos, vel, p
@@ -259,10 +267,14 @@ def _solve(tank, cfg, variant, l0, t_end, probes, start, snapshots, log, threads
         origin = str(start.get("origin", "given state"))
     s = State(tank, cfg, l0, fpos, fvel)
     pos0 = s.pos[: s.nf].copy()
-    dt = time_step(tank, l0, cfg["time.courant"])
-    nsteps = int(np.ceil(t_end / dt - 1e-9))
-    every = max(1, int(round(cfg["time.sample_interval"] / dt)))
-    snap_at = set(np.linspace(0, nsteps, snapshots).round().astype(int)) if snapshots else set()
+    dt0 = time_step(tank, l0, cfg["time.courant"])
+    vcfl = cfg["time.velocity_courant"]
+    nsteps = int(np.ceil(t_end / dt0 - 1e-9))  # steps at the base time step
+    every = max(1, int(round(cfg["time.sample_interval"] / dt0)))
+    sample_dt = every * dt0  # s between samples (every base steps, as many shorter ones as it takes)
+    snap_times = list(np.linspace(0.0, nsteps * dt0, snapshots)[1:]) if snapshots else []
+    tol = 1e-6 * dt0
+    elapsed, next_sample, dt_min, short_steps = 0.0, sample_dt, dt0, 0
     monitor = rest.Monitor(rest_cfg["energy_ratio"], rest_cfg["window"])
     probes = np.asarray(probes, float).reshape(-1, 2)
     rec = {k: [] for k in ("time", "panel", "probe", "rms", "vmax", "energy", "count", "resid", "iters", "surf")}
@@ -273,11 +285,20 @@ def _solve(tank, cfg, variant, l0, t_end, probes, start, snapshots, log, threads
     wall0 = time.perf_counter()
     last_log = wall0
     k = 0
-    for k in range(1, nsteps + 1):
+    while elapsed < nsteps * dt0 - tol:
+        k += 1
+        dt = dt0
+        if vcfl > 0.0:  # Courant condition on the largest liquid speed: u_max dt / l0 <= vcfl
+            umax = float(np.sqrt(np.max((s.vel[: s.nf] ** 2).sum(1), initial=0.0)))
+            if umax * dt0 > vcfl * l0:
+                dt = vcfl * l0 / umax
+                dt_min = min(dt_min, dt)
+                short_steps += 1
         bad, resid, its = step(s, dt, variant, cfg, timers)
         max_resid = max(max_resid, resid)
         iters.append(its)
-        t = t0 + k * dt
+        elapsed += dt
+        t = t0 + elapsed
         if bad[0] == 1:
             status, message = "nonfinite", f"step {step0 + k}: particle {bad[1]} has a non-finite position or velocity"
         elif bad[0] == 2:
@@ -294,7 +315,10 @@ def _solve(tank, cfg, variant, l0, t_end, probes, start, snapshots, log, threads
             status, message = "solver_failed", (f"step {step0 + k}: pressure solve residual {resid:.3g} > {fail_tol:.3g} "
                                                 f"after {its} iterations {s.solve_error}").strip()
         at_rest = False
-        if k % every == 0 or status or k == nsteps:
+        last = elapsed >= nsteps * dt0 - tol
+        if elapsed >= next_sample - tol or status or last:
+            while next_sample <= elapsed + tol:
+                next_sample += sample_dt
             v = s.vel[: s.nf]
             speed2 = (v**2).sum(1)
             e = rest.energy_ratio(0.5 * speed2.sum() * s.weight / units.G, s.weight * s.nf, depth0)
@@ -309,7 +333,8 @@ def _solve(tank, cfg, variant, l0, t_end, probes, start, snapshots, log, threads
             rec["resid"].append(resid)
             rec["iters"].append(its)
             rec["surf"].append(int(s.surf[: s.nf].sum()))
-        if k in snap_at:
+        if snap_times and elapsed >= snap_times[0] - 0.5 * dt0:
+            snap_times.pop(0)
             snaps.append(s.pos[: s.nf].copy())
             snap_t.append(t)
         if status:
@@ -321,14 +346,14 @@ def _solve(tank, cfg, variant, l0, t_end, probes, start, snapshots, log, threads
             break
         now = time.perf_counter()
         if now - last_log > LOG_EVERY:
-            log(f"mps {variant} l0={l0:g} cm: step {k}/{nsteps}, t = {t:.3f} s, rms speed "
+            log(f"mps {variant} l0={l0:g} cm: step {k}, t = {t:.3f} s of {t0 + nsteps * dt0:.3f} s, rms speed "
                 f"{rec['rms'][-1] if rec['rms'] else 0:.3g} cm/s, e = {monitor.last:.3g}")
             last_log = now
     wall = time.perf_counter() - wall0
     rms = float(np.sqrt((s.vel[: s.nf] ** 2).sum(1).mean()))
     if status is None:
         status = "step_limit"
-        message = (f"step {step0 + k}: t = {t0 + k * dt:.3f} s (time limit), rms speed {rms:.3g} cm/s, kinetic energy / "
+        message = (f"step {step0 + k}: t = {t0 + elapsed:.3f} s (time limit), rms speed {rms:.3g} cm/s, kinetic energy / "
                    f"(W h) {monitor.last:.3g} (rest: below {monitor.limit:g} for {monitor.window:g} s)")
     t_rest = monitor.time_to_rest() - t0 if status == "converged" else np.nan
     times = np.array(rec["time"])
@@ -360,7 +385,8 @@ def _solve(tank, cfg, variant, l0, t_end, probes, start, snapshots, log, threads
     rows_note = (f"depth rounded to whole rows: {depth0:.4g} cm (tank {tank.depth:g} cm), weight held at {tank.weight:g} N"
                  if abs(depth0 - tank.depth) > 1e-9 else "none")
     params = {
-        "source_term": variant, "spacing_cm": l0, "dt_s": dt, "rho0_N_s2_cm4": s.rho0, "particle_weight_N": s.weight,
+        "source_term": variant, "spacing_cm": l0, "dt_s": dt0, "velocity_courant": vcfl, "min_dt_s": dt_min,
+        "short_steps": short_steps, "rho0_N_s2_cm4": s.rho0, "particle_weight_N": s.weight,
         "re_density_cm": s.re_n, "re_gradient_cm": s.re_g, "re_laplacian_cm": s.re_l, "re_surface_cm": s.re_s,
         "n0_density": s.n0_n, "n0_laplacian": s.n0_l, "n0_gradient": s.n0_g, "n0_surface": s.n0_s,
         "lambda_cm2": s.lam, "beta": cfg["model.beta"], "relaxation": cfg["model.relaxation"],
@@ -386,5 +412,5 @@ def _solve(tank, cfg, variant, l0, t_end, probes, start, snapshots, log, threads
         method="mps", variant=variant, pos0=pos0, pos=s.pos[: s.nf].copy(), weight=np.full(s.nf, s.weight),
         contact_wall=s.panel_wall, contact_point=s.panel_centre, contact_force=panels[window].mean(0),
         status=status, message=message, steps=step0 + k, start_step=step0, wall_time=wall, force_evals=k,
-        residual=rms, residual_name="rms speed", residual_units="cm s-1", sim_time=t0 + k * dt,
+        residual=rms, residual_name="rms speed", residual_units="cm s-1", sim_time=t0 + elapsed,
         history=hist, fields=fields, params=params)
