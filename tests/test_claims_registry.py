@@ -213,7 +213,7 @@ def existing_runs():
     runs |= {f"solid:{c}_{v}" for c in cases for v in ("paper", "hooke")}
     runs |= {"solid:vessel_pressure_load", "solid:vessel_water_particles", "solid:floor_uniform_uniform_load"}
     runs |= {f"solid:floor_{m}_oneway" for m in methods.tank_methods()}
-    return runs | {"sph1d:sweep"}
+    return runs | {"sph1d:sweep", "sph1d:sweep_n8192"}
 
 
 def test_runs_exist_or_are_flagged_new():

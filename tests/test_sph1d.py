@@ -9,10 +9,11 @@ below), so 1e-10 bounds it for N <= 1000 with a margin of 100.
 import numpy as np
 import pytest
 
-from isaflow.methods.sph1d import closed_form, column, settings, sweep, system
+from isaflow.methods.sph1d import claims as sph1d_claims, closed_form, column, settings, sweep, system
 from isaflow.inputs import InputError as SceneError
 
 KERNELS = ("cubic_spline", "wendland_c2", "wendland_c4", "wendland_c6")
+RULE = sph1d_claims.rule_of_file("config/claims/merino_alonso2020.yaml")  # (settle_band, round_off)
 FLOORS = ("mirror_hydrostatic", "mirror_equal")
 ROUND_OFF = 1e-10
 
@@ -83,14 +84,14 @@ def test_ill_conditioned_case_condition_number_grows_exponentially():
     assert np.all(np.array(regular[1:]) / regular[:-1] < 2.5)
 
 
-@pytest.mark.xfail(strict=True, reason="claim 3 not reproduced with our reading (docs/sph1d.md): "
-                   "Wendland C2 with two neighbours per side gives no divergent ratio")
+@pytest.mark.xfail(strict=True, reason="with our reading (docs/sph1d.md) Wendland C2 with two neighbours per side "
+                   "gives no divergent ratio (registry row mer-abs-c2-divergent-two)")
 def test_wendland_c2_two_neighbours_has_divergent_ratios():
-    s = {"classify": {"window": 4, "settle_factor": 1.25}}
+    band, round_off = RULE
     found = []
     for ratio in np.round(np.arange(1.01, 1.501, 0.01), 2):
         e = [column.solve_column(n, ratio, "wendland_c2").error for n in (256, 512, 1024, 2048)]
-        found.append(sweep.behaviour(e, s["classify"]["settle_factor"]) == "divergent")
+        found.append(sweep.behaviour(e, band, round_off) == "divergent")
     assert any(found)
 
 
@@ -127,10 +128,20 @@ def test_settings_reject_unknown_keys(tmp_path):
 
 
 def test_behaviour_classes():
-    assert sweep.behaviour([0.1, 0.1, 0.1, 0.1], 1.25) == "settled"
-    assert sweep.behaviour([0.4, 0.2, 0.1, 0.05], 1.25) == "decreasing"
-    assert sweep.behaviour([0.1, 0.3, 0.1, 0.5], 1.25) == "divergent"
-    assert sweep.behaviour([1e-14, 3e-13, 1e-15, 2e-14], 1.25) == "settled"
+    """The registry's rule (config/claims/merino_alonso2020.yaml header) on histories of known class."""
+    band, round_off = RULE
+    assert sweep.behaviour([0.1, 0.1, 0.1, 0.1], band, round_off) == "settled"
+    assert sweep.behaviour([0.1, 0.09, 0.08, 0.075], band, round_off) == "settled"
+    assert sweep.behaviour([0.4, 0.2, 0.1, 0.05], band, round_off) == "decreasing"
+    assert sweep.behaviour([0.1, 0.3, 0.1, 0.5], band, round_off) == "divergent"
+    assert sweep.behaviour([0.1, 0.2, np.inf, 0.5], band, round_off) == "divergent"
+    assert sweep.behaviour([0.4, 0.2, 0.15, 0.14], band, round_off) == "undetermined"  # a decrease slowing down
+    assert sweep.behaviour([0.1, 0.3, 0.05, 0.04], band, round_off) == "undetermined"  # a jump, then a net decrease
+    assert sweep.behaviour([1e-14, 3e-13, 1e-15, 2e-14], band, round_off) == "exact"
+    ns = [256, 512, 1024, 2048]
+    assert not sweep.ill_conditioned([256.0, 512.0, 1024.0, 2048.0], ns, band)  # cond ~ N: regular
+    assert sweep.ill_conditioned([1e3, 1e4, 1e5, 1e6], ns, band)  # exponential growth
+    assert not sweep.ill_conditioned([1e3, 1e4, 1e3, 1e3], ns, band)  # one jump, no net growth beyond N
 
 
 def test_condition_estimate_matches_lapack_dgbcon():

@@ -1,14 +1,16 @@
 # The truncated SPH hydrostatic problem in 1D as a linear system (Merino-Alonso et al. 2020, abstract
-# only).  Sweep -> tables -> figures, claims and report fragment 60.  Package: src/isaflow/methods/sph1d/.
+# only).  Sweep -> tables (classified by the claims registry's rule) -> figures and report fragment 60; the
+# claims are judged by the claims rule (claims.smk) from the sweep.  Package: src/isaflow/methods/sph1d/.
 # Every rule calls one package function through scripts/call.py.
 
 SPH1D_SETTINGS = "config/methods/sph1d.yaml"
 SPH1D_CODE = code("methods/sph1d/*", "core/smoothing", "runfile")
+SPH1D_REGISTRY = "config/claims/merino_alonso2020.yaml"  # the classification rule's numbers
 SPH1D_FIGURES = [f for name in ("error_vs_n", "maps", "variants") for f in figure(f"sph1d_{name}")]
 SPH1D_REPORT_FIGURES = [f for name in ("error_vs_n", "maps", "variants")
                         for f in report_figure(f"sph1d_{name}", "sph1d_figure", "Methods compared")]
 
-register(SPH1D_FIGURES + ["results/sph1d/summary.csv"], ["results/report/60_sph1d.md"], ["results/claims/sph1d.csv"],
+register(SPH1D_FIGURES + ["results/sph1d/summary.csv"], ["results/report/60_sph1d.md"], [],
          ["results/timing/60_sph1d.md"])
 
 
@@ -18,8 +20,6 @@ rule sph1d_sweep:
         code=SPH1D_CODE,
     output:
         "results/sph1d/sweep.nc",
-        "results/sph1d/cases.csv",
-        "results/sph1d/summary.csv",
     params:
         func="methods.sph1d.pipeline.run_sweep",
     resources:
@@ -28,6 +28,43 @@ rule sph1d_sweep:
         "../../envs/isaflow.yaml"
     log:
         "logs/sph1d/sweep.log",
+    script:
+        "../../scripts/call.py"
+
+
+rule sph1d_sweep_n8192:
+    input:
+        settings_path=SPH1D_SETTINGS,
+        code=SPH1D_CODE,
+    output:
+        "results/sph1d/sweep_n8192.nc",
+    params:
+        func="methods.sph1d.pipeline.run_sweep",
+        kw={"resolution": "n8192"},
+    resources:
+        runtime=20,
+    conda:
+        "../../envs/isaflow.yaml"
+    log:
+        "logs/sph1d/sweep_n8192.log",
+    script:
+        "../../scripts/call.py"
+
+
+rule sph1d_cases:
+    input:
+        sweep_nc="results/sph1d/sweep.nc",
+        registry=SPH1D_REGISTRY,
+        code=SPH1D_CODE,
+    output:
+        "results/sph1d/cases.csv",
+        "results/sph1d/summary.csv",
+    params:
+        func="methods.sph1d.pipeline.make_cases",
+    conda:
+        "../../envs/isaflow.yaml"
+    log:
+        "logs/sph1d/cases.log",
     script:
         "../../scripts/call.py"
 
@@ -56,10 +93,10 @@ rule sph1d_report:
         sweep_nc="results/sph1d/sweep.nc",
         cases_csv="results/sph1d/cases.csv",
         summary_csv="results/sph1d/summary.csv",
+        registry=SPH1D_REGISTRY,
         figure_files=SPH1D_FIGURES,
         code=SPH1D_CODE,
     output:
-        "results/claims/sph1d.csv",
         "results/report/60_sph1d.md",
         "results/timing/60_sph1d.md",
     params:
@@ -74,3 +111,4 @@ rule sph1d_report:
 
 # the sweep the claims read (claims.smk)
 OTHER_RUN_FILES["sph1d:sweep"] = "results/sph1d/sweep.nc"
+OTHER_RUN_FILES["sph1d:sweep_n8192"] = "results/sph1d/sweep_n8192.nc"  # registry input n_window (sensitivity)

@@ -23,6 +23,5 @@ METHOD = Method(
     values="isaflow.methods.mps.settings:VALUES",
     settings="config/methods/mps.yaml",
     report="results/report/55_mps.md",
-    claims="results/claims/mps.csv",
     timing="results/timing/55_mps.md",
 )

@@ -1,4 +1,6 @@
-"""MPS report fragment (results/report/55_mps.md) and claims rows, generated from results/mps/summary.csv."""
+"""MPS report fragment (results/report/55_mps.md), timing fragment and the single-vessel table, generated from
+results/mps/summary.csv.  The claims on MPS (Hattori et al.; the ISA paper's introduction) are judged by
+isaflow.claims from the registry (config/claims/), measures in methods/mps/claims.py."""
 
 from pathlib import Path
 
@@ -7,19 +9,10 @@ import pandas as pd
 
 from . import settings
 
-CLAIM_COLUMNS = ["paper", "section", "claim", "measured", "verdict", "evidence", "why"]
-
-
 def _fmt(x, f="{:.3g}"):
     if x is None or (isinstance(x, float) and np.isnan(x)):
         return "n/a"
     return str(int(x)) if isinstance(x, (int, np.integer)) else f.format(x)
-
-
-def noise_bound(row):
-    """Relative panel-load noise that counts as 'suppressed': l0 / h, the relative hydrostatic head over one
-    spacing (the resolution error of a panel load), derived from the discretisation, not from the results."""
-    return row.spacing_cm / row.depth if row.depth > 0 else np.nan
 
 
 def dt_rows(df):
@@ -29,48 +22,6 @@ def dt_rows(df):
         return dt
     same = df[(df.case == "single") & (df.source_term == "standard") & np.isclose(df.spacing_cm, dt.spacing_cm.iloc[0])]
     return pd.concat([dt, same]).sort_values("courant")
-
-
-def claims(df):
-    """Claims rows: Hattori's checkable statement and the Papadopoulos introduction's claim on MPS oscillations."""
-    single = df[df.case == "single"].copy()
-    single["bound"] = [noise_bound(r) for r in single.itertuples()]
-    std = single[single.source_term == "standard"]
-    quiet = std[std.panel_noise_rel < std.bound]
-    rest = single[single.status == "converged"]
-    rows = [dict(
-        paper="hattori", section="eqs. (1)-(5)",
-        claim="By adding the equation (3) and the equation (5), we obtain the discrete time Navier-Stokes equation (1) and (2).",
-        measured="one MPS step satisfies (1)-(2) to relative 1e-9 with grad P taken at U* and rho0 for Rho[n+1]; "
-                 "at U[n+1] (as eq. 1 writes it) it does not (strict xfail)",
-        verdict="reproduced",
-        evidence="tests/test_mps.py::test_eqs_3_and_5_add_up_to_the_discrete_navier_stokes_eqs_1_2",
-        why="an algebraic identity of the two half steps"),
-        dict(
-        paper="papadopoulos2016", section="1 (introduction)",
-        claim="in the MPS method (Moving Particles Semi-Implicit) ... some high frequency oscillations are suppressed, "
-              "depending on time step-length, because of the implicit nature of the method, with no additional technique for suppression",
-        measured="single vessel, standard source: panel-load noise std/mean "
-                 + "by Courant number (time step) " + ", ".join(f"{r.courant:g}: {r.panel_noise_rel:.3f}" for r in dt_rows(df).itertuples())
-                 + "; by spacing "
-                 + ", ".join(f"{r.panel_noise_rel:.3f} (bound l0/h {r.bound:.3f}, l0 {r.spacing_cm:.3g} cm)" for r in std.itertuples())
-                 + f"; runs at rest (any source term): {len(rest)} of {len(single)}",
-        verdict="reproduced" if len(std) and len(quiet) == len(std) and len(rest) == len(single) else "not reproduced",
-        evidence="results/mps/summary.csv (panel_noise_rel, status; runs dt_standard_c*), figures/mps_wall_loads.png, figures/mps_rest.png",
-        why="suppressed = wall-load noise below the resolution error l0/h of a panel load and the liquid coming to rest")]
-    hat = single[single.source_term == "hattori"]
-    rows.append(dict(
-        paper="hattori", section="eq. (6)",
-        claim="Considering the temporal compressibility between between sampling times, we obtain the following pressure "
-              "Poisson equation",
-        measured="single vessel, hattori source: panel-load noise std/mean "
-                 + ", ".join(f"{r.panel_noise_rel:.3f} (l0 {r.spacing_cm:.3g} cm, {r.status})" for r in hat.itertuples())
-                 + "; standard (relaxed): " + ", ".join(f"{r.panel_noise_rel:.3f}" for r in std.itertuples()),
-        verdict="not testable here (the paper states no property of eq. (6) beyond its derivation; the runs only show how it behaves)",
-        evidence="results/mps/summary.csv, figures/mps_wall_loads.png",
-        why="eq. (6) is implemented with Rho* = rho0 n*/n0 and the relaxation every source term gets (model.relax_all_sources), "
-            "so at rest it is the standard source"))
-    return pd.DataFrame(rows, columns=CLAIM_COLUMNS)
 
 
 def findings(df):
@@ -216,13 +167,12 @@ SINGLE_COLUMNS = ["run", "source_term", "spacing_cm", "particles", "status", "si
 
 
 def write(summary, cfg, bench, outputs):
-    """outputs = [claims CSV, report fragment, timing fragment, docs/tables/mps_single.csv] from the summary
-    table, the settings file and the step-cost benchmark."""
+    """outputs = [report fragment, timing fragment, docs/tables/mps_single.csv] from the summary table, the
+    settings file and the step-cost benchmark."""
     df = pd.read_csv(summary, keep_default_na=True)
     cfg_ = settings.load(cfg)
     for p in outputs:
         Path(p).parent.mkdir(parents=True, exist_ok=True)
-    claims(df).to_csv(outputs[0], index=False)
-    Path(outputs[1]).write_text(fragment(df, cfg_) + "\n")
-    Path(outputs[2]).write_text(timing(df, cfg_, bench))
-    df[df.case == "single"][SINGLE_COLUMNS].to_csv(outputs[3], index=False, float_format="%.6g")
+    Path(outputs[0]).write_text(fragment(df, cfg_) + "\n")
+    Path(outputs[1]).write_text(timing(df, cfg_, bench))
+    df[df.case == "single"][SINGLE_COLUMNS].to_csv(outputs[2], index=False, float_format="%.6g")

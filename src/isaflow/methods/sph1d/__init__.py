@@ -4,8 +4,9 @@ Merino-Alonso, Macia & Souto-Iglesias (2020), abstract only: a liquid column
 at rest, the SPH momentum balance grad p = -rho g at every particle, the kernel
 truncated at the free surface; A p = b is solved directly (no time stepping).
 Modules: ``system`` (assembly, banded), ``column`` (one solve), ``closed_form``
-(one neighbour per side), ``sweep`` (N x h/dx x kernel), ``figures``,
-``report``.  A 1D static study: it writes its own tables, not the 2D contract.
+(one neighbour per side), ``sweep`` (N x h/dx x kernel, the classification), ``figures``,
+``report``, ``claims`` (the measures of the abstract's claims in
+config/claims/merino_alonso2020.yaml).  A 1D static study: it writes its own tables, not the 2D contract.
 """
 
 from isaflow.methods import Method, Variant
@@ -33,6 +34,5 @@ METHOD = Method(
     settings="config/methods/sph1d.yaml",
     checks="isaflow.methods.sph1d.settings",
     report="results/report/60_sph1d.md",
-    claims="results/claims/sph1d.csv",
     timing="results/timing/60_sph1d.md",
 )

@@ -54,8 +54,9 @@ def error_vs_n(sweep_nc, cases_csv, variant, outputs):
     save(fig, outputs)
 
 
-def maps(sweep_nc, cases_csv, variant, ill_threshold, outputs):
-    """Error at the largest N and cond_1(A)/N against h/dx for every kernel; divergent marked."""
+def maps(sweep_nc, cases_csv, variant, outputs):
+    """Error at the largest N and cond_1(A)/N against h/dx for every kernel; divergent (x) and
+    ill-conditioned (o) cases marked (the case table's classes, sweep.classify)."""
     ds = xr.open_dataset(sweep_nc).load()
     cases = pd.read_csv(cases_csv)
     c = cases[cases.variant == variant]
@@ -70,9 +71,11 @@ def maps(sweep_nc, cases_csv, variant, ill_threshold, outputs):
         d = k[k.behaviour == "divergent"]
         a1.plot(d.ratio, d.error_limit, "x", color=col, ms=5)
         a2.plot(d.ratio, d.cond_over_n, "x", color=col, ms=5)
-    a1.plot([], [], "x", color="k", label="divergent (error grows or jumps, N = 256-2048)")
+        ill = k[k.ill_conditioned.astype(bool)]
+        a2.plot(ill.ratio, ill.cond_over_n, "o", mfc="none", color=col, ms=6)
+    a1.plot([], [], "x", color="k", label="divergent (error jumps up, no net decrease, over the window)")
     a1.plot([], [], color="k", lw=2.5, alpha=0.35, label="closed form |kappa - 1| (one neighbour)")
-    a2.axhline(ill_threshold, color="k", ls=":", lw=1, label=f"ill-conditioned: cond / N > {ill_threshold:g}")
+    a2.plot([], [], "o", mfc="none", color="k", label="ill-conditioned (cond_1 grows faster than N)")
     a1.set_ylabel(f"relative quadratic error at N = {nmax} [1]")
     a2.set_ylabel(f"cond_1(A) / N at N = {nmax} [1]")
     a2.set_xlabel("h / dx [1] (kernel support 2 h; nb = neighbours per side)")

@@ -11,7 +11,7 @@ import xarray as xr
 from isaflow import runfile
 from isaflow.methods import registry
 
-from . import figures, report, settings, sweep
+from . import claims, figures, report, settings, sweep
 
 log = logging.getLogger("isaflow.methods.sph1d")
 
@@ -24,23 +24,32 @@ def _logging():
     return handler
 
 
-def run_sweep(settings_path, outputs):
-    """Solve the sweep; outputs: the netCDF (with provenance), the case table and the summary table."""
-    sweep_nc, cases_csv, summary_csv = outputs
+def run_sweep(settings_path, outputs, resolution=None):
+    """Solve the sweep (the settings file's ``resolutions`` entry ``resolution`` applied if given); outputs:
+    [the netCDF (with provenance)]."""
+    (sweep_nc,) = outputs
     handler = _logging()
     try:
-        s = settings.load(settings_path)
+        s = settings.load(settings_path, resolution)
         started = runfile.now()
         ds = sweep.run_sweep(s)
         ds.attrs.update(started=started, finished=runfile.now(),
                         **runfile.provenance({"method_settings": settings_path}))
         runfile.write(ds, sweep_nc)
-        cases = sweep.classify(ds, s)
-        cases.to_csv(cases_csv, index=False, float_format="%.6g")
-        sweep.summarise(cases).to_csv(summary_csv, index=False, float_format="%.6g")
-        log.info("sph1d: %d cases solved in %.1f s", cases.shape[0], ds.attrs["solve_seconds"])
+        log.info("sph1d: %d cases solved in %.1f s", ds.error.size // ds.sizes["n"], ds.attrs["solve_seconds"])
     finally:
         log.removeHandler(handler)
+
+
+def make_cases(sweep_nc, registry, outputs):
+    """outputs: the case table and the summary table, classified by the rule of the claims registry file
+    ``registry`` (claims.rule_of_file), over the sweep's window."""
+    cases_csv, summary_csv = outputs
+    band, round_off = claims.rule_of_file(registry)
+    with xr.open_dataset(sweep_nc) as ds:
+        cases = sweep.classify(ds.load(), int(ds.attrs["classify_window"]), band, round_off)
+    cases.to_csv(cases_csv, index=False, float_format="%.6g")
+    sweep.summarise(cases).to_csv(summary_csv, index=False, float_format="%.6g")
 
 
 def _labels():
@@ -59,7 +68,7 @@ def make_figures(settings_path, sweep_nc, cases_csv, outputs):
         s = settings.load(settings_path)
         default = list(s["variants"])[0]
         figures.error_vs_n(sweep_nc, cases_csv, default, out["error_vs_n"])
-        figures.maps(sweep_nc, cases_csv, default, s["classify"]["ill_conditioned"], out["maps"])
+        figures.maps(sweep_nc, cases_csv, default, out["maps"])
         labels = {v: lc for v, lc in _labels().items() if v in s["variants"]}
         figures.variants(cases_csv, labels, out["variants"])
         log.info("sph1d figures written")
@@ -67,28 +76,24 @@ def make_figures(settings_path, sweep_nc, cases_csv, outputs):
         log.removeHandler(handler)
 
 
-def make_report(settings_path, sweep_nc, cases_csv, summary_csv, outputs, figure_files=()):
-    """outputs: the claims CSV, the report fragment and the timing fragment, from the tables (figure_files:
-    inputs for ordering only)."""
-    claims_csv, fragment_md, timing_md = outputs
+def make_report(settings_path, sweep_nc, cases_csv, summary_csv, registry, outputs, figure_files=()):
+    """outputs: the report fragment and the timing fragment, from the tables (figure_files: inputs for ordering
+    only).  The claims are judged by isaflow.claims from the registry (config/claims/merino_alonso2020.yaml)."""
+    fragment_md, timing_md = outputs
     handler = _logging()
     try:
         s = settings.load(settings_path)
         cases, summary = pd.read_csv(cases_csv), pd.read_csv(summary_csv)
         variants = list(s["variants"])
-        evidence = ["figures/sph1d_maps.png (top, one-neighbour band)", "figures/sph1d_error_vs_n.png, "
-                    "figures/sph1d_maps.png", "figures/sph1d_maps.png (x marks), figures/sph1d_error_vs_n.png",
-                    "figures/sph1d_maps.png, figures/sph1d_variants.png"]
-        claims = report.claims_table(cases, variants, s["classify"]["small_error"], evidence)
-        Path(claims_csv).parent.mkdir(parents=True, exist_ok=True)
-        claims.to_csv(claims_csv, index=False)
+        band, round_off = claims.rule_of_file(registry)
         with xr.open_dataset(sweep_nc) as ds:
             nmax, secs = int(ds.n[-1]), float(ds.attrs["solve_seconds"])
+            ns = [int(n) for n in ds.n.values[-int(ds.attrs["classify_window"]):]]
         labels = {v: lab for v, (lab, _) in _labels().items()}
-        text = report.fragment(cases, summary, claims, variants, labels, nmax)
+        text = report.fragment(cases, summary, variants, labels, nmax, ns, band, round_off)
         for path, content in ((fragment_md, text), (timing_md, report.timing(cases, nmax, secs))):
             Path(path).parent.mkdir(parents=True, exist_ok=True)
             Path(path).write_text(content)
-        log.info("sph1d claims: %s", ", ".join(claims.verdict))
+        log.info("sph1d report fragment written")
     finally:
         log.removeHandler(handler)

@@ -27,33 +27,37 @@ VALUES = {
     "n": {"type": "array", "minItems": 2, "items": {"type": "integer", "minimum": 8}},
     "gradient": {"enum": list(GRADIENT_FORMS)}, "floor": {"enum": list(FLOORS)},
     "classify.window": {"type": "integer", "minimum": 2},
-    "classify.settle_factor": {"type": "number", "exclusiveMinimum": 1},
-    "classify.ill_conditioned": _POS, "classify.small_error": _POS,
 }
 
 
-def load(path):
-    """{name: value} of a settings file; adds 'ratios' (array of h/dx) and 'path'."""
+def load(path, resolution=None):
+    """{name: value} of a settings file (with its ``resolutions`` entry ``resolution`` applied, e.g. the longer
+    N range of the sweep to N = 8192); adds 'ratios' (array of h/dx), 'path' and 'resolution'."""
     import numpy as np
 
-    s = validate(path)
+    s = validate(path, resolution)
     r = s["ratio"]
     s["ratios"] = np.round(np.arange(r["start"], r["stop"] + 0.5 * r["step"], r["step"]), 10)
     s["n"] = sorted(s["n"])
     s["path"] = str(path)
+    s["resolution"] = resolution or ""
     return s
 
 
-def validate(path):
-    """{name: value} of a settings file, checked (schema, variants, checks.check); pure Python."""
+def validate(path, resolution=None):
+    """{name: value} of a settings file, checked (schema, variants, checks.check); pure Python.  resolution
+    None checks the file's defaults and every entry of its ``resolutions`` (returns the defaults)."""
     path = Path(path)
     spec = S.read(path, VALUES, "1D SPH settings")
     if not spec.get("variants"):
         raise SceneError(f"{path}: field 'variants': at least one reading to solve")
-    s = S.load(path, VALUES, spec=spec).tree()
+    if resolution is None:
+        for name in spec.get("resolutions") or {}:
+            validate(path, name)
+    s = S.load(path, VALUES, resolution=resolution, spec=spec).tree()
     s["variants"] = {}
     for name in spec["variants"]:
-        v = S.load(path, VALUES, variant=name, spec=spec)
+        v = S.load(path, VALUES, variant=name, resolution=resolution, spec=spec)
         s["variants"][name] = {"gradient": v["gradient"], "floor": v["floor"]}
     del s["gradient"], s["floor"]
     r = s["ratio"]

@@ -3,7 +3,9 @@
 run_sweep -> xarray Dataset (dims variant, kernel, ratio, n) of the relative
 quadratic error and the 1-norm condition number of A; classify -> one row per
 (variant, kernel, ratio): the error at the largest N, its behaviour over the
-last ``window`` N and the conditioning there.
+last ``window`` N and the conditioning there, by the rule of the claims registry
+(config/claims/merino_alonso2020.yaml, file header; its numbers are the
+registry's, passed in).
 """
 
 import logging
@@ -21,7 +23,6 @@ from .system import neighbours_per_side
 
 log = logging.getLogger(__name__)
 PROGRESS_S = 20.0  # a progress line at least this often
-EXACT = 1e-9  # errors below this are round-off of an exact solution (cond <= 1e4, eps 2e-16)
 
 
 def run_sweep(s):
@@ -61,43 +62,68 @@ def run_sweep(s):
                 "ratio": ("ratio", ratios, {"units": "1", "long_name": "h / dx (kernel support 2 h)"}),
                 "n": ("n", np.asarray(ns), {"units": "1", "long_name": "particles N (dx = H / N)"})},
         attrs={"height_cm": height, "rho_g_N_cm3": rho_g, "solve_seconds": time.perf_counter() - t0,
-               "method": "sph1d", "settings_file": s["path"]},
+               "method": "sph1d", "settings_file": s["path"], "resolution": s.get("resolution", ""),
+               "classify_window": int(s["classify"]["window"]),
+               "variant_gradient": " ".join(s["variants"][v]["gradient"] for v in variants),
+               "variant_floor": " ".join(s["variants"][v]["floor"] for v in variants)},
     )
 
 
-def behaviour(errors, settle_factor):
-    """'settled' | 'decreasing' | 'divergent' from the errors (window,) at increasing N.
+def behaviour(errors, settle_band, round_off):
+    """Class of an error history (window,) at doubling N (1): the rule of config/claims/merino_alonso2020.yaml
+    (file header), with its numbers settle_band b and round_off (tolerance.parameters of its rows).
 
-    settled: max/min <= settle_factor (or all below EXACT); decreasing: monotone decrease beyond it;
-    divergent: anything else (grows, or jumps from one N to the next).
+    With r = E(2N) / E(N) (first-order convergence r -> 1/2, a non-zero limit r -> 1):
+    'divergent' if some E is not finite; 'exact' if every E < round_off (no ratio is formed);
+    'settled' if every r in [b, 1/b]; 'decreasing' if every r < b; 'divergent' if some r > 1/b with
+    E(N_max) > E(N_min); 'undetermined' otherwise.
     """
     e = np.asarray(errors, float)
     if not np.all(np.isfinite(e)):
         return "divergent"
-    if e.max() < EXACT:
+    if e.max() < round_off:
+        return "exact"
+    r = e[1:] / e[:-1]
+    if np.all((r >= settle_band) & (r <= 1.0 / settle_band)):
         return "settled"
-    if e.max() <= settle_factor * e.min():
-        return "settled"
-    return "decreasing" if np.all(np.diff(e) < 0) else "divergent"
+    if np.all(r < settle_band):
+        return "decreasing"
+    if np.any(r > 1.0 / settle_band) and e[-1] > e[0]:
+        return "divergent"
+    return "undetermined"
 
 
-def classify(ds, s):
-    """DataFrame, one row per (variant, kernel, ratio): neighbours, error_limit (error at the
-    largest N), behaviour, cond_max_n, cond_over_n, ill_conditioned, residue (one neighbour)."""
-    c = s["classify"]
-    window, nmax = c["window"], int(ds.n[-1])
+def ill_conditioned(cond, ns, settle_band):
+    """True if cond_1(A) over the window (window,) at N = ns (doublings) grows faster than N by the margin of
+    the divergence rule (config/claims/merino_alonso2020.yaml, file header): some cond is not finite, or some
+    cond(2N)/cond(N) > 2/b with cond(N_max)/cond(N_min) > N_max/N_min."""
+    c, n = np.asarray(cond, float), np.asarray(ns, float)
+    if not np.all(np.isfinite(c)):
+        return True
+    jump = np.any(c[1:] / c[:-1] > (n[1:] / n[:-1]) / settle_band)
+    return bool(jump and c[-1] / c[0] > n[-1] / n[0])
+
+
+def classify(ds, window, settle_band, round_off):
+    """DataFrame, one row per (variant, kernel, ratio): neighbours, error_limit (error at the largest N),
+    behaviour (over the last ``window`` N), cond_max_n, cond_over_n (cond_1 / N at the largest N),
+    ill_conditioned (over the window), residue (one neighbour).  The rule and its numbers: behaviour,
+    ill_conditioned."""
+    ns = ds.n.values[-window:]
+    nmax = int(ns[-1])
     rows = []
     for var in ds.variant.values:
         for kern in ds.kernel.values:
             e = ds.error.sel(variant=var, kernel=kern).values
             k = ds.cond.sel(variant=var, kernel=kern).values
+            res = ds.residue.sel(kernel=kern).values
             for i, r in enumerate(ds.ratio.values):
                 rows.append(dict(
-                    variant=var, kernel=kern, ratio=float(r), neighbours=int(ds.neighbours[i]),
-                    error_limit=e[i, -1], behaviour=behaviour(e[i, -window:], c["settle_factor"]),
+                    variant=str(var), kernel=str(kern), ratio=float(r), neighbours=int(ds.neighbours[i]),
+                    error_limit=e[i, -1], behaviour=behaviour(e[i, -window:], settle_band, round_off),
                     cond_max_n=k[i, -1], cond_over_n=k[i, -1] / nmax,
-                    ill_conditioned=bool(k[i, -1] / nmax > c["ill_conditioned"]),
-                    residue=float(ds.residue.sel(kernel=kern).values[i])))
+                    ill_conditioned=ill_conditioned(k[i, -window:], ns, settle_band),
+                    residue=float(res[i])))
     return pd.DataFrame(rows)
 
 
@@ -112,6 +138,7 @@ def summarise(cases):
             variant=var, kernel=kern, neighbours=nb, ratios=len(g),
             median_error=ok.error_limit.median(), min_error=ok.error_limit.min(), max_error=ok.error_limit.max(),
             settled=int((g.behaviour == "settled").sum()), decreasing=int((g.behaviour == "decreasing").sum()),
+            exact=int((g.behaviour == "exact").sum()), undetermined=int((g.behaviour == "undetermined").sum()),
             divergent=len(div), divergent_ratios=" ".join(f"{r:.2f}" for r in div.ratio),
             ill_conditioned=int(g.ill_conditioned.sum()),
             ill_conditioned_ratios=" ".join(f"{r:.2f}" for r in g[g.ill_conditioned].ratio),

@@ -1,0 +1,361 @@
+"""Measures of the claims of Merino-Alonso et al. (2020)'s abstract (config/claims/merino_alonso2020.yaml) on
+the 1D sweep: numbers and whether each row's tolerance test passed, every threshold read from the registry
+entry (isaflow.claims turns them into verdicts).
+
+``MEASURES = {claim id: function(ctx, entry) -> isaflow.claims.Measurement}``.  Every measure reads the
+sweep (``ctx.run('sph1d:sweep')``, results/sph1d/sweep.nc: relative quadratic error and cond_1(A) per
+variant, kernel, h/dx and N).  A row is judged on the sweep's first variant (the kept readings of the
+gradient form and the floor); the other variants are reported as its sensitivity.  The behaviour of an
+error history (settled, decreasing, divergent, ...) is sweep.behaviour with the numbers of the entry's
+``tolerance.parameters`` (the rule: the registry file's header).
+
+Units: errors and condition numbers are dimensionless (errors relative to ||p_exact||_2); h/dx [1];
+heights [cm]; rho g [N/cm^3].
+"""
+
+import numpy as np
+import pandas as pd
+from scipy import stats
+
+from ... import claims_registry
+from ...claims import Measurement
+from ...inputs import InputError, load as load_yaml
+from . import closed_form, column, sweep
+
+SWEEP = "sph1d:sweep"
+EXTENDED = "sph1d:sweep_n8192"  # the sweep to N = 8192 (registry input n_window): sensitivity only
+EVIDENCE = "results/sph1d/sweep.nc"
+WENDLAND = ("wendland_c2", "wendland_c4", "wendland_c6")
+SHORT = {"cubic_spline": "cubic", "wendland_c2": "C2", "wendland_c4": "C4", "wendland_c6": "C6"}
+CLASSES = ("settled", "decreasing", "divergent", "undetermined", "exact")
+
+
+def parameters(entry):
+    """The named thresholds of the entry's tolerance ({} if none)."""
+    return dict(entry["tolerance"].get("parameters", {}))
+
+
+def rule(entry):
+    """(settle_band, round_off) of the classification rule, from the entry's tolerance.parameters."""
+    p = parameters(entry)
+    return float(p["settle_band"]), float(p["round_off"])
+
+
+def cases(ds, entry):
+    """sweep.classify of the sweep by the entry's rule, over the sweep's own window (its attribute
+    classify_window, config/methods/sph1d.yaml classify.window)."""
+    band, round_off = rule(entry)
+    return sweep.classify(ds, int(ds.attrs["classify_window"]), band, round_off)
+
+
+def limits(ds):
+    """DataFrame, one row per (variant, kernel, ratio): neighbours, error_limit (error at the largest N) and
+    cond_over_n (cond_1(A) / N there); no classification."""
+    nmax = int(ds.n.values[-1])
+    rows = []
+    for var in ds.variant.values:
+        for kern in ds.kernel.values:
+            e = ds.error.sel(variant=var, kernel=kern).values[:, -1]
+            k = ds.cond.sel(variant=var, kernel=kern).values[:, -1]
+            rows += [dict(variant=str(var), kernel=str(kern), ratio=float(r), neighbours=int(nb), error_limit=e[i],
+                          cond_over_n=k[i] / nmax)
+                     for i, (r, nb) in enumerate(zip(ds.ratio.values, ds.neighbours.values))]
+    return pd.DataFrame(rows)
+
+
+def _variant_forms(ds):
+    """{variant: (gradient form, floor)} of the sweep's variants (its attributes)."""
+    grads = str(ds.attrs["variant_gradient"]).split()
+    floors = str(ds.attrs["variant_floor"]).split()
+    return {str(v): (g, f) for v, g, f in zip(ds.variant.values, grads, floors)}
+
+
+def _judged(ctx, judge, table, entry):
+    """Measurement of judge(rows of one variant, entry) -> (passed, text, margin, why) on the sweep's first
+    variant; the sensitivity: the other variants, and the first variant of the sweep extended to N = 8192
+    (EXTENDED, input n_window) when the workflow made it.  table(ds, entry) -> the rows of every variant."""
+    ds = ctx.run(SWEEP)
+    rows = table(ds, entry)
+    variants = [str(v) for v in ds.variant.values]
+    per = {v: judge(rows[rows.variant == v], entry) for v in variants}
+    ok, text, margin, why = per[variants[0]]
+    notes = []
+    if len(variants) > 1:
+        notes.append("readings of gradient_form and floor_treatment: " + "; ".join(
+            f"{v}: the test {'passes' if per[v][0] else 'fails'} ({per[v][1]})" for v in variants[1:]))
+    if ctx.has(EXTENDED):
+        ext = ctx.run(EXTENDED)
+        v0 = str(ext.variant.values[0])
+        er = table(ext, entry)
+        e_ok, e_text, _, _ = judge(er[er.variant == v0], entry)
+        notes.append(f"n_window ({EXTENDED}, {_window_text(ext)}): {v0}: the test {'passes' if e_ok else 'fails'} "
+                     f"({e_text})")
+    else:
+        notes.append(f"n_window: {EXTENDED} not made")
+    return Measurement(measured=f"{variants[0]}, {_window_text(ds)}: {text}", passed=bool(ok), evidence=EVIDENCE,
+                       why="" if ok else why, margin=margin, sensitivity="; ".join(notes))
+
+
+def _window_text(ds):
+    w = int(ds.attrs["classify_window"])
+    return f"N = {int(ds.n.values[-w])}-{int(ds.n.values[-1])}"
+
+
+# --- the sweep's design and the linear system --------------------------------------------------------------
+
+
+def measure_setup(ctx, entry):
+    ds = ctx.run(SWEEP)
+    n = ds.n.values
+    refined = len(n) >= 2 and bool(np.all(np.diff(n) > 0))
+    doubling = bool(np.all(n[1:] == 2 * n[:-1]))
+    missing = int(np.isnan(ds.error.values).sum())
+    ok = refined and missing == 0 and ds.error.dims == ("variant", "kernel", "ratio", "n")
+    r = ds.ratio.values
+    return Measurement(
+        measured=f"1D column H = {float(ds.attrs['height_cm']):g} cm; N = {', '.join(str(int(x)) for x in n)} "
+                 f"({'doublings' if doubling else 'not doublings'}) at each fixed h/dx of {len(r)} in "
+                 f"[{r.min():.2f}, {r.max():.2f}] x {ds.sizes['kernel']} kernels x {ds.sizes['variant']} variants; "
+                 f"{missing} (case, N) without a solve",
+        passed=ok, evidence=EVIDENCE,
+        why="" if ok else "some case is not solved at every N, or N is not refined",
+        margin="exact rule (no threshold)")
+
+
+def measure_linear(ctx, entry):
+    tol = entry["tolerance"]["value"]
+    ds = ctx.run(SWEEP)
+    v0 = str(ds.variant.values[0])
+    grad, floor = _variant_forms(ds)[v0]
+    n = int(ds.n.values[-1])
+    height, rho_g = float(ds.attrs["height_cm"]), float(ds.attrs["rho_g_N_cm3"])
+    parts, worst = [], 0.0
+    for kern in ds.kernel.values:
+        cond = ds.cond.sel(variant=v0, kernel=kern).values[:, -1]
+        ratio = float(ds.ratio.values[int(np.nanargmin(np.where(np.isfinite(cond), cond, np.nan)))])
+        p1 = column.solve_column(n, ratio, str(kern), grad, floor, height, rho_g).p
+        p2 = column.solve_column(n, ratio, str(kern), grad, floor, height, 2.0 * rho_g).p
+        d = float(np.abs(p2 - 2.0 * p1).max() / np.abs(2.0 * p1).max())
+        worst = max(worst, d)
+        parts.append(f"{SHORT[str(kern)]} h/dx {ratio:.2f}: {d:.3g}")
+    ok = worst <= tol
+    return Measurement(
+        measured=f"{v0}, N = {n}, the best-conditioned h/dx of each kernel: max |p(2 rho g) - 2 p(rho g)| / "
+                 f"max |2 p(rho g)| = " + "; ".join(parts),
+        passed=ok, evidence="isaflow.methods.sph1d.column.solve_column (A p = b, b linear in rho g)",
+        why="" if ok else f"a relative difference {worst:.3g} > {tol:g}",
+        margin=f"largest difference {worst:.3g} against {tol:g}")
+
+
+# --- one neighbour per side ---------------------------------------------------------------------------------
+
+
+def measure_one_nb_explicit(ctx, entry):
+    tol = entry["tolerance"]["value"]
+    ds = ctx.run(SWEEP)
+    one = ds.neighbours.values == 1
+    ratios = ds.ratio.values[one]
+    worst, worst_abs, largest, where, checked = 0.0, 0.0, 0.0, "", []
+    for var, (grad, floor) in _variant_forms(ds).items():
+        if grad != "symmetric" or floor not in ("mirror_hydrostatic", "mirror_equal"):
+            continue  # the closed form is that of the symmetric form with a mirrored floor
+        checked.append(var)
+        for kern in ds.kernel.values:
+            solver_e = ds.error.sel(variant=var, kernel=kern).values[one]
+            for k, n in enumerate(ds.n.values):
+                closed = closed_form.error(int(n), ratios, str(kern), floor)
+                d = np.abs(solver_e[:, k] - closed)
+                worst_abs, largest = max(worst_abs, float(d.max())), max(largest, float(closed.max()))
+                scaled = d / (1.0 + closed)  # the solve's round-off is relative to ||p|| <= (1 + E) ||p_exact||
+                if scaled.max() > worst:
+                    i = int(np.argmax(scaled))
+                    worst, where = float(scaled.max()), f"{var}, {SHORT[str(kern)]}, h/dx {ratios[i]:.2f}, N {int(n)}"
+    ok = bool(checked) and worst <= tol
+    return Measurement(
+        measured=f"closed-form error E = sqrt((kappa - 1)^2 + [6 (kappa - 1)(kappa - beta) + 3 (kappa - beta)^2] / "
+                 f"(4 N^2 - 1)) against the solver over {one.sum()} one-neighbour h/dx x {ds.sizes['kernel']} kernels x "
+                 f"{ds.sizes['n']} N, variants {', '.join(checked) or 'none'}: max |E_solver - E_closed| / (1 + E_closed) "
+                 f"= {worst:.3g}" + (f" ({where})" if where else "") + f"; max |E_solver - E_closed| = {worst_abs:.3g} "
+                 f"(E_closed up to {largest:.3g})",
+        passed=ok, evidence=f"{EVIDENCE}; isaflow.methods.sph1d.closed_form.error; docs/sph1d.md",
+        why="" if ok else ("no variant has the symmetric gradient with a mirrored floor" if not checked
+                           else f"the closed form and the solver differ by {worst:.3g} > {tol:g}"),
+        margin=f"largest scaled difference {worst:.3g} against {tol:g}")
+
+
+def _one_nb(c):
+    return c[c.neighbours == 1]
+
+
+def _judge_no_convergence(c, entry):
+    share_min = entry["tolerance"]["value"]
+    _, round_off = rule(entry)
+    one = _one_nb(c)
+    nonconv = (one.residue > round_off) & (one.behaviour != "decreasing")
+    share = nonconv.groupby(one.kernel, sort=False).mean()
+    count = nonconv.groupby(one.kernel, sort=False).sum()
+    size = one.groupby(one.kernel, sort=False).size()
+    ok = bool((share >= share_min).all())
+    text = "one-neighbour ratios with residue |kappa - 1| > {:g} and error not decreasing: ".format(round_off) + \
+        ", ".join(f"{SHORT[k]} {int(count[k])} of {int(size[k])}" for k in share.index)
+    worst = share.idxmin()
+    return (ok, text, f"smallest share {share.min():.3f} ({SHORT[worst]}) against {share_min:g}",
+            f"{SHORT[worst]}: only {int(count[worst])} of {int(size[worst])} ratios do not converge")
+
+
+def measure_one_nb_no_convergence(ctx, entry):
+    return _judged(ctx, _judge_no_convergence, cases, entry)
+
+
+def measure_one_nb_residue(ctx, entry):
+    large = entry["tolerance"]["value"]
+    most = parameters(entry)["most"]
+    ds = ctx.run(SWEEP)
+    one = ds.neighbours.values == 1
+    parts, flips, ok = [], {}, True
+    for kern in ds.kernel.values:
+        res = np.sort(ds.residue.sel(kernel=kern).values[one])[::-1]
+        share = float(np.mean(res >= large))
+        ok = ok and share > most
+        # largest threshold t at which more than 'most' of the ratios still have residue >= t
+        need = int(np.floor(most * len(res))) + 1
+        flips[str(kern)] = float(res[need - 1])
+        parts.append(f"{SHORT[str(kern)]} median {np.median(res):.3g}, {100 * share:.0f} % >= {large:g}")
+    k_min = min(flips, key=flips.get)
+    return Measurement(
+        measured=f"residue |kappa - 1| (closed form, the solver's limit) over the {one.sum()} one-neighbour h/dx: "
+                 + "; ".join(parts),
+        passed=bool(ok), evidence=f"{EVIDENCE} (residue); figures/sph1d_maps.png",
+        why="" if ok else f"for {SHORT[k_min]} at most half of the ratios have a residue >= {large:g}",
+        margin=f"the test holds for any 'large' threshold up to {flips[k_min]:.3g} ({SHORT[k_min]}; "
+               + ", ".join(f"{SHORT[k]} {v:.3g}" for k, v in flips.items()) + f"), here {large:g}",
+        sensitivity="the residue is the closed form of the symmetric gradient with a mirrored floor (both floors: the "
+                    "same limit); readings of surface_placement and error_norm are not swept")
+
+
+# --- two and three neighbours, conditioning, Wendland C2 ------------------------------------------------------
+
+
+def _judge_cond_association(c, entry):
+    alpha = entry["tolerance"]["value"]
+    two = c[(c.neighbours == 2) & np.isfinite(c.cond_over_n) & np.isfinite(c.error_limit)]
+    rho, p = stats.spearmanr(two.cond_over_n, two.error_limit, alternative="greater")
+    rho, p = float(rho), float(p)
+    ok = rho > 0 and p < alpha
+    med = two.groupby("kernel", sort=False)[["cond_over_n", "error_limit"]].median()
+    text = (f"Spearman rho {rho:.3f}, one-sided p {p:.2g} over {len(two)} two-neighbour (kernel, h/dx) cases; "
+            "median cond_1/N and error by kernel: " + ", ".join(
+                f"{SHORT[k]} {r.cond_over_n:.3g} / {r.error_limit:.3g}" for k, r in med.iterrows()))
+    return ok, text, f"p {p:.2g} against {alpha:g} (rho {rho:.3f} against 0)", \
+        "no significant positive rank association between cond_1/N and the error"
+
+
+def measure_cond_association(ctx, entry):
+    return _judged(ctx, _judge_cond_association, lambda ds, entry: limits(ds), entry)
+
+
+def _judge_two_three_small(c, entry):
+    most = entry["tolerance"]["value"]
+    p = parameters(entry)
+    small, round_off = p["small"], p["round_off"]
+    t = c[c.neighbours.isin([2, 3])]
+    settled = t.behaviour == "settled"
+    inside = (t.error_limit >= round_off) & (t.error_limit < small)
+    good = settled & inside
+    share = float(good.mean())
+    counts = t.behaviour.value_counts()
+    text = (f"{int(good.sum())} of {len(t)} two- and three-neighbour cases ({100 * share:.0f} %) settle to a limit in "
+            f"[{round_off:g}, {small:g}); limit in that range {int(inside.sum())}, settled {int(settled.sum())}; "
+            "behaviour " + ", ".join(f"{k} {int(counts.get(k, 0))}" for k in CLASSES))
+    return (share > most, text, f"share {share:.3f} against {most:g}",
+            f"only {100 * share:.0f} % of the cases settle to a small non-zero limit")
+
+
+def measure_two_three_small(ctx, entry):
+    return _judged(ctx, _judge_two_three_small, cases, entry)
+
+
+def _divergent(c, kernel, neighbours=None):
+    k = c[c.kernel == kernel]
+    if neighbours is not None:
+        k = k[k.neighbours == neighbours]
+    return k, k[k.behaviour == "divergent"]
+
+
+def _elsewhere(c):
+    div = c[c.behaviour == "divergent"]
+    if not len(div):
+        return "no divergent case in the sweep"
+    return "divergent cases: " + "; ".join(
+        f"{SHORT[k]} {nb} nb h/dx {g.ratio.min():.2f}-{g.ratio.max():.2f} ({len(g)})"
+        for (k, nb), g in div.groupby(["kernel", "neighbours"], sort=False))
+
+
+def _judge_c2_divergent_two(c, entry):
+    need = entry["tolerance"]["value"]
+    k, div = _divergent(c, "wendland_c2", 2)
+    counts = k.behaviour.value_counts()
+    text = (f"Wendland C2, two neighbours: {len(div)} divergent of {len(k)} h/dx (behaviour "
+            + ", ".join(f"{b} {int(counts.get(b, 0))}" for b in CLASSES) + f", max cond_1/N {k.cond_over_n.max():.3g}); "
+            + _elsewhere(c))
+    return len(div) >= need, text, f"{len(div)} divergent ratios against {need:g}", \
+        "no two-neighbour ratio of Wendland C2 diverges"
+
+
+def measure_c2_divergent_two(ctx, entry):
+    return _judged(ctx, _judge_c2_divergent_two, cases, entry)
+
+
+def _judge_c2_worst(c, entry):
+    n = {k: len(_divergent(c, k)[1]) for k in WENDLAND}
+    ok = n["wendland_c2"] > n["wendland_c4"] and n["wendland_c2"] > n["wendland_c6"]
+    text = "divergent ratios over the sweep: " + ", ".join(f"{SHORT[k]} {v}" for k, v in n.items())
+    rival = max(n["wendland_c4"], n["wendland_c6"])
+    return ok, text, f"C2 {n['wendland_c2']} against the most of C4 and C6, {rival}", \
+        f"C2 has {n['wendland_c2']} divergent ratios, not more than C4 ({n['wendland_c4']}) and C6 ({n['wendland_c6']})"
+
+
+def measure_c2_worst(ctx, entry):
+    return _judged(ctx, _judge_c2_worst, cases, entry)
+
+
+def _judge_c2_illcond(c, entry):
+    share_min = entry["tolerance"]["value"]
+    k, div = _divergent(c, "wendland_c2")
+    ill = int(div.ill_conditioned.sum())
+    share = ill / len(div) if len(div) else float("nan")
+    ok = len(div) >= 1 and share >= share_min
+    text = (f"Wendland C2: {len(div)} divergent h/dx over the sweep, {ill} of them ill-conditioned; "
+            f"ill-conditioned C2 ratios in all {int(k.ill_conditioned.sum())}")
+    why = "no Wendland C2 ratio diverges" if not len(div) else f"{len(div) - ill} divergent C2 ratios are well conditioned"
+    return ok, text, (f"share {share:.3f} against {share_min:g}" if len(div) else "needs one divergent C2 ratio"), why
+
+
+def measure_c2_illcond(ctx, entry):
+    return _judged(ctx, _judge_c2_illcond, cases, entry)
+
+
+MEASURES = {
+    "mer-abs-setup": measure_setup,
+    "mer-abs-linear": measure_linear,
+    "mer-abs-one-nb-explicit": measure_one_nb_explicit,
+    "mer-abs-one-nb-no-convergence": measure_one_nb_no_convergence,
+    "mer-abs-one-nb-residue": measure_one_nb_residue,
+    "mer-abs-cond-association": measure_cond_association,
+    "mer-abs-two-three-small": measure_two_three_small,
+    "mer-abs-c2-divergent-two": measure_c2_divergent_two,
+    "mer-abs-c2-worst": measure_c2_worst,
+    "mer-abs-c2-illcond": measure_c2_illcond,
+}
+
+
+def rule_of_file(path):
+    """(settle_band, round_off) of the classification rule of a registry file (config/claims/
+    merino_alonso2020.yaml): the same in every row that states it (InputError naming the file otherwise).
+    The method's own tables and figures classify with it (pipeline.make_cases), so they agree with the claims."""
+    _, spec = load_yaml(path, claims_registry.SCHEMA, "claims registry file")
+    found = {rule(c) for c in spec["claims"] if "settle_band" in c.get("tolerance", {}).get("parameters", {})}
+    if len(found) != 1:
+        raise InputError(f"{path}: the rows state {len(found)} different classification rules "
+                         "(tolerance.parameters settle_band, round_off); exactly one is needed")
+    return found.pop()
