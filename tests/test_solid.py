@@ -381,3 +381,48 @@ def test_water_particles_pressure_drops_as_ring_expands_and_step_rule():
     assert (np.diff(ui) > 0).all() and (np.diff(pw) < 0).all()  # the paper's 400 steps: still expanding
     with pytest.raises(ValueError, match="above the step rule"):
         Wt.coupled_history(CFG, 1.01 * st.dt_max, 1, 1)
+
+
+# ---- the runs the claims registry asks for: eq. 27 stepping, sustained tension, other disk radii ----
+
+
+def test_eq27_step_from_the_particle_speed_and_the_move_recorded():
+    """Eq. 27: dt = 0.1 dx / V_max with V_max the particle's speed (3-4-5 velocity: |v| = 5 cm/s), capped by
+    eq. 26 (dx / (4 c)); a force-free particle then moves exactly 0.1 dx, which the state records."""
+    b = lattice.unlinked(1, 1.0)
+    st = solve.State(b, solve.Material(1.0, 0.3, 1.0), "paper", np.ones((1, 3)), push=0)  # c = 1 cm/s
+    st.vel[0] = [3.0, 4.0, 0.0]
+    solve.relax(st, 0.0, 1, min_steps=1)
+    assert st.clock[3] == pytest.approx(0.1 / 5.0, rel=1e-12) and st.clock[6] == pytest.approx(0.1, rel=1e-12)
+    # clock[3] is the largest step so far (the steps grow below): 0.1 dx / 0.5 = 0.2 s < dx / (4 c) = 0.25 s; at
+    # 0.05 cm/s the cap acts
+    st.vel[0] = [0.3, 0.4, 0.0]
+    solve.relax(st, 0.0, 1, min_steps=1)
+    assert st.clock[3] == pytest.approx(0.2, rel=1e-12)
+    st.vel[0] = [0.03, 0.04, 0.0]
+    solve.relax(st, 0.0, 1, min_steps=1)
+    assert st.clock[3] == pytest.approx(0.25, rel=1e-12)
+    st.vel[0] = 0.0  # eq. 27 alone at rest: the speed floor sets the step
+    solve.relax(st, 0.0, 1, min_steps=1, cap=False, vfloor=1e-3)
+    assert st.clock[3] == pytest.approx(100.0, rel=1e-12)
+    with pytest.raises(ValueError, match="speed floor"):
+        solve.relax(st, 0.0, 1, cap=False)
+
+
+def test_long_bar_starts_in_equilibrium_and_stays_affine():
+    """The bar held at 1 % strain, started on its affine positions plus 1e-6 dx: an equilibrium of the printed
+    model (no clumping: the registry's test is 0.1 dx), 2,000 undamped steps here (10^5 in the run)."""
+    cfg = {**CFG, "bar_long": {**CFG["bar_long"], "steps": 2000, "record_every": 500}}
+    r = C.run_bar_long(cfg, "paper", 0.01, 0.25)
+    assert r.status == "step_limit"
+    assert r.history["max_nonaffine_over_dx"][1][0] < 1e-3
+    assert min(r.history["min_link_over_dx_t"][1]) > 0.999
+    assert C.long_bar_case(CFG, "bar_tension_long_e5_dt0.1") == (0.05, 0.1)
+    with pytest.raises(ValueError, match="outside bar_long"):
+        C.long_bar_case(CFG, "bar_tension_long_e2_dt0.1")
+
+
+def test_scale_radii_come_from_the_settings():
+    assert C.scale_radius_mm(CFG, "hertz_R50.8mm") == 50.8 and C.scale_radius_mm(CFG, "hertz_R20m") == 20000.0
+    with pytest.raises(ValueError, match="scale_radii_mm"):
+        C.scale_radius_mm(CFG, "hertz_R3m")

@@ -325,7 +325,8 @@ def tension_hooke(ctx, e):
         why="" if ok else f"peak stress differs from E delta / L by {p[kept]:+.2e}",
         margin=f"|error| {abs(p[kept]):.2e} against {lim:.1e}",
         sensitivity="bar_length: " + "; ".join(f"{k}: {x:+.2%}" for k, x in p.items())
-        + " (the paper's own stress: mar-4.1-stress-vs-hooke); bar_grips: only clamped grips were run")
+        + " (the paper's own stress: mar-4.1-stress-vs-hooke); bar_grips: the printed model has no lateral coupling, so "
+        "sliding grips give the same axial stress (only clamped grips were run)")
 
 
 def width_change_um(ds):
@@ -353,8 +354,9 @@ def necking_value(ctx, e):
         evidence="results/solid/bar_tension_{paper,hooke}.nc width_change_x, width_change_z",
         why="" if abs(err) <= lim else "the printed model has no Poisson coupling (mar-3-no-poisson): no necking",
         margin=f"|error| {abs(err):.1%} against {lim:.0%}; the hooke completion at {abs(dh / paper - 1):.1%}",
-        sensitivity="bar_grips: only clamped grips were run (sliding grips would free the ends' contraction); "
-                    "necking_reading does not enter (the per-side change is compared)")
+        sensitivity="bar_grips: the printed model has no lateral coupling, so no grip makes it neck (only clamped grips "
+                    "were run; for the hooke completion sliding grips free the ends' contraction); necking_reading does "
+                    "not enter (the per-side change is compared)")
 
 
 def poisson_arith(ctx, e):
@@ -406,7 +408,7 @@ def poisson_method(ctx, e):
         margin=f"|error| {abs(err):.1%} against {lim:.0%}",
         sensitivity="necking_reading (paper / hooke): " + "; ".join(
             f"{k}: {out['paper'][k]:.3f} / {out['hooke'][k]:.3f}" for k in out["paper"])
-        + "; bar_grips: only clamped grips were run")
+        + "; bar_grips: no grip makes the printed model neck (only clamped grips were run)")
 
 
 def compression_symmetric(ctx, e):
@@ -910,9 +912,11 @@ def vessel_inputs(ctx, e):
     p = solid(ctx, "vessel_pressure_load")
     dx = float(w.attrs["dx_cm"])
     E, nu, rho = material_units({"E_GPa": num(e, "E_GPa"), "nu": num(e, "nu"), "rho_kg_m3": num(e, "rho_kg_m3")})
+    # the radii as methods.solid.vessel.geometry builds them from the page's counts (the same operations)
+    a_page = num(e, "water_radius_particles") * (num(e, "dx_mm") * MM)
     pairs = {
-        "ring thickness [particles]": ((w.attrs["b_cm"] - w.attrs["a_cm"]) / dx, num(e, "ring_particles")),
-        "water radius [particles]": (w.attrs["a_cm"] / dx, num(e, "water_radius_particles")),
+        "water radius a [cm]": (w.attrs["a_cm"], a_page),
+        "outer radius b [cm]": (w.attrs["b_cm"], a_page + num(e, "ring_particles") * (num(e, "dx_mm") * MM)),
         "dx [cm]": (dx, num(e, "dx_mm") * MM),
         "E [N/cm^2]": (w.attrs["E_N_cm2"], E), "nu": (w.attrs["nu"], nu), "rho [N s^2/cm^4]": (w.attrs["rho_N_s2_cm4"], rho),
         "water rho [N s^2/cm^4]": (attr(w, "rho_water_N_s2_cm4", "vessel_water_particles"), num(e, "rho_water_kg_m3") * 1e-8),
@@ -925,7 +929,8 @@ def vessel_inputs(ctx, e):
     dev = {k: abs(float(a) / float(b) - 1) for k, (a, b) in pairs.items()}
     lim = tol(e)
     ok = all(d <= lim for d in dev.values())
-    return measurement("; ".join(f"{k} {float(a):.6g} (page {float(b):.6g})" for k, (a, b) in pairs.items()), ok,
+    return measurement(f"ring {num(e, 'ring_particles'):g} particles thick, water radius {num(e, 'water_radius_particles'):g} "
+                       "particles: " + "; ".join(f"{k} {float(a):.6g} (page {float(b):.6g})" for k, (a, b) in pairs.items()), ok,
                        evidence="results/solid/vessel_{water_particles,pressure_load}.nc attributes",
                        why="" if ok else "differs: " + ", ".join(k for k, d in dev.items() if d > lim),
                        margin=f"largest relative difference {max(dev.values()):.1e} against {lim:g}",
