@@ -3,6 +3,8 @@
 # scripts/call.py.
 import re
 
+from isaflow.methods.solid import cases as _solid_cases
+
 SOLID_CFG = "config/methods/solid.yaml"
 SOLID_CASES = ["bar_tension", "bar_compression", "shear", "hertz", "hertz_dt15ns", "hertz_dt56ns"]
 SOLID_RUNS = expand("results/solid/{case}_{variant}.nc", case=SOLID_CASES, variant=["paper", "hooke"])
@@ -36,25 +38,12 @@ SOLID_CLAIM_RUN_IDS = ["hertz_R50.8mm_paper", "hertz_R127mm_paper", "hertz_R20m_
                        "vessel_water_particles_paper"]
 
 
-def _solid_claim_ids():
-    """The run ids above from the settings (hertz.scale_radii_mm, bar_long sweep): refuse the rule file if the
-    list and the settings disagree."""
-    from isaflow.methods.solid import settings as _solid_settings
-
-    c = _solid_settings.load(SOLID_CFG)
-    radii = [f"{r:g}mm" if r < 1000 else f"{r / 1000:g}m" for r in c["hertz"]["scale_radii_mm"]]
-    lg = c["bar_long"]
-    sweep = [f"bar_tension_long_e{100 * e:g}_dt{d:g}_paper" for e in lg["strain_sweep"] for d in lg["dt_sweep"]
-             if (e, d) != (lg["strain"], lg["dt_over_dx_c"])]
-    want = ([f"hertz_R{r}_paper" for r in radii] + ["hertz_eq27_paper", "hertz_eq27_hooke", "hertz_eq27_uncapped_paper",
-            "bar_tension_long_paper"] + sweep + ["vessel_water_particles_paper"])
-    if sorted(want) != sorted(SOLID_CLAIM_RUN_IDS):
-        refuse(f"{SOLID_CFG}: the runs of hertz.scale_radii_mm and the bar_long sweep are {sorted(want)}, "
-               f"workflow/rules/methods/solid.smk lists {sorted(SOLID_CLAIM_RUN_IDS)}")
-    return SOLID_CLAIM_RUN_IDS
-
-
-SOLID_CLAIM_RUNS = [f"results/solid/{r}.nc" for r in _solid_claim_ids()]
+# the list above is what the settings give (hertz.scale_radii_mm, the bar_long sweep): refuse the rule file otherwise
+if sorted(_solid_cases.claim_run_ids(SOLID_CFG)) != sorted(SOLID_CLAIM_RUN_IDS):
+    refuse(f"{SOLID_CFG}: the runs of hertz.scale_radii_mm and the bar_long sweep are "
+           f"{sorted(_solid_cases.claim_run_ids(SOLID_CFG))}, workflow/rules/methods/solid.smk lists "
+           f"{sorted(SOLID_CLAIM_RUN_IDS)}")
+SOLID_CLAIM_RUNS = [f"results/solid/{r}.nc" for r in SOLID_CLAIM_RUN_IDS]
 SOLID_CLAIM_CASES = sorted({r.rsplit("_", 1)[0] for r in SOLID_CLAIM_RUN_IDS})
 
 register(SOLID_RUNS + SOLID_NEW_RUNS + SOLID_CLAIM_RUNS + SOLID_FIGURES, ["results/report/65_solid.md"],
