@@ -196,7 +196,7 @@ def test_every_old_row_maps_to_an_entry():
 
 # --- run ids: the workflow's names, or flagged new_run ------------------------------------------------
 def _smk_list(path, name):
-    m = re.search(rf"^{name} = \[(.*?)\]", (ROOT / path).read_text(), re.M)
+    m = re.search(rf"^{name} = \[(.*?)\]", (ROOT / path).read_text(), re.M | re.S)
     return re.findall(r'"([^"]+)"', m.group(1))
 
 
@@ -213,6 +213,7 @@ def existing_runs():
     runs |= {f"solid:{c}_{v}" for c in cases for v in ("paper", "hooke")}
     runs |= {"solid:vessel_pressure_load", "solid:vessel_water_particles", "solid:floor_uniform_uniform_load"}
     runs |= {f"solid:floor_{m}_oneway" for m in methods.tank_methods()}
+    runs |= {f"solid:{r}" for r in _smk_list("workflow/rules/methods/solid.smk", "SOLID_CLAIM_RUN_IDS")}
     return runs | {"sph1d:sweep", "sph1d:sweep_n8192"}
 
 

@@ -1,6 +1,10 @@
 # Hooke's-law solid particles (marko2017 section 4): bar, shear, Hertz runs, figures, claims, report
 # fragment 65.  Package: src/isaflow/methods/solid/.  Every rule calls one package function through
 # scripts/call.py.
+import re
+
+from isaflow.methods.solid import cases as _solid_cases
+
 SOLID_CFG = "config/methods/solid.yaml"
 SOLID_CASES = ["bar_tension", "bar_compression", "shear", "hertz", "hertz_dt15ns", "hertz_dt56ns"]
 SOLID_RUNS = expand("results/solid/{case}_{variant}.nc", case=SOLID_CASES, variant=["paper", "hooke"])
@@ -22,8 +26,32 @@ SOLID_FIGURES += figure("solid_vessel") + figure("solid_floor")
 SOLID_REPORT_FIGURES_44 = [f for name in ("solid_vessel", "solid_floor")
                            for f in report_figure(name, "solid_figure", "Methods compared")]
 
-register(SOLID_RUNS + SOLID_NEW_RUNS + SOLID_FIGURES, ["results/report/65_solid.md"], ["results/claims/solid.csv"],
-         ["results/timing/65_solid.md"])
+# runs the claims registry asks for (config/claims/marko2017.yaml): the 4.3 plate under disks of the other
+# stated radii, stepped by eq. 27 undamped (capped by eq. 26 and not), the 4.1 bar held in sustained tension
+# (the strain x step sweep of input tension_test_setup), the 4.4 vessel with water under the printed solid model
+SOLID_CLAIM_RUN_IDS = ["hertz_R50.8mm_paper", "hertz_R127mm_paper", "hertz_R20m_paper", "hertz_R50m_paper",
+                       "hertz_eq27_paper", "hertz_eq27_hooke", "hertz_eq27_uncapped_paper", "bar_tension_long_paper",
+                       "bar_tension_long_e0.1_dt0.1_paper", "bar_tension_long_e0.1_dt0.25_paper",
+                       "bar_tension_long_e0.1_dt0.5_paper", "bar_tension_long_e1_dt0.1_paper",
+                       "bar_tension_long_e1_dt0.5_paper", "bar_tension_long_e5_dt0.1_paper",
+                       "bar_tension_long_e5_dt0.25_paper", "bar_tension_long_e5_dt0.5_paper",
+                       "vessel_water_particles_paper"]
+
+
+# the list above is what the settings give (hertz.scale_radii_mm, the bar_long sweep): refuse the rule file otherwise
+try:
+    _claim_ids = _solid_cases.claim_run_ids(SOLID_CFG)
+except _inputs.InputError as _err:
+    refuse(_err)
+if sorted(_claim_ids) != sorted(SOLID_CLAIM_RUN_IDS):
+    refuse(f"{SOLID_CFG}: the runs of hertz.scale_radii_mm and the bar_long sweep are "
+           f"{sorted(_claim_ids)}, workflow/rules/methods/solid.smk lists "
+           f"{sorted(SOLID_CLAIM_RUN_IDS)}")
+SOLID_CLAIM_RUNS = [f"results/solid/{r}.nc" for r in SOLID_CLAIM_RUN_IDS]
+SOLID_CLAIM_CASES = sorted({r.rsplit("_", 1)[0] for r in SOLID_CLAIM_RUN_IDS})
+
+register(SOLID_RUNS + SOLID_NEW_RUNS + SOLID_CLAIM_RUNS + SOLID_FIGURES, ["results/report/65_solid.md"],
+         ["results/claims/solid.csv"], ["results/timing/65_solid.md"])
 
 
 rule solid_run:
@@ -33,7 +61,7 @@ rule solid_run:
     output:
         "results/solid/{case}_{variant}.nc",
     wildcard_constraints:
-        case="|".join(SOLID_CASES),
+        case="|".join(re.escape(c) for c in SOLID_CASES + SOLID_CLAIM_CASES),
         variant="paper|hooke",
     params:
         func="methods.solid.outputs.run_case",
@@ -139,15 +167,15 @@ rule solid_figures:
 
 rule solid_claims:
     input:
-        cfg=SOLID_CFG,
-        runs=SOLID_RUNS + SOLID_NEW_RUNS,
-        code=code("methods/solid/claims", "methods/solid/theory", "methods/solid/figures"),
+        runs=SOLID_RUNS + SOLID_NEW_RUNS + SOLID_CLAIM_RUNS,
+        registry=sorted(glob.glob("config/claims/*.yaml")),
+        code=code("methods/solid/report"),
     output:
         "results/claims/solid.csv",
         "results/report/65_solid.md",
         "results/timing/65_solid.md",
     params:
-        func="methods.solid.claims.claims_and_report",
+        func="methods.solid.report.claims_and_report",
     conda:
         "../../envs/isaflow.yaml"
     log:
@@ -157,4 +185,5 @@ rule solid_claims:
 
 
 # the solid runs the claims read (claims.smk): 'solid:<case>_<variant>'
-OTHER_RUN_FILES.update({f"solid:{os.path.splitext(os.path.basename(f))[0]}": f for f in SOLID_RUNS + SOLID_NEW_RUNS})
+OTHER_RUN_FILES.update({f"solid:{os.path.splitext(os.path.basename(f))[0]}": f
+                        for f in SOLID_RUNS + SOLID_NEW_RUNS + SOLID_CLAIM_RUNS})

@@ -3,7 +3,10 @@
 # figures, claims, report fragment 50 and timing fragment.  Package: src/isaflow/methods/sph/.
 _SPH_RUNS = settings_runs("sph")
 declare_runs("sph", _SPH_RUNS)
-SPH_FILES = [run_file("sph", r) for r in _SPH_RUNS]
+# the periodic blocks (tensile-instability test, settings.domain periodic_block) load no wall: claims only
+_SPH_BLOCKS = [r for r, d in _SPH_RUNS.items()
+               if d.get("set", {}).get("settings.domain", {}).get("value") == "periodic_block"]
+SPH_FILES = [run_file("sph", r) for r in _SPH_RUNS if r not in _SPH_BLOCKS]
 SPH_SINGLE = [run_file("sph", r) for r, d in _SPH_RUNS.items() if r.startswith("single_wcsph_") and d["variant"] == "wcsph"]
 SPH_FLOW = [run_file("sph", r) for r, d in _SPH_RUNS.items() if d["tank"] != "single" and d.get("start")]
 SPH_REPORT_FIGURES = [f for name in ("sph_single", "sph_flow", "sph_flow_snapshots")

@@ -115,14 +115,26 @@ def set_depth(st, R, depth):
     st.disk[:] = [0.0, 0.5 * st.block.dx + R - depth, R, 1.0]
 
 
-def run_hertz(cfg, variant):
+def scale_radius_mm(cfg, case):
+    """The disk radius [mm] of a case 'hertz_R<r>mm' or 'hertz_R<r>m', one of hertz.scale_radii_mm
+    (ValueError otherwise: a run names its radius, the settings give its source)."""
+    tag = case[len("hertz_R"):]
+    r = float(tag[:-2]) if tag.endswith("mm") else 1e3 * float(tag[:-1]) if tag.endswith("m") else np.nan
+    radii = cfg["hertz"]["scale_radii_mm"]
+    if not any(np.isclose(r, x, rtol=1e-9) for x in radii):
+        raise ValueError(f"case '{case}': radius {r:g} mm is not one of hertz.scale_radii_mm {radii}")
+    return r
+
+
+def run_hertz(cfg, variant, radius_mm=None, case="hertz"):
     """4.3: the disk pressed in increments; per increment the load and the peak contact pressure.
 
     Load = the plate's force on the disk per unit thickness [N/cm]; peak pressure
-    = largest contact force on one top particle / dx [N/cm^2]."""
+    = largest contact force on one top particle / dx [N/cm^2].  radius_mm: the disk radius
+    (default hertz.radius_mm; the scale cases of section 4.3 keep plate and depths)."""
     c = cfg["hertz"]
     st = hertz_state(cfg, variant)
-    R, dx = c["radius_mm"] * MM, st.block.dx
+    R, dx = (c["radius_mm"] if radius_mm is None else radius_mm) * MM, st.block.dx
     rows = {k: [] for k in ("depth", "load", "pmax", "n_contact", "steps", "status")}
     status, msg, resid = "converged", "", 0.0
     for d in c["depths_um"]:
@@ -145,7 +157,166 @@ def run_hertz(cfg, variant):
     }
     if status == "converged" and len(rows["depth"]) < len(c["depths_um"]):
         status = "step_limit"
-    return S.result(st, "hertz", status, msg, resid, hist, {"radius_cm": R})
+    return S.result(st, case, status, msg, resid, hist, {"radius_cm": R})
+
+
+def run_hertz_eq27(cfg, variant, cap=True):
+    """4.3 stepped as the paper says, undamped (section 3 has no dissipation): every increment runs
+    hertz.dt_check_steps steps with dt from eq. 27 (V_max the largest particle speed at the step's
+    start), capped by eq. 26 (cap) or not (V_max floored at hertz.eq27_vfloor_m_s).  Per increment: the
+    load and peak pressure at its end, the largest move of a particle in one step over dx, the step
+    range; samples of the kinetic energy every hertz.eq27_record_every steps."""
+    c = cfg["hertz"]
+    st = hertz_state(cfg, variant)
+    st.damp = 0
+    R, dx = c["radius_mm"] * MM, st.block.dx
+    vfloor = c["eq27_vfloor_m_s"] * 100.0  # cm/s
+    every, n = c["eq27_record_every"], c["dt_check_steps"]
+    rows = {k: [] for k in ("depth", "load", "pmax", "move", "dt_min", "dt_max", "status")}
+    t, ke = [0.0], [0.0]
+    status, msg, resid, overall = "step_limit", "", 0.0, 0.0
+    for d in c["depths_um"]:
+        set_depth(st, R, d * UM)
+        st.clock[6] = 0.0
+        st.clock[2], st.clock[3] = np.inf, 0.0
+        done, g = 0, np.zeros(2)
+        while done < n:
+            k = min(every, n - done)
+            status, msg, resid, g = S.relax(st, 0.0, k, min_steps=k, chunk=k, log_every=1e9, cap=cap, vfloor=vfloor,
+                                            label=f"hertz eq27 {variant} {d} um")
+            done += k
+            t.append(float(st.clock[1]))
+            ke.append(float(st.clock[0]))
+            if status in ("escaped", "nonfinite"):
+                break
+        overall = max(overall, float(st.clock[6])) if np.isfinite(st.clock[6]) else np.inf
+        for key, val in zip(rows, (d * UM, g[1], st.pres.max() / dx, float(st.clock[6]), float(st.clock[2]),
+                                   float(st.clock[3]), status)):
+            rows[key].append(val)
+        if status in ("escaped", "nonfinite"):
+            break
+    st.clock[6] = overall
+    hist = {
+        "depth": (("record",), rows["depth"], "cm", "disk indentation delta"),
+        "load": (("record",), rows["load"], "N cm-1", "force of the plate on the disk per unit thickness, end of increment"),
+        "pmax": (("record",), rows["pmax"], "N cm-2", "largest contact force on a top particle / dx, end of increment"),
+        "increment_max_move_over_dx": (("record",), rows["move"], "1",
+                                       "largest move of a free particle in one step of the increment / dx"),
+        "increment_dt_min": (("record",), rows["dt_min"], "s", "smallest step of the increment"),
+        "increment_dt_max": (("record",), rows["dt_max"], "s", "largest step of the increment"),
+        "increment_stable": (("record",), [int(s not in ("escaped", "nonfinite")) for s in rows["status"]], "1",
+                             "1 if the increment ended without escape or non-finite value"),
+        "time": (("sample",), t, "s", "simulated time"),
+        "kinetic_energy_t": (("sample",), ke, "N cm", "kinetic energy (per unit thickness)"),
+    }
+    if status == "step_limit":
+        msg = f"undamped, {n} steps per increment (no rest test): {len(rows['depth'])} increments stepped"
+    case = "hertz_eq27" if cap else "hertz_eq27_uncapped"
+    return S.result(st, case, status, msg, resid, hist, {"radius_cm": R, "dt_rule": "eqs. 26-27" if cap else
+                                                         "eq. 27 alone", "vfloor_cm_s": vfloor, "damped": 0})
+
+
+def run_bar_long(cfg, variant, strain, dt_frac, case="bar_tension_long"):
+    """Sustained tension (claims registry input tension_test_setup; not in the paper): the 4.1 bar held
+    at axial strain `strain` between its end layers, started at rest from the uniformly stretched
+    (affine) positions plus a random perturbation of bar_long.perturbation_dx dx on the free dofs
+    (seed bar_long.seed), run undamped for bar_long.steps steps of dt_frac dx / c.  Records every
+    bar_long.record_every steps: the largest distance of a particle from its affine position over dx,
+    the smallest linked distance and the smallest distance of any two particles over dx, the kinetic
+    energy."""
+    c, lg = cfg["bar"], cfg["bar_long"]
+    nx, ny, nz = c["particles"]
+    dx = c["dx_mm"] * MM
+    b = L.block(nx, ny, nz, dx, (-(nx - 1) / 2 * dx, 0.0, -(nz - 1) / 2 * dx))
+    st = S.State(b, _material(cfg), variant, np.ones((b.n, 3)))
+    st.damp = 0
+    j = b.index[:, 1]
+    affine = np.zeros((b.n, 3))
+    affine[:, 1] = strain * b.ref[:, 1]
+    mask = np.zeros((b.n, 3), bool)
+    ends = (j == 0) | (j == ny - 1)
+    if c["grips"] == "clamped":
+        mask[ends] = True
+    else:
+        mask[ends, 1] = True
+        mask[(j == 0) & (b.index[:, 0] == nx // 2) & (b.index[:, 2] == nz // 2)] = True
+    S.prescribe(st, mask, affine)
+    rng = np.random.default_rng(lg["seed"])
+    kick = lg["perturbation_dx"] * dx * rng.uniform(-1.0, 1.0, (b.n, 3)) * st.free
+    st.pos[:] = b.ref + affine + kick
+    dt = dt_frac * dx / st.mat.c
+    x_aff = b.ref + affine
+    iu = np.triu_indices(b.n, 1)
+
+    def measures():
+        dev = np.sqrt(((st.pos - x_aff) ** 2).sum(1)).max() / dx
+        link = np.sqrt(((st.pos[b.lb] - st.pos[b.la]) ** 2).sum(1)).min() / dx
+        d2 = ((st.pos[:, None, :] - st.pos[None, :, :]) ** 2).sum(2)[iu]
+        return dev, link, float(np.sqrt(d2.min())) / dx
+
+    t, rec = [0.0], [measures()]
+    ke = [0.0]
+    status, msg, resid = "step_limit", "", 0.0
+    done, n, every = 0, lg["steps"], lg["record_every"]
+    while done < n:
+        k = min(every, n - done)
+        status, msg, resid, _ = S.relax(st, 0.0, k, dt=dt, min_steps=k, chunk=k, log_every=1e9,
+                                        label=f"bar long {variant}")
+        done += k
+        t.append(float(st.clock[1]))
+        rec.append(measures())
+        ke.append(float(st.clock[0]))
+        if status in ("escaped", "nonfinite"):
+            break
+    if status == "step_limit":
+        msg = f"undamped, {done} steps of {dt:.4g} s (no rest test)"
+    rec = np.array(rec)
+    hist = {
+        "time": (("sample",), t, "s", "simulated time"),
+        "nonaffine_over_dx_t": (("sample",), rec[:, 0], "1", "largest distance of a particle from its affine position / dx"),
+        "min_link_over_dx_t": (("sample",), rec[:, 1], "1", "smallest linked distance / dx"),
+        "min_pair_over_dx_t": (("sample",), rec[:, 2], "1", "smallest distance between any two particles / dx"),
+        "kinetic_energy_t": (("sample",), ke, "N cm", "kinetic energy"),
+        "max_nonaffine_over_dx": (("record",), [float(np.nanmax(rec[:, 0])) if np.isfinite(rec[:, 0]).all()
+                                                else np.inf], "1", "largest of nonaffine_over_dx_t"),
+    }
+    return S.result(st, case, status, msg, resid, hist,
+                    {"strain": strain, "dt_over_dx_c": dt_frac, "dt_s": dt, "perturbation_dx": lg["perturbation_dx"],
+                     "seed": lg["seed"], "grips": c["grips"], "damped": 0})
+
+
+def claim_run_ids(config_path):
+    """The run ids '<case>_<variant>' the claims registry asks for, from the settings file: the Hertz plate under
+    every hertz.scale_radii_mm disk, eqs. 26-27 stepping (paper, hooke) and eq. 27 alone, the bar in sustained
+    tension at every bar_long strain x step (the kept pair named bar_tension_long), the vessel with water under
+    the printed solid model."""
+    from .settings import load
+
+    c = load(config_path)
+    radii = [f"{r:g}mm" if r < 1000 else f"{r / 1000:g}m" for r in c["hertz"]["scale_radii_mm"]]
+    lg = c["bar_long"]
+    sweep = [f"bar_tension_long_e{100 * e:g}_dt{d:g}_paper" for e in lg["strain_sweep"] for d in lg["dt_sweep"]
+             if (e, d) != (lg["strain"], lg["dt_over_dx_c"])]
+    return ([f"hertz_R{r}_paper" for r in radii] + ["hertz_eq27_paper", "hertz_eq27_hooke", "hertz_eq27_uncapped_paper",
+            "bar_tension_long_paper"] + sweep + ["vessel_water_particles_paper"])
+
+
+def long_bar_case(cfg, case):
+    """(strain, dt / (dx / c)) of 'bar_tension_long' (bar_long.strain, bar_long.dt_over_dx_c) or
+    'bar_tension_long_e<strain %>_dt<dt / (dx / c)>' (one of bar_long.strain_sweep x bar_long.dt_sweep)."""
+    lg = cfg["bar_long"]
+    if case == "bar_tension_long":
+        return lg["strain"], lg["dt_over_dx_c"]
+    tag = case[len("bar_tension_long_"):]
+    try:
+        e, d = tag.split("_dt")
+        strain, frac = float(e.removeprefix("e")) / 100.0, float(d)
+    except ValueError:
+        raise ValueError(f"case '{case}': expected bar_tension_long_e<strain %>_dt<dt c / dx>") from None
+    if not any(np.isclose(strain, x) for x in lg["strain_sweep"]) or not any(np.isclose(frac, x) for x in lg["dt_sweep"]):
+        raise ValueError(f"case '{case}': strain {strain:g} or dt {frac:g} dx / c outside bar_long.strain_sweep "
+                         f"{lg['strain_sweep']} x bar_long.dt_sweep {lg['dt_sweep']}")
+    return strain, frac
 
 
 def run_hertz_dt(cfg, variant, dt_ns):
@@ -174,8 +345,24 @@ CASES = {"bar_tension": lambda cfg, v: run_bar(cfg, v, +1), "bar_compression": l
 
 
 def run_case(cfg, case, variant, loads=None):
-    """Dispatch: case is a key of CASES, 'hertz_dt<ns>' (the paper's fixed step), 'vessel' (4.4) or
-    'floor_<source>' (elastic floor; loads: the rigid-floor run file of variant 'oneway')."""
+    """Dispatch: case is a key of CASES, 'hertz_dt<ns>' (the paper's fixed step), 'hertz_eq27' and
+    'hertz_eq27_uncapped' (undamped, eq. 27 with and without eq. 26's cap), 'hertz_R<r>mm' / 'hertz_R<r>m'
+    (other disk radii), 'bar_tension_long[_e<%>_dt<f>]' (sustained tension), 'vessel' (4.4; variant
+    pressure_load or water_particles), 'vessel_water_particles' (4.4 with water, the solid model = the
+    variant) or 'floor_<source>' (elastic floor; loads: the rigid-floor run file of variant 'oneway')."""
+    if case == "vessel_water_particles":
+        from .water import run_water_vessel
+
+        r = run_water_vessel({**cfg, "vessel": {**cfg["vessel"], "solid_model": variant}})
+        r.variant = variant
+        r.params["case"] = case
+        return r
+    if case in ("hertz_eq27", "hertz_eq27_uncapped"):
+        return run_hertz_eq27(cfg, variant, cap=case == "hertz_eq27")
+    if case.startswith("hertz_R"):
+        return run_hertz(cfg, variant, scale_radius_mm(cfg, case), case)
+    if case.startswith("bar_tension_long"):
+        return run_bar_long(cfg, variant, *long_bar_case(cfg, case), case=case)
     if case == "vessel" and variant == "water_particles":
         from .water import run_water_vessel
 

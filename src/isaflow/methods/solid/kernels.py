@@ -23,8 +23,10 @@ E_u = sigma_u / E (paper, eq. 14) or (sigma_u - nu (sigma_v + sigma_w)) / E
 (hooke).  2D is plane strain in 'hooke' (sigma_z = nu (sigma_x + sigma_y)).
 
 Time integration as section 3: accelerations -> velocities -> positions ->
-stresses; dt = min(dx / (4 c), 0.1 dx / V_max) (eqs. 26-27) unless a fixed dt
-is given.  Settling: kinetic damping (all velocities zeroed when the kinetic
+stresses; dt = min(dx / (4 c), 0.1 dx / V_max) (eqs. 26-27; V_max the largest particle
+speed at the start of the step) unless a fixed dt is given; cap = 0 drops eq. 26's cap
+(dt = 0.1 dx / max(V_max, vfloor), the sentence after eq. 27 read alone).  The largest
+move of any free particle in one step, over its size, is kept in state[6].  Settling: kinetic damping (all velocities zeroed when the kinetic
 energy falls; not in the paper, which only says the particles "settle"); damp = 0
 runs undamped (time histories).  fext (N, 3) [N]: prescribed external loads.
 """
@@ -191,14 +193,16 @@ def stresses(vir, size, dim, E, nu, poisson, sig, strain):
 @njit(**JIT)
 def relax(pos, vel, ref, target, free, mass, size, la, lb, d0, laxis, partners, disk,
           E, nu, G, rho, dim, poisson, shear, push, dt_fixed, tol, min_steps, n_steps,
-          sig, strain, frc, pres, state, fext, damp):
+          sig, strain, frc, pres, state, fext, damp, cap, vfloor):
     """Run up to n_steps steps; stop early when converged (residual < tol) or unstable.
 
-    target (N, 3): positions of the prescribed dofs (free == 0).  state (6,)
+    target (N, 3): positions of the prescribed dofs (free == 0).  state (7,)
     float64 carries between chunks: [kinetic energy of the previous step,
-    sim time s, smallest dt, largest dt, pair-list anchor flag, steps].
-    Returns (steps, status, residual = max free |F| / max link |f_n|,
-    disk force x, disk force y).
+    sim time s, smallest dt, largest dt, pair-list anchor flag, steps, largest
+    move of a free particle in one step / its size].  dt_fixed > 0: that step [s];
+    else eqs. 26-27 with cap = 1, eq. 27 alone with cap = 0 (V_max floored at
+    vfloor [cm/s], > 0).  Returns (steps, status, residual = max free |F| / max
+    link |f_n|, disk force x, disk force y).
     """
     n = pos.shape[0]
     smin = size.min()
@@ -248,7 +252,7 @@ def relax(pos, vel, ref, target, free, mass, size, la, lb, d0, laxis, partners, 
         for a in range(n):
             for u in range(3):
                 fres = max(fres, abs(frc[a, u]) * free[a, u])
-                vmax = max(vmax, abs(vel[a, u]))
+            vmax = max(vmax, np.sqrt(vel[a, 0] ** 2 + vel[a, 1] ** 2 + vel[a, 2] ** 2))  # eq. 27's V_max: speed
         resid = fres / fmax if fmax > 0.0 else fres
         if not np.isfinite(resid):
             status = NONFINITE
@@ -257,8 +261,10 @@ def relax(pos, vel, ref, target, free, mass, size, la, lb, d0, laxis, partners, 
             status = CONVERGED
             break
         dt = dt_fixed
-        if dt <= 0.0:
+        if dt <= 0.0 and cap:
             dt = dt_max if vmax == 0.0 else min(dt_max, 0.1 * smin / vmax)  # eqs. 26-27
+        elif dt <= 0.0:
+            dt = 0.1 * smin / max(vmax, vfloor)  # eq. 27 alone
         ke = 0.0
         for a in range(n):
             for u in range(3):
@@ -270,13 +276,18 @@ def relax(pos, vel, ref, target, free, mass, size, la, lb, d0, laxis, partners, 
         state[0] = ke
         bad = False
         for a in range(n):
+            mv = 0.0
             for u in range(3):
                 if free[a, u] > 0.0:
                     pos[a, u] += dt * vel[a, u]
+                    mv += (dt * vel[a, u]) ** 2
                 else:
                     pos[a, u] = target[a, u]
                 if not abs(pos[a, u] - ref[a, u]) < size[a]:  # a particle moved a full width: blow-up
                     bad = True
+            mv = np.sqrt(mv) / size[a]
+            if not mv <= state[6]:  # also a non-finite move
+                state[6] = mv
         state[1] += dt
         state[2] = min(state[2], dt)
         state[3] = max(state[3], dt)

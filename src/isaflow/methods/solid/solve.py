@@ -52,7 +52,7 @@ class State:
     frc: np.ndarray = None  # last force (reactions on prescribed dofs), N
     pres: np.ndarray = None  # (N,) disk contact force, N
     disk: np.ndarray = field(default_factory=lambda: np.zeros(4))  # cx, cy, R cm, on
-    clock: np.ndarray = None  # kernel state: [ke, sim time, dt min, dt max, -, steps]
+    clock: np.ndarray = None  # kernel state: [ke, sim time, dt min, dt max, -, steps, max step move / dx]
     push: int = 0  # unlinked pairs push (2D only)
     damp: int = 1  # kinetic damping on (1) or off (0: undamped time history)
     fext: np.ndarray = None  # (N, 3) external loads, N (per unit thickness in 2D)
@@ -68,7 +68,7 @@ class State:
         self.frc = np.zeros((b.n, 3))
         self.pres = np.zeros(b.n)
         self.fext = np.zeros((b.n, 3)) if self.fext is None else self.fext
-        self.clock = np.array([0.0, 0.0, np.inf, 0.0, 0.0, 0.0])
+        self.clock = np.array([0.0, 0.0, np.inf, 0.0, 0.0, 0.0, 0.0])
         self.mass = np.full(b.n, self.mat.rho * b.dx**b.dim)
         self.size = np.full(b.n, b.dx)
 
@@ -82,12 +82,14 @@ class State:
         return int(self.clock[5])
 
 
-def relax(st, tol, max_steps, dt=0.0, min_steps=10, chunk=20000, log_every=10.0, label=""):
+def relax(st, tol, max_steps, dt=0.0, min_steps=10, chunk=20000, log_every=10.0, label="", cap=True, vfloor=0.0):
     """Step until the residual max|F_free| / max|f_link| < tol, instability, or max_steps.
 
-    dt = 0: the paper's rule (eqs. 26-27); dt > 0: that fixed step [s].
-    Returns (status, message, residual, disk force (2,) N).
+    dt = 0: the paper's rule (eqs. 26-27; cap=False: eq. 27 alone, V_max floored at vfloor [cm/s] > 0);
+    dt > 0: that fixed step [s].  Returns (status, message, residual, disk force (2,) N).
     """
+    if not cap and not vfloor > 0.0 and dt <= 0.0:
+        raise ValueError("relax: eq. 27 without the eq. 26 cap needs a speed floor vfloor > 0 (dt = 0.1 dx / V_max)")
     poisson, shear = VARIANT_FLAGS[st.variant]
     b, m = st.block, st.mat
     done, last = 0, time.perf_counter()
@@ -97,7 +99,7 @@ def relax(st, tol, max_steps, dt=0.0, min_steps=10, chunk=20000, log_every=10.0,
         steps, code, resid, gx, gy = K.relax(
             st.pos, st.vel, b.ref, st.target, st.free, st.mass, st.size, b.la, b.lb, b.d0, b.axis, b.partners,
             st.disk, m.E, m.nu, m.G, m.rho, b.dim, poisson, shear, st.push, float(dt), float(tol), min_steps, n,
-            st.sig, st.strain, st.frc, st.pres, st.clock, st.fext, st.damp)
+            st.sig, st.strain, st.frc, st.pres, st.clock, st.fext, st.damp, int(bool(cap)), float(vfloor))
         done += steps
         min_steps = max(0, min_steps - steps)
         now = time.perf_counter()
@@ -153,4 +155,5 @@ def result(st, case, status, msg, resid, history, params, start=None):
         history=history, fields=fields,
         params={"case": case, "dim": b.dim, "dx_cm": b.dx, "E_N_cm2": st.mat.E, "nu": st.mat.nu,
                 "rho_N_s2_cm4": st.mat.rho, "dt_min_s": float(st.clock[2]), "dt_max_s": float(st.clock[3]),
+                "max_step_move_over_dx": float(st.clock[6]),
                 "dt_rule_s": st.dt_max, **params})

@@ -86,9 +86,11 @@ def settle(cfg):
     return st, inner, status, msg, resid
 
 
-def history(cfg, dt):
+def history(cfg, dt, snapshot=None):
     """Undamped response to the pressure applied at t = 0 from rest, at the fixed step dt [s]:
-    (t (M,) s, mean inner radial displacement (M,) cm, outer (M,) cm, final state)."""
+    (t (M,) s, mean inner radial displacement (M,) cm, outer (M,) cm, final state).  snapshot (dict,
+    optional) receives 'u_paper': the radial displacement [cm] of every ring particle at the first record
+    at or after the paper's vessel.steps, and 'u_min': the smallest radial displacement at every record."""
     v = cfg["vessel"]
     st, inner = pressure_state(cfg, damp=0)
     r = np.hypot(st.block.ref[:, 0], st.block.ref[:, 1])
@@ -98,11 +100,19 @@ def history(cfg, dt):
     every = v["record_every"]
     n_rec = int(np.ceil(v["history_us"] * US / dt / every))
     t, ui, uo = [0.0], [0.0], [0.0]
+    ring_all = np.ones(st.block.n, bool)
+    u_min, u_paper = [0.0], None
     for _ in range(n_rec):
         S.relax(st, 0.0, every, dt=dt, min_steps=every, chunk=every, log_every=1e9)
         t.append(st.clock[1])
-        ui.append(radial(st, inner).mean())
-        uo.append(radial(st, outer).mean())
+        ur = radial(st, ring_all)
+        ui.append(ur[inner].mean())
+        uo.append(ur[outer].mean())
+        u_min.append(ur.min())
+        if u_paper is None and st.steps >= v["steps"]:
+            u_paper = ur
+    if snapshot is not None:
+        snapshot.update(u_paper=u_paper if u_paper is not None else np.full(st.block.n, np.nan), u_min=np.array(u_min))
     return np.array(t), np.array(ui), np.array(uo), st
 
 
@@ -119,7 +129,8 @@ def run_vessel(cfg, variant):
     r_in = np.hypot(*st.block.ref[inner, :2].T)
     u_th = lame(cfg, r_in)
     dt = v["dt_ns"] * NS
-    t, ui, uo, hst = history(cfg, dt)
+    snap = {}
+    t, ui, uo, hst = history(cfg, dt, snap)
     t_paper = v["steps"] * dt
     u_paper = float(np.interp(t_paper, t, ui))
     # first time the undamped inner wall reaches its settled value (quarter of the breathing swing)
@@ -154,9 +165,17 @@ def run_vessel(cfg, variant):
         "t_sound_steel": (("record",), [(b - a) / st.mat.c], "s", "steel wave crossing of the wall (b - a) / c"),
         "history_dt": (("record",), [dt], "s", "fixed step of the undamped run"),
         "history_wall_time": (("record",), [hst.wall_time], "s", "solver time of the undamped run"),
+        "history_max_step_move_over_dx": (("record",), [float(hst.clock[6])], "1",
+                                          "largest move of a particle in one step of the undamped run / dx"),
+        "u_radial_paper_end": (("particle",), snap["u_paper"], "cm",
+                               "radial displacement of every ring particle at the paper's 400 steps, undamped"),
+        "u_radial_settled": (("particle",), radial(st, np.ones(st.block.n, bool)), "cm",
+                             "settled radial displacement of every ring particle"),
+        "u_radial_min_t": (("sample",), snap["u_min"], "cm", "smallest radial displacement of a ring particle, undamped"),
     }
     r = S.result(st, "vessel", status, msg, resid, hist,
                 {"a_cm": a, "b_cm": b, "pressure_N_cm2": v["pressure_Pa"] * 1e-4, "solid_model": v["solid_model"],
-                 "ring_lattice": "square lattice, centre radius in [a, b)", "n_inner": int(inner.sum())})
+                 "ring_lattice": "square lattice, centre radius in [a, b)", "n_inner": int(inner.sum()),
+                 "dt_s": dt, "paper_steps": v["steps"], "coupling": "pressure_load"})
     r.variant = variant
     return r

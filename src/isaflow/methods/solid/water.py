@@ -93,9 +93,12 @@ def water_sites(na, dx):
     return dx * np.column_stack([i[inside], j[inside]]).astype(float)
 
 
-def coupled_history(cfg, dt, steps, every):
+def coupled_history(cfg, dt, steps, every, outcome=None):
     """Undamped ring + SPH water from rest at p0, fixed step dt [s]: (t (M,) s, mean inner radial
-    displacement (M,) cm, mean water pressure (M,) N/cm^2, ring state, inner mask, water density)."""
+    displacement (M,) cm, mean water pressure (M,) N/cm^2, ring state, inner mask, water density).
+    Stops early when a ring particle escapes (moves a full width) or a value turns non-finite; outcome
+    (dict, optional) receives 'status', 'message', 'steps' and 'water_max_move_over_dx' (the largest move
+    of a water particle in one step / dx)."""
     from . import solve as S
     from .vessel import geometry, pressure_state, radial
 
@@ -117,21 +120,38 @@ def coupled_history(cfg, dt, steps, every):
     vw, rho = np.zeros_like(xw), np.full(nw, rho0)
     fw, fs, drho = np.zeros((nw, 2)), np.zeros((st.block.n, 2)), np.zeros(nw)
     t, ui, pw = [0.0], [0.0], [p0]
+    ring_all = np.ones(st.block.n, bool)
+    ur = [np.zeros(st.block.n)]  # radial displacement of every ring particle at every record
+    ur_paper = np.full(st.block.n, np.nan)
     t0 = time.perf_counter()
+    status, message, wmove, done = "step_limit", f"{steps} steps of {dt:.4g} s", 0.0, 0
     for step in range(1, steps + 1):
         pos = np.vstack([xw, st.pos[:, :2]])
         vel = np.vstack([vw, st.vel[:, :2]])
         water_forces(pos, vel, rho, nw, m, h, kind, norm, K, rho0, p0, v["water_alpha"], c0, fw, fs, drho)
         st.fext[:, :2] = fs
-        S.relax(st, 0.0, 1, dt=dt, min_steps=1, chunk=1, log_every=1e9)
+        ring, msg, _, _ = S.relax(st, 0.0, 1, dt=dt, min_steps=1, chunk=1, log_every=1e9)
         vw += dt * fw / m
         xw += dt * vw
         rho += dt * drho
+        move = float(np.sqrt((vw**2).sum(1)).max()) * dt / dx
+        wmove = move if not move <= wmove else wmove
+        done = step
+        if ring in ("escaped", "nonfinite") or not np.isfinite(move) or not np.isfinite(rho).all():
+            status = ring if ring in ("escaped", "nonfinite") else "nonfinite"
+            message = msg if ring in ("escaped", "nonfinite") else f"water: non-finite value at step {step}"
+            break
+        if step == v["steps"]:
+            ur_paper = radial(st, ring_all)
         if step % every == 0:
             t.append(step * dt)
-            ui.append(radial(st, inner).mean())
+            ur.append(radial(st, ring_all))
+            ui.append(ur[-1][inner].mean())
             pw.append(float(np.mean(p0 + c0 * c0 * (rho - rho0))))  # water_pressure, vectorised
     st.wall_time = time.perf_counter() - t0  # the coupled loop: water and ring
+    if outcome is not None:
+        outcome.update(status=status, message=message, steps=done, water_max_move_over_dx=wmove, ur=np.array(ur),
+                       ur_paper=ur_paper)
     return np.array(t), np.array(ui), np.array(pw), st, inner, rho
 
 
@@ -145,13 +165,15 @@ def run_water_vessel(cfg):
     dx, a, b = geometry(v)
     dt = v["dt_ns"] * NS
     steps = int(np.ceil(v["history_us"] * US / dt))
-    t, ui, pw, st, inner, rho = coupled_history(cfg, dt, steps, v["record_every"])
+    out = {}
+    t, ui, pw, st, inner, rho = coupled_history(cfg, dt, steps, v["record_every"], out)
     p0, K = v["pressure_Pa"] * 1e-4, v["K_GPa"] * 1e5
     # whole cycles: between the first and the last upward crossing of the history's mean
     dev = ui - ui.mean()
     up = np.flatnonzero((dev[:-1] < 0) & (dev[1:] >= 0)) + 1
     lo, hi = (up[0], up[-1]) if len(up) > 1 else (0, len(t) - 1)
     u_mean, p_mean = float(ui[lo:hi].mean()), float(pw[lo:hi].mean())
+    ur_mean = out["ur"][lo:hi].mean(0) if hi > lo else np.full(st.block.n, np.nan)
     r_in = np.hypot(*st.block.ref[inner, :2].T)
     u_l = float(lame(cfg, r_in).mean())
     p_eq = p0 / (1.0 + 2.0 * K * u_l / (a * p0))
@@ -168,17 +190,30 @@ def run_water_vessel(cfg):
         "u_paper_end": ([float(np.interp(t_paper, t, ui))], "cm", "mean inner displacement at the paper's 400 steps"),
         "t_paper": ([t_paper], "s", "the paper's simulated time, steps x dt"),
         "n_water": ([len(rho)], "1", "water particles"),
+        "water_max_step_move_over_dx": ([out["water_max_move_over_dx"]], "1",
+                                        "largest move of a water particle in one step / dx"),
     }
     hist = {k: (("record",), val, u, ln) for k, (val, u, ln) in rec.items()}
     hist.update({
+        "u_radial_paper_end": (("particle",), out["ur_paper"], "cm",
+                               "radial displacement of every ring particle at the paper's 400 steps (NaN: not reached)"),
+        "u_radial_mean_cycles": (("particle",), ur_mean, "cm",
+                                 "radial displacement of every ring particle averaged over whole breathing cycles"),
+        "u_radial_min_t": (("sample",), out["ur"].min(1), "cm", "smallest radial displacement of a ring particle"),
         "time": (("sample",), t, "s", "time since the start from rest at p0 (undamped, alpha viscosity)"),
         "u_inner_t": (("sample",), ui, "cm", "mean radial displacement of the inner (wetted) particles"),
         "p_water_t": (("sample",), pw, "N cm-2", "mean water pressure"),
     })
-    r = _result(st, "vessel", "step_limit", f"undamped coupled run, {steps} steps of {dt:.4g} s (no rest test)",
-                float("nan"), hist,
+    msg = (f"undamped coupled run, {steps} steps of {dt:.4g} s (no rest test)" if out["status"] == "step_limit" else
+           f"undamped coupled run stopped after {out['steps']} of {steps} steps: {out['message']}")
+    r = _result(st, "vessel", out["status"], msg, float("nan"), hist,
                 {"a_cm": a, "b_cm": b, "pressure_N_cm2": p0, "solid_model": v["solid_model"],
                  "water_kernel": v["water_kernel"], "water_h_cm": v["water_h_over_dx"] * dx,
-                 "water_alpha": v["water_alpha"], "ring_lattice": "square lattice, centre radius in [a, b)"})
+                 "water_alpha": v["water_alpha"], "ring_lattice": "square lattice, centre radius in [a, b)",
+                 "K_N_cm2": K, "rho_water_N_s2_cm4": v["rho_water_kg_m3"] * 1e-8, "dt_s": dt, "paper_steps": v["steps"],
+                 "history_steps": steps, "coupling": "mirror_pressure",
+                 "coupling_description": "ring particles within 2h stand for water of the water particle's mass, "
+                                         "pressure and density; the ring takes the opposite force (no stop-at-"
+                                         "the-boundary force)"})
     r.variant = "water_particles"
     return r

@@ -7,6 +7,7 @@ Units: cm, N, s.
 
 from ... import runfile
 from ...inputs import InputError
+from . import block
 from . import settings as S
 from . import solver
 
@@ -17,8 +18,11 @@ START_VARS = ("pos", "velocity", "density", "weight")
 
 
 def check(tank, settings, variant, resolution, start=None):
-    """Every check that can refuse the run: one resolution, and a start file that is an SPH run with its state."""
+    """Every check that can refuse the run: one resolution, and a start file that is an SPH run with its state
+    (a periodic block starts from its lattice, never from a file)."""
     S.resolution(settings)
+    if start is not None and settings["settings.domain"] == "periodic_block":
+        raise InputError("--start: a periodic block (settings.domain) starts from its stretched lattice, not a run file")
     if start is not None:
         with runfile.open_run(start) as ds:
             if ds.attrs.get("method") != "sph":
@@ -31,8 +35,9 @@ def check(tank, settings, variant, resolution, start=None):
 
 
 def warm_up(threads=None):
-    """Compile (or load from numba's cache) the kernels a run times."""
+    """Compile (or load from numba's cache) the kernels a run times (the tank loop and the periodic block's)."""
     solver.warm_up(threads or 1)
+    block.warm_up()
 
 
 def solve(tank, settings, variant, resolution, start=None, progress=None, threads=None):
@@ -40,6 +45,10 @@ def solve(tank, settings, variant, resolution, start=None, progress=None, thread
     s = S.physics(settings)
     start_ds = runfile.read(start) if start is not None else None
     log = progress.log if progress is not None else (lambda msg: None)
+    if s["domain"] == "periodic_block":
+        res = block.run(tank, s, S.resolution(settings), log)
+        res.variant = variant
+        return res
     res = solver._run(tank, s, S.resolution(settings), start_ds, bool(settings["resolution.on_wall"]), None, log,
                       solver.set_threads(threads or 1))
     res.variant = variant

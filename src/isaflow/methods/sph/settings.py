@@ -35,6 +35,11 @@ SETTINGS = {
     "chunk_time": _POS,          # s
     "panel_length": _POS,        # cm
     "snapshot_times": {"type": "array", "items": _NONNEG},
+    "domain": {"enum": ["tank", "periodic_block"]},  # the tank's walls, or its liquid lattice made periodic (block)
+    "stretch": {"type": "number", "exclusiveMinimum": -0.5, "maximum": 1.0},  # block: uniform linear strain
+    "perturbation": _NONNEG,     # block: random initial displacement / spacing
+    "seed": {"type": "integer", "minimum": 0},  # block: seed of the perturbation
+    "t_max_block": _POS,         # s
 }
 VALUES = {**{f"settings.{k}": v for k, v in SETTINGS.items()},
           "resolution.particles": {"type": ["integer", "null"], "minimum": 4},
