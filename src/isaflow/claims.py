@@ -151,7 +151,7 @@ def judge(ctx, claims=None, inputs=None, found=None):
             except Missing as err:
                 m = Measurement(f"needs {err.args[0]}, which this workflow did not make", None)
         rows.append(dict(id=e["id"], paper=e["paper"], section=e["section"], kind=e["kind"], half=e.get("half", ""),
-                         claim=e["quote"], measured=m.measured, tolerance=tolerance_text(e),
+                         claim=e.get("quote", e.get("quantity", "")), measured=m.measured, tolerance=tolerance_text(e),
                          verdict=verdict(e, m, inputs), evidence=m.evidence, why=m.why, margin=m.margin,
                          sensitivity=m.sensitivity))
     return pd.DataFrame(rows, columns=COLUMNS)

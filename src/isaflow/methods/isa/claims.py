@@ -221,10 +221,11 @@ SWEEPS = {
     ],
     "rhomb_alternative": [
         ("square lattice of the rhomb side (kept)", {}, _never, {}),
-        ("random close packing", {}, lambda k: "square" in k, {}),
+        ("disordered packing (the square lattice jittered by +-0.1 spacing, seed 0)",
+         _subs({"single_coarse_square_capped": "single_coarse_square_jitter_capped"}), _never, {}),
     ],
 }
-PARTIAL = {"pap-abs-converges", "pap-7-isa-oscillations", "pap-5-rigid"}  # aggregates: a sweep judges what it has
+PARTIAL = {"pap-abs-converges", "pap-7-isa-oscillations", "pap-5-rigid", "pap-5-incompressible"}  # aggregates: a sweep judges what it has
 
 
 def sensitivity(ctx, entry, core, kept):
@@ -603,15 +604,23 @@ def incompressible(view, e):
         loss = 1 - (level(view, ds) - fl) / (init - fl)
         worst = max(worst, loss)
         rows.append(f"{k}: {loss:.1%} ({level(view, ds):.2f} cm from {init:.2f} cm)")
-    fc, sc = view.run("flow_complete"), view.run("single_coarse")
-    v2, v1 = M.vessel_view(fc, second(fc)), M.vessel_view(sc)
-    per2 = v2["width"] * (level(view, fc, second(fc)) - v2["floor_y"]) / int(v2["inside"].sum())
-    per0 = v1["width"] * (_initial_level(view, sc) - v1["floor_y"]) / sc.sizes["particle"]
-    loss = 1 - per2 / per0
-    worst = max(worst, loss)
-    rows.append(f"flow_complete, second vessel: {loss:.1%} (area per particle {per2:.1f} against {per0:.1f} cm^2)")
+    left = []
+    try:
+        fc, sc = view.run("flow_complete"), view.run("single_coarse")
+    except NoRun as err:
+        if not view.partial:
+            raise
+        left.append(err.args[0].removeprefix(ISA))
+    else:
+        v2, v1 = M.vessel_view(fc, second(fc)), M.vessel_view(sc)
+        per2 = v2["width"] * (level(view, fc, second(fc)) - v2["floor_y"]) / int(v2["inside"].sum())
+        per0 = v1["width"] * (_initial_level(view, sc) - v1["floor_y"]) / sc.sizes["particle"]
+        loss = 1 - per2 / per0
+        worst = max(worst, loss)
+        rows.append(f"flow_complete, second vessel: {loss:.1%} (area per particle {per2:.1f} against {per0:.1f} cm^2)")
     return Out(worst <= bound, "area per particle lost against the initial lattice (same level definition): "
                                + "; ".join(rows) + f" (bound {bound:.2%})", short=f"worst {worst:.1%}",
+               partial=("not swept: " + ", ".join(left)) if left else "",
                margin=f"flips if the largest loss falls to {bound:.2%}",
                why="the lattice compacts by a fifth of its area under its own weight: the activated diagonals are "
                    "linear springs, not rigid bars")
@@ -667,9 +676,9 @@ def gap(view, e):
     for k in ("single_coarse", "single_refined"):
         r = IM.wall_law_usage(view.run(k))["wall_gap_reduction"]
         worst = max(worst, r)
-        rows.append(f"{k}: {r:.1%}")
+        rows.append(f"{k}: {r:.4%}")
     return Out(worst <= tol(e), "largest reduction of a particle's wall distance below l_bu: " + "; ".join(rows),
-               short=f"worst {worst:.1%}", margin=f"flips above {tol(e):.0%}",
+               short=f"worst {worst:.4%}", margin=f"flips above {tol(e):.0%}",
                why="with a convex law the reaction that carries the load needs a deeper approach to the wall")
 
 
@@ -698,10 +707,10 @@ def du_rule(view, e):
         x = r["max_pair_increment_N"] / w
         worst = max(worst, x)
         ok &= x <= tol(e) + 1e-9
-        rows.append(f"{k}: largest pair-reaction change in one step {r['max_pair_increment_N']:.3g} N = {x:.3f} w "
+        rows.append(f"{k}: largest pair-reaction change in one step {r['max_pair_increment_N']:.6g} N = {x:.6f} w "
                     f"(step {r['at_step']:,} of {r['steps']:,}; 2 k_p du = "
                     f"{2 * float(ds.attrs['pair_r_u']) / float(ds.attrs['pair_l_u']) * float(ds.attrs['du']):.3g} N)")
-    return Out(ok, "; ".join(rows), short=f"worst {worst:.3f} w", margin=f"flips above {tol(e):g} w",
+    return Out(ok, "; ".join(rows), short=f"worst {worst:.6f} w", margin=f"flips above {tol(e):g} w (+1e-9)",
                why="a pair closes by up to 2 sqrt(2) du per step (both particles move du in each component), not 2 du: "
                    "the du rule 2 k_p du = w/5 bounds only the closing along one axis")
 
@@ -854,6 +863,26 @@ def same_way(view, e):
     return Out(not off, "; ".join(f"{k}: {x:.4g} against {y:.4g} ({x / y - 1:+.1%})" for k, (x, y) in checks.items()),
                short="off: " + ", ".join(off) if off else "all within",
                margin=f"each within {t:.0%} of its rule", why="not followed: " + ", ".join(off))
+
+
+@measure("figures/fig06_single_coarse.png, figures/fig08_single_refined.png")
+def improved(view, e):
+    c, r = wall_errors(view, view.run("single_coarse")), wall_errors(view, view.run("single_refined"))
+    side_c, side_r = max(abs(x) for x in c[1].values()), max(abs(x) for x in r[1].values())
+    rms_c, rms_r = c[2]["contact_rms"], r[2]["contact_rms"]
+    ok = side_r < side_c and rms_r < rms_c
+    rep = []
+    cc, rc = view.opt("single_coarse_capped"), view.opt("single_refined_capped")
+    if cc is not None and rc is not None:
+        a, b = wall_errors(view, cc), wall_errors(view, rc)
+        rep.append(f"capped (variant, not judged): side {max(abs(x) for x in a[1].values()):.1%} -> "
+                   f"{max(abs(x) for x in b[1].values()):.1%}, RMS {a[2]['contact_rms']:.3f} -> {b[2]['contact_rms']:.3f}")
+    return Out(ok, f"largest side-wall error {side_c:.1%} (coarse) -> {side_r:.1%} (refined); per-contact RMS "
+                   f"{rms_c:.3f} -> {rms_r:.3f} gamma h a ({view.level})" + ("; " + "; ".join(rep) if rep else ""),
+               short=f"side {side_c:.1%} -> {side_r:.1%}, RMS {rms_c:.3f} -> {rms_r:.3f}",
+               margin="both measures must fall from coarse to refined",
+               why="the refined lattice's side-wall deficit is larger: the wall law near the walls (l_bu = 5 cm, twice "
+                   "the refined row pitch) and the lattice's stress ratio set the side loads, not the resolution")
 
 
 # ================================================================================ sections 6.3-6.4: the flows
@@ -1196,8 +1225,7 @@ def _at_rest(view, ds):
 def sph_needs_technique(view, e):
     nov, vis = view.run("sph:stab_no_viscosity"), view.run("sph:single_wcsph_n684")
     t, y = _side_series(nov)
-    keep = t >= t[0] + float(num(e, "transient_s"))
-    f = _dominant_hz(t[keep], y[keep])
+    f = _dominant_hz(t, y)
     f0 = _sloshing_hz(nov)
     hf = f >= tol(e) * f0
     moving = not _at_rest(view, nov)
@@ -1316,6 +1344,7 @@ MEASURES = {
     "pap-6.2-steps-refined": _steps("single_refined"),
     "pap-6.2-level-refined": _level("single_refined", "level_cm", figure="figures/fig08_single_refined.png"),
     "pap-6.2-satisfactory-refined": _satisfactory("single_refined", "figures/fig08_single_refined.png"),
+    "pap-6.2-improved": improved,
     "pap-6.3-start": start,
     "pap-6.3-opening": opening,
     "pap-6.3-steps-prescribed": steps_prescribed,

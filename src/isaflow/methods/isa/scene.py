@@ -150,7 +150,11 @@ def initial_positions(scene):
     if "lattice" in part:
         lat = part["lattice"]
         build = square_lattice if lat.get("kind", "rhombic") == "square" else rhombic_lattice
-        return build(lat["a"], lat["rows"], lat["row_lengths"], lat["center_x"], lat["bottom_y"])
+        pos = build(lat["a"], lat["rows"], lat["row_lengths"], lat["center_x"], lat["bottom_y"])
+        if lat.get("jitter", 0.0) > 0:  # a named alternative (disordered packing), not the paper's
+            rng = np.random.default_rng(int(lat.get("seed", 0)))
+            pos = pos + rng.uniform(-1.0, 1.0, pos.shape) * float(lat["jitter"]) * float(lat["a"])
+        return pos
     if "points" in part:
         return np.array(part["points"], float).reshape(-1, 2)
     raise SceneError(f"{scene.path}: field 'particles.from_run': positions come from a run file")

@@ -35,6 +35,8 @@ VALUES = {
     "particles.lattice.center_x": {"type": "number"},  # cm
     "particles.lattice.bottom_y": {"type": "number"},  # cm
     "particles.lattice.kind": {"enum": ["rhombic", "square"]},
+    "particles.lattice.jitter": {"type": "number", "minimum": 0, "maximum": 0.25},  # fraction of a
+    "particles.lattice.seed": {"type": "integer", "minimum": 0, "maximum": 2**31 - 1},
     "forces.wall.law": _LAW, "forces.wall.l_u": _POS, "forces.wall.r_u": _POS,  # cm, N
     "forces.pair.law": _LAW, "forces.pair.l_u": _POS, "forces.pair.r_u": _POS,
     "solver.du": _POS,  # cm
