@@ -10,8 +10,8 @@ metrics table's row.
 
 import numpy as np
 
-from ...metrics import (contact_loads, flow_measures, hydrostatic_errors, level_of, load_errors, pairs,  # noqa: F401
-                        surface_measures, surface_of, vessel_view)
+from ...metrics import (contact_in_vessel, contact_loads, flow_measures, hydrostatic_errors, level_of,  # noqa: F401
+                        load_errors, pairs, surface_measures, surface_of, vessel_view)
 from . import theory
 
 

@@ -69,22 +69,29 @@ def fire_dt_max(k_wall, k_pair, factor=1.0):
     return factor / math.hypot(math.sqrt(2 * k_wall), math.sqrt(2 * PAIR_NEIGHBOURS * k_pair))
 
 
-OVERDAMPED_DT_SAFETY = 0.5  # fraction of the linear stability limit the default overdamped time step takes
+OVERDAMPED_DT_SAFETY = 0.5  # fraction of the linear stability limit the overdamped time step may take at most
+OVERDAMPED_DT_RESOLUTION = 0.25  # radians of the stiffest mode per time step, times max(1, zeta)
 
 
-def overdamped_dt(weight, k_wall, k_pair, zeta, lambda_max, safety=OVERDAMPED_DT_SAFETY):
+def overdamped_dt(weight, k_wall, k_pair, zeta, lambda_max, safety=OVERDAMPED_DT_SAFETY,
+                  resolution=OVERDAMPED_DT_RESOLUTION):
     """Default time step [s] of the overdamped variant (dynamics.py) for particles of weight [N].
 
-    The update v' = (v + dt F / m) / (1 + dt c / m), x' = x + dt v' (damping implicit) is linearly stable
-    on a mode of stiffness lam iff (dt w)^2 < 4 + 4 z dt w (w = sqrt(lam / m), z its damping ratio c / (2 m w)),
-    i.e. dt w < 2 z + 2 sqrt(z^2 + 1).  Taken on the Gershgorin bound lam_G = 2 k_b + 12 k_p of every
-    state's stiffness (the stiffest a lattice can be, with c fixed by zeta on lambda_max), times safety.
+    The update v' = (v + dt F / m) / (1 + dt c / m), x' = x + dt v' (damping implicit) follows a mode of
+    frequency w = sqrt(lam / m) and damping ratio z without oscillating only while dt w is small (at z = 1 its
+    discrete map has complex eigenvalues for every 0 < dt w < 4; at dt w = 0.25 they turn by 0.1 rad per step
+    and shrink by 0.82, so a critically damped mode released at rest overshoots by 0.16 % of its amplitude), and for
+    z >> 1 (the gradient-flow limit x' = F / c) while dt lam / c = dt w / (2 z) is small.  So dt w =
+    resolution x max(1, zeta) on the stiffest mode lambda_max (dt lam / c <= 0.125), and at most safety times
+    the linear stability limit dt w < 2 z + 2 sqrt(z^2 + 1) on the Gershgorin bound lam_G = 2 k_b + 12 k_p of
+    any state's stiffness (c fixed by zeta on lambda_max).
     """
     m = weight / G
     lam_g = 2 * k_wall + 2 * PAIR_NEIGHBOURS * k_pair
-    omega = math.sqrt(lam_g / m)
+    omega_g = math.sqrt(lam_g / m)
     z = zeta * math.sqrt(lambda_max / lam_g)
-    return safety * (2 * z + 2 * math.sqrt(z * z + 1)) / omega
+    stable = safety * (2 * z + 2 * math.sqrt(z * z + 1)) / omega_g
+    return min(stable, resolution * max(1.0, zeta) / math.sqrt(lambda_max / m))
 
 
 def settings(scene):

@@ -29,7 +29,7 @@ def overdamped_figure(inputs, outputs, isa_chain=("flow_incomplete", "flow_compl
     against time; (d) its end state against the paper's update's.  inputs: the run files named by the other
     arguments (run ids); inferred: the footer naming the inferred inputs."""
     runs = _by_stem(inputs)
-    fig, ax = plt.subplots(2, 2, figsize=(13, 10.5))
+    fig, ax = plt.subplots(2, 2, figsize=(14, 12))
     ax_f, ax_s, ax_e, ax_v = ax[0, 0], ax[0, 1], ax[1, 0], ax[1, 1]
     # (a) transfer curves
     chain = [runs[k] for k in isa_chain]
@@ -48,7 +48,7 @@ def overdamped_figure(inputs, outputs, isa_chain=("flow_incomplete", "flow_compl
     ax_f.set_xlim(0, TAU[-1])
     ax_f.set_ylim(0, 1)
     ax_f.set_title("(a) transfer on the normalised time axis")
-    legend_below(ax_f, ncol=1, fontsize=8)
+    legend_below(ax_f, ncol=1)
     # (b) end states of the flow
     isa, od = chain[-1], runs[flows[0]]
     draw_walls(ax_s, isa)
@@ -64,7 +64,7 @@ def overdamped_figure(inputs, outputs, isa_chain=("flow_incomplete", "flow_compl
     ax_s.set_aspect("equal")
     ax_s.set_xlabel("x (cm)")
     ax_s.set_ylabel("y (cm)")
-    legend_below(ax_s, ncol=1, fontsize=8)
+    ax_s.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=1, fontsize=8, frameon=False)
     # (c) the single vessel's overdamped history
     so = runs[singles[0]]
     tt = (so["hist_step"].values - int(so["start_step"])) * float(so.attrs["dt"])
@@ -77,7 +77,7 @@ def overdamped_figure(inputs, outputs, isa_chain=("flow_incomplete", "flow_compl
     ax_e.set_xlabel("t (s)")
     ax_e.set_title(f"(c) single vessel, overdamped (zeta {float(so.attrs['zeta']):g}, dt = "
                    f"{float(so.attrs['dt']):.3g} s): {so.attrs['status']} at t = {float(so['sim_time']):.3g} s")
-    legend_below(ax_e, ncol=2, fontsize=8)
+    ax_e.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2, fontsize=8, frameon=False)
     # (d) single-vessel end states
     si = runs[single]
     draw_walls(ax_v, si)
@@ -87,16 +87,16 @@ def overdamped_figure(inputs, outputs, isa_chain=("flow_incomplete", "flow_compl
         d = runs[k]
         ax_v.plot(*d["pos"].values.T, "o", ms=5.5, mfc="none", color=c,
                   label=f"overdamped zeta {float(d.attrs['zeta']):g} ({d.attrs['status']}): level {level_of(d):.2f} cm, "
-                        f"largest distance from the update's particles "
-                        f"{np.abs(d['pos'].values - si['pos'].values).max():.2g} cm")
+                        f"particle by particle at most "
+                        f"{np.abs(d['pos'].values - si['pos'].values).max():.2g} cm from the update's")
     ax_v.set_aspect("equal")
     ax_v.set_xlabel("x (cm)")
     ax_v.set_ylabel("y (cm)")
     ax_v.set_title("(d) single vessel: end states")
-    legend_below(ax_v, ncol=1, fontsize=8)
+    ax_v.legend(loc="upper center", bbox_to_anchor=(0.5, -0.12), ncol=1, fontsize=8, frameon=False)
     fig.suptitle("The paper's update against overdamped dynamics of the same particles and force laws "
                  "(m x'' = F - c x', m = w/g, c = 2 zeta sqrt(m lambda_max); a project addition, not the paper's)",
                  fontsize=10)
-    fig.subplots_adjust(hspace=0.55, bottom=0.14)
+    fig.subplots_adjust(hspace=0.62, bottom=0.13, top=0.92)
     inferred_note(fig, inferred)
     save(fig, outputs)

@@ -160,12 +160,15 @@ def flow_complete_figure(inputs, outputs, paper=None, inferred=None):
     left = fm["particles_left"]
     n = ds.sizes["particle"]
     exp_ours = (n - left) / n * paper.get("level_first", np.nan) / 2
-    floor_dev = np.nanmax(np.abs(mag[np.isfinite(th)] - th[np.isfinite(th)])) if np.isfinite(th).any() else np.nan
+    fin = np.isfinite(th)
+    dev = float(np.sqrt(np.mean((mag[fin] - th[fin]) ** 2))) if fin.any() else np.nan
+    rel = dev / float(np.mean(th[fin])) if fin.any() else np.nan
     ax.set_title(f"(Fig. 10) {state_phrase(ds)}: {left} particles left in the first vessel "
                  f"(paper {paper.get('particles_left', '?')})\nsecond vessel: mean depth {e['depth']:.1f} cm "
                  f"(paper {paper.get('level_second', np.nan):.1f} cm); from the particles transferred ((N - {left})/N) x "
-                 f"{paper.get('level_first', '?')}/2 = {exp_ours:.1f} cm\nsecond vessel, a heap: floor contacts within "
-                 f"{floor_dev:.0f} N of the column above them; no hydrostatic overlay (the surface is not level)")
+                 f"{paper.get('level_first', '?')}/2 = {exp_ours:.1f} cm\nsecond vessel, a heap: floor contacts against the "
+                 f"column above them, RMS {dev:.0f} N ({rel:.0%} of their mean); no hydrostatic overlay (the surface is "
+                 f"not level)")
     ax.set_xlim(-15, 335)
     ax.set_ylim(-62, 108)
     fig.suptitle(run_caption(ds), fontsize=8)

@@ -27,11 +27,14 @@ def _law_axes(ax, l_u, r_u, sym, title, note=""):
     ax.set_ylim(0, 1.08 * r_u / 1000)
 
 
-def inferred_note(fig, note, y=0.005):
-    """The figure's inferred inputs (config/methods/isa_workflow.yaml 'inferred'), in a footer marked 'inferred'."""
+def inferred_note(fig, note, width=150):
+    """The figure's inferred inputs (config/methods/isa_workflow.yaml 'inferred'), a red header line above the
+    title marked 'inferred' (the saved figure's tight box takes it in)."""
     if note:
-        fig.text(0.005, y, f"inferred: {note}", fontsize=7.5, color="tab:red", style="italic", ha="left", va="bottom",
-                 wrap=True)
+        import textwrap
+
+        text = "\n".join(textwrap.wrap(f"inferred: {note}", width))
+        fig.text(0.5, 1.0, text, fontsize=8, color="tab:red", style="italic", ha="center", va="bottom")
 
 
 def inputs_figure(inputs, outputs, inferred=None):
@@ -76,7 +79,7 @@ def inputs_figure(inputs, outputs, inferred=None):
               "(d) inter-particle function $R_p - l_p$",
               note=f"\ncalibrated to the paper's levels\n(config/inferred.yaml); the literal\n"
                    f"k_p = k_b/2 would be {float(ds.attrs['wall_r_u']) / wl / 2:.4g} N/cm")
-    fig.subplots_adjust(hspace=0.3, bottom=0.1 if inferred else 0.07)
+    fig.subplots_adjust(hspace=0.3)
     fig.suptitle(f"Inputs of scene {case_name(ds)}: du = {ds.attrs['du'] * 10:g} mm, f_tol = {ds.attrs['f_tol']:g} N "
                  f"(solver: {ds.attrs['variant_label']})")
     inferred_note(fig, inferred)
@@ -106,8 +109,8 @@ def _level_lines(ax, x_span, level, paper_level, literal, initial=None):
     across x_span, named in the legend only."""
     if initial is not None:
         ax.plot(x_span, [initial] * 2, color="0.45", ls=(0, (2, 2)), lw=1.1, zorder=3,
-                label=f"initial (uncompacted) lattice's level {initial:.1f} cm: the same reading of its top "
-                      f"particles; the liquid loses {1 - level / initial:.0%} of its depth")
+                label=f"initial (uncompacted) lattice, same reading: {initial:.1f} cm ({1 - level / initial:.0%} "
+                      f"of the depth lost)")
     ours = f"our level {level:.1f} cm"
     if paper_level is not None:
         ours += f": {CALIBRATED}"
