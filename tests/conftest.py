@@ -85,16 +85,18 @@ def settings_spec(spec):
     src = "inferred: test scene"
     leaf = lambda v: {"value": v, "source": src}  # noqa: E731
     part, sol = spec["particles"], spec["solver"]
-    lat = part.get("lattice", {"a": 10.0, "rows": 1, "row_lengths": [1], "center_x": 0.0, "bottom_y": 0.0})
+    lat = {"kind": "rhombic", "jitter": 0.0, "seed": 0,
+           **part.get("lattice", {"a": 10.0, "rows": 1, "row_lengths": [1], "center_x": 0.0, "bottom_y": 0.0})}
     return {
         "particles": {"weight": leaf(part["weight"]), "points": leaf(part.get("points")),
                       "lattice": {k: leaf(v) for k, v in lat.items()}},
         "forces": {w: {k: leaf(v) for k, v in spec["forces"][w].items()} for w in ("wall", "pair")},
         "solver": {k: leaf(sol.get(k, d)) for k, d in (("du", None), ("f_tol", None), ("max_steps", None),
                                                        ("f_ref", None), ("dt_max", None), ("skin", None),
-                                                       ("chunk", 1000), ("stop_on_cycle", True), ("history", {}))},
+                                                       ("chunk", 1000), ("stop_on_cycle", True), ("history", {}),
+                                                       ("zeta", 1.0), ("lambda_max", 3176.4), ("dt", None))},
         "resolutions": {"r": {"source": src, "set": {}}},
-        "variants": {"paper": {"set": {}}, "capped": {"set": {}}, "fire": {"set": {}}},
+        "variants": {"paper": {"set": {}}, "capped": {"set": {}}, "fire": {"set": {}}, "overdamped": {"set": {}}},
     }
 
 

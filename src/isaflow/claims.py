@@ -108,6 +108,12 @@ def measures():
     return out
 
 
+def number(entry, name):
+    """A number of the entry's ``numbers`` (the paper's printed values, a test's constants): its value, a
+    float or a list."""
+    return entry["numbers"][name]["value"]
+
+
 def calibrated_inputs(entry, inputs):
     """Names of the inputs this claim rests on that were calibrated against it (registry 'calibrated_against')."""
     return [i for i in entry.get("inferred_inputs", []) if entry["id"] in inputs.get(i, {}).get("calibrated_against", [])]

@@ -87,6 +87,7 @@ rule isa_fig_inputs:
         report_figure("{name}", "paper_figure", "Paper figures", "Single vessel"),
     params:
         func="methods.isa.figures.single.inputs_figure",
+        kw=lambda wc: {"inferred": ISA.get("inferred", {}).get(wc.name)},
     log:
         "logs/isa/figures/{name}.log",
     wildcard_constraints:
@@ -105,7 +106,8 @@ rule isa_fig_single:
         report_figure("{name}", "paper_figure", "Paper figures", "Single vessel"),
     params:
         func="methods.isa.figures.single.single_vessel_figure",
-        kw=lambda wc: {"paper_level": ISA["paper"][FIGS[wc.name].removesuffix("_capped")]["level"]},
+        kw=lambda wc: {"paper_level": ISA["paper"][FIGS[wc.name].removesuffix("_capped")]["level"],
+                       "inferred": ISA.get("inferred", {}).get(wc.name)},
     log:
         "logs/isa/figures/{name}.log",
     wildcard_constraints:
@@ -160,11 +162,32 @@ rule isa_fig_flow:
             "fig09_flow_incomplete": "methods.isa.figures.flow.flow_incomplete_figure",
             "fig10_flow_complete": "methods.isa.figures.flow.flow_complete_figure",
         }[wc.name],
-        kw={"paper": FLOW["paper"]},
+        kw=lambda wc: {"paper": FLOW["paper"], "inferred": ISA.get("inferred", {}).get(wc.name)},
     log:
         "logs/isa/figures/{name}.log",
     wildcard_constraints:
         name="fig09_flow_incomplete|fig10_flow_complete",
+    conda:
+        "../../envs/isaflow.yaml"
+    script:
+        "../../scripts/call.py"
+
+
+_OD = ISA.get("overdamped", {})
+OD_RUNS = [*_OD.get("isa_chain", []), _OD.get("single"), *_OD.get("flows", []), *_OD.get("singles", [])] if _OD else []
+
+
+rule isa_fig_overdamped:
+    input:
+        inputs=[isa_file(r) for r in OD_RUNS],
+        code=code("methods.isa.figures.damping"),
+    output:
+        report_figure("isa_overdamped", "study_figure", "Studies", "ISA against overdamped dynamics"),
+    params:
+        func="methods.isa.figures.damping.overdamped_figure",
+        kw={**_OD, "inferred": ISA.get("inferred", {}).get("isa_overdamped")},
+    log:
+        "logs/isa/figures/isa_overdamped.log",
     conda:
         "../../envs/isaflow.yaml"
     script:
@@ -310,19 +333,17 @@ rule isa_fig_stability_map:
         "../../scripts/call.py"
 
 
-rule isa_report_claims:
+rule isa_report_findings:
     input:
         metrics="results/isa/metrics.csv",
         calibration="results/isa/calibration.csv",
-        config=ISA_WORKFLOW_CFG,
-        code=code("methods.isa.report.claims"),
+        code=code("methods.isa.report.findings"),
     output:
-        report_file("results/claims/papadopoulos2016.csv", "claims", "Claims"),
         "results/report/findings.md",
     params:
-        func="methods.isa.report.claims.paper_claims",
+        func="methods.isa.report.findings.findings_file",
     log:
-        "logs/isa/report/claims.log",
+        "logs/isa/report/findings.log",
     conda:
         "../../envs/isaflow.yaml"
     script:
@@ -453,7 +474,7 @@ PAPER_TARGETS = [f for name in ("fig05_inputs_coarse", "fig06_single_coarse", "f
                                 "fig08_single_refined", "fig09_flow_incomplete", "fig10_flow_complete")
                  for f in figure(name)] + ["results/isa/table1.csv", "results/isa/table1.md",
                                            "results/report/10_single.md", "results/report/20_flow.md",
-                                           "results/claims/papadopoulos2016.csv"]
+                                           "results/report/findings.md"]
 
 
 rule paper:
@@ -462,26 +483,9 @@ rule paper:
 
 
 register(targets=PAPER_TARGETS + figure("calibration_free_surface") + figure("convergence_single")
-         + figure("flow_history") + figure("error_vs_runtime") + figure("stability_map")
+         + figure("flow_history") + figure("error_vs_runtime") + figure("stability_map") + figure("isa_overdamped")
          + ["results/isa/study/fire_ratio.csv", "results/isa/metrics.csv"])
 register(report=["results/report/10_single.md", "results/report/20_flow.md", "results/report/30_study.md"])
-register(claims=["results/claims/papadopoulos2016.csv"], timing=["results/timing/10_isa.md"])
-
-
-rule isa_claims_methods:
-    input:
-        table="results/compare/runs.csv",
-        code=code("methods.isa.report.claims"),
-    output:
-        "results/claims/papadopoulos2016_methods.csv",
-    params:
-        func="methods.isa.report.claims.damping_claim",
-    log:
-        "logs/isa/report/claims_methods.log",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
-
-
-register(claims=["results/claims/papadopoulos2016_methods.csv"])
+# the paper's claims are judged by the shared claims rule (claims.smk) from config/claims/papadopoulos2016.yaml
+# and methods.isa.claims: results/claims/registry/papadopoulos2016.csv
+register(timing=["results/timing/10_isa.md"])

@@ -1,7 +1,9 @@
 """Incremental static analysis of point particles (Papadopoulos, Koutitas & Lazaridis 2016).
 
 Modules: ``forces`` (force laws, plain force evaluation, wall contacts),
-``relax`` (the compiled step loop of the three update rules), ``settings``
+``relax`` (the compiled step loop of the three update rules), ``dynamics`` (the
+compiled loop of the overdamped variant: the same particles with masses w/g),
+``settings``
 (solver settings with defaults), ``solver`` (chunks, history, outcome ->
 contract.Result).
 """
@@ -16,6 +18,8 @@ METHOD = Method(
         "paper": Variant("paper", "paper: x += du F / max|F| (section 3.3, literal)", "tab:blue", "o", paper=True),
         "capped": Variant("capped", "capped: x += du F / max(max|F|, f_ref) (variant, not in paper)", "tab:green", "s"),
         "fire": Variant("fire", "fire: FIRE relaxation, Bitzek et al. 2006 (variant, not in paper)", "tab:purple", "^"),
+        "overdamped": Variant("overdamped", "overdamped: m x'' = F - c x', m = w/g, same laws (variant, not in paper)",
+                              "tab:olive", "v"),
     },
     marker="o",
     paper_label="Papadopoulos, Koutitas & Lazaridis (2016), the paper replicated",

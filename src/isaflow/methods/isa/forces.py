@@ -1,9 +1,13 @@
 """The paper's force laws and the plain force evaluation (numba).
 
-Force laws are linear and repulsive (paper Fig. 1c, 1d):
-``R(l) = r_u (1 - l / l_u)`` for ``l < l_u``, else 0, so the stiffness is
-``r_u / l_u``.  ``wall_*`` is the particle-wall law (R_b, l_bu of the paper),
-``pair_*`` the particle-particle law (R_p, l_pu).
+Force laws are repulsive (paper Fig. 1c, 1d):
+``R(l) = r_u (1 - l / l_u)^p`` for ``l < l_u``, else 0.  The kept shape is
+linear (p = 1, stiffness ``r_u / l_u``); p = 1.5 and p = 2 are the named
+options of the ``law`` setting (settings.LAW_EXPONENT; the figures give only
+the shape's end points, the text none), not the paper's.  ``wall_*`` is the
+particle-wall law (R_b, l_bu of the paper), ``pair_*`` the particle-particle
+law (R_p, l_pu); ``p`` arguments default to 1 (linear), whose arithmetic is
+unchanged by the option.
 Arrays: ``pos`` (N, 2) cm; ``weight`` (N,) N; ``walls`` (W, 4) cm.
 """
 
@@ -15,9 +19,17 @@ from ...core.geometry import segment_closest
 JIT = dict(cache=True, nogil=True)
 
 
+@njit(inline="always", **JIT)
+def law_over_d(d, l_u, r_u, p):
+    """R(d) / d [N/cm] of the law r_u (1 - d / l_u)^p at 0 < d < l_u (p = 1: the linear law's own arithmetic)."""
+    if p == 1.0:
+        return r_u * (1.0 / d - 1.0 / l_u)
+    return r_u * (1.0 - d / l_u) ** p / d
+
+
 @njit(**JIT)
-def wall_push(px, py, x0, y0, x1, y1, l_u, r_u):
-    """Force (fx, fy) [N] of wall segment on a particle at (px, py).
+def wall_push(px, py, x0, y0, x1, y1, l_u, r_u, p=1.0):
+    """Force (fx, fy) [N] of wall segment on a particle at (px, py); p the law's exponent.
 
     Uses the true point-to-segment distance, so near a segment end the force
     is radial from that end.  A particle exactly on the wall is pushed along
@@ -31,7 +43,7 @@ def wall_push(px, py, x0, y0, x1, y1, l_u, r_u):
         return 0.0, 0.0
     d = np.sqrt(d2)
     if d > 0.0:
-        s = r_u * (1.0 / d - 1.0 / l_u)  # R(d) / d
+        s = law_over_d(d, l_u, r_u, p)  # R(d) / d
         return s * dx, s * dy
     ex = x1 - x0
     ey = y1 - y0
@@ -40,8 +52,8 @@ def wall_push(px, py, x0, y0, x1, y1, l_u, r_u):
 
 
 @njit(**JIT)
-def pair_push(dx, dy, l_u, r_u):
-    """Force (fx, fy) [N] on particle i from j, with (dx, dy) = x_i - x_j.
+def pair_push(dx, dy, l_u, r_u, p=1.0):
+    """Force (fx, fy) [N] on particle i from j, with (dx, dy) = x_i - x_j; p the law's exponent.
 
     Coincident particles are pushed apart along +x (i) / -x (j).
     """
@@ -50,7 +62,7 @@ def pair_push(dx, dy, l_u, r_u):
         return 0.0, 0.0
     d = np.sqrt(d2)
     if d > 0.0:
-        s = r_u * (1.0 / d - 1.0 / l_u)
+        s = law_over_d(d, l_u, r_u, p)
         return s * dx, s * dy
     return r_u, 0.0
 
@@ -64,8 +76,8 @@ def track_max(fx, fy, fmax, finite):
 
 
 @njit(**JIT)
-def forces(pos, weight, walls, wall_l_u, wall_r_u, pair_l_u, pair_r_u, pi, pj, m, f):
-    """Out-of-balance forces f (N, 2) [N] = weight + wall + pair forces.
+def forces(pos, weight, walls, wall_l_u, wall_r_u, pair_l_u, pair_r_u, pi, pj, m, f, wall_p=1.0, pair_p=1.0):
+    """Out-of-balance forces f (N, 2) [N] = weight + wall + pair forces (law exponents wall_p, pair_p).
 
     Pairs are taken from the first m entries of the neighbour list (pi, pj).
     Returns max|F| = max over particles of max(|Fx|, |Fy|) (paper §3.3);
@@ -78,7 +90,8 @@ def forces(pos, weight, walls, wall_l_u, wall_r_u, pair_l_u, pair_r_u, pi, pj, m
         px = pos[i, 0]
         py = pos[i, 1]
         for w in range(walls.shape[0]):
-            gx, gy = wall_push(px, py, walls[w, 0], walls[w, 1], walls[w, 2], walls[w, 3], wall_l_u, wall_r_u)
+            gx, gy = wall_push(px, py, walls[w, 0], walls[w, 1], walls[w, 2], walls[w, 3], wall_l_u, wall_r_u,
+                               wall_p)
             fx += gx
             fy += gy
         f[i, 0] = fx
@@ -86,7 +99,7 @@ def forces(pos, weight, walls, wall_l_u, wall_r_u, pair_l_u, pair_r_u, pi, pj, m
     for k in range(m):
         i = pi[k]
         j = pj[k]
-        gx, gy = pair_push(pos[i, 0] - pos[j, 0], pos[i, 1] - pos[j, 1], pair_l_u, pair_r_u)
+        gx, gy = pair_push(pos[i, 0] - pos[j, 0], pos[i, 1] - pos[j, 1], pair_l_u, pair_r_u, pair_p)
         f[i, 0] += gx
         f[i, 1] += gy
         f[j, 0] -= gx
@@ -101,8 +114,8 @@ def forces(pos, weight, walls, wall_l_u, wall_r_u, pair_l_u, pair_r_u, pi, pj, m
 
 
 @njit(**JIT)
-def wall_contacts(pos, walls, l_u, r_u):
-    """All wall-particle contacts with a non-zero force.
+def wall_contacts(pos, walls, l_u, r_u, p=1.0):
+    """All wall-particle contacts with a non-zero force (law exponent p).
 
     Returns (particle (C,) int64, wall (C,) int64, point (C, 2) [cm] closest
     point on the wall, force (C, 2) [N] exerted by the wall on the particle).
@@ -112,7 +125,7 @@ def wall_contacts(pos, walls, l_u, r_u):
     c = 0
     for i in range(n):
         for w in range(nw):
-            gx, gy = wall_push(pos[i, 0], pos[i, 1], walls[w, 0], walls[w, 1], walls[w, 2], walls[w, 3], l_u, r_u)
+            gx, gy = wall_push(pos[i, 0], pos[i, 1], walls[w, 0], walls[w, 1], walls[w, 2], walls[w, 3], l_u, r_u, p)
             if gx != 0.0 or gy != 0.0:
                 c += 1
     part = np.empty(c, np.int64)
@@ -122,7 +135,7 @@ def wall_contacts(pos, walls, l_u, r_u):
     c = 0
     for i in range(n):
         for w in range(nw):
-            gx, gy = wall_push(pos[i, 0], pos[i, 1], walls[w, 0], walls[w, 1], walls[w, 2], walls[w, 3], l_u, r_u)
+            gx, gy = wall_push(pos[i, 0], pos[i, 1], walls[w, 0], walls[w, 1], walls[w, 2], walls[w, 3], l_u, r_u, p)
             if gx != 0.0 or gy != 0.0:
                 cx, cy = segment_closest(pos[i, 0], pos[i, 1], walls[w, 0], walls[w, 1], walls[w, 2], walls[w, 3])
                 part[c] = i

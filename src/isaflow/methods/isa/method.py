@@ -53,7 +53,8 @@ def solve(tank, settings, variant, resolution, start=None, progress=None, thread
     if start is None:
         pos0, weight, start_step, spacing = scenes.initial_state(scene)
         state = None
-        pitch = spacing / 2 if scene.spec["particles"].get("lattice") else float("nan")
+        lattice = scene.spec["particles"].get("lattice")
+        pitch = scenes.layer_pitch(lattice) if lattice else float("nan")
         held, depth, diff = tank_difference(tank, pos0, weight, pitch, tank.floor_y(0))
     else:
         st = scenes.start_file(scene)
@@ -61,7 +62,8 @@ def solve(tank, settings, variant, resolution, start=None, progress=None, thread
         pitch, held, depth, diff = st["chain"]
         extra = dict(restart=st["restart"], start_sha256=st["sha256"], start_step=st["steps"])
     report = (lambda step, fmax: progress(step, "max|F|", fmax, "N")) if progress else None
-    result = solver.solve(scene, pos0, weight, start_step=start_step, progress=report, state=state)
+    result = solver.solve(scene, pos0, weight, start_step=start_step, progress=report, state=state,
+                          rest_depth=tank.depth)
     result.spacing = spacing
     result.params.update(layer_pitch=pitch, held_weight=held, initial_depth=depth, tank_difference=diff, **extra)
     return result

@@ -10,8 +10,8 @@ metrics table's row.
 
 import numpy as np
 
-from ...metrics import (contact_loads, flow_measures, hydrostatic_errors, level_of, load_errors, pairs,  # noqa: F401
-                        surface_measures, surface_of, vessel_view)
+from ...metrics import (contact_in_vessel, contact_loads, flow_measures, hydrostatic_errors, level_of,  # noqa: F401
+                        load_errors, pairs, surface_measures, surface_of, vessel_view)
 from . import theory
 
 
@@ -189,3 +189,34 @@ def law_usage(ds):
     else:
         out["pair_use"] = 0.0
     return out
+
+
+def transfer_curve(chain):
+    """(t, f) of a flow: time since the opening (s; an ISA update's steps, counted as 1 s each, for the static
+    update rules) and the fraction of the particles in the receiving vessel, from the vessel counts recorded at
+    chunk ends.  chain: the run Datasets of one flow in order (an ISA chain: application 3, then 4); the first
+    one's start is the opening.  A liquid run (SPH: sampled vessel weights) is read from its samples."""
+    ds = chain[0]
+    if "sample_vessel_weight" in ds:
+        t = ds["sample_time"].values - float(ds.attrs.get("start_time", 0.0))
+        f = ds["sample_vessel_weight"].values[:, -1] / float(ds["weight"].values.sum())
+        return np.concatenate([[0.0], t]), np.concatenate([[f[0]], f])
+    ts, fs = [0.0], []
+    t0 = int(ds["start_step"])
+    x2 = ds["vessel_x"].values[-1]
+    x = ds["pos0"].values[:, 0]
+    fs.append(float(np.count_nonzero((x >= x2[0]) & (x < x2[1]))) / ds.sizes["particle"])
+    for d in chain:
+        dt = float(d.attrs["dt"]) if d.attrs.get("variant") == "overdamped" else 1.0
+        ts += list((d["sample_step"].values - t0) * dt)
+        fs += list(d["hist_vessel_count"].values[:, -1] / d.sizes["particle"])
+    return np.array(ts, float), np.array(fs, float)
+
+
+def normalised_curve(t, f, grid):
+    """(f on tau = t / t_50 sampled at grid, t_50): t_50 the first time f reaches half its final value (linear
+    between samples); beyond the last sample f keeps its final value (the flow has ended)."""
+    half = 0.5 * f[-1]
+    k = int(np.argmax(f >= half))
+    t50 = t[k] if k == 0 else t[k - 1] + (half - f[k - 1]) * (t[k] - t[k - 1]) / (f[k] - f[k - 1])
+    return np.interp(grid * t50, t, f, right=f[-1]), t50

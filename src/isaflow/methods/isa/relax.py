@@ -48,8 +48,9 @@ def _near_walls(pos, walls, reach):
 
 
 @njit(**JIT)
-def _move_and_wall_forces(pos, direction, scale, move, weight, walls, wall_l_u, wall_r_u, near_part, near_wall, force):
-    """If move: pos += scale * direction.  Then force = weight + wall forces at pos (one pass).
+def _move_and_wall_forces(pos, direction, scale, move, weight, walls, wall_l_u, wall_r_u, near_part, near_wall, force,
+                          wall_p=1.0):
+    """If move: pos += scale * direction.  Then force = weight + wall forces at pos (one pass; wall law exponent wall_p).
 
     Walls are taken from the near-wall list only: the other walls would add
     exact zeros, so force is the same as in forces.forces.
@@ -66,7 +67,7 @@ def _move_and_wall_forces(pos, direction, scale, move, weight, walls, wall_l_u, 
         while c < nc and near_part[c] == q:
             w = near_wall[c]
             gx, gy = wall_push(pos[q, 0], pos[q, 1], walls[w, 0], walls[w, 1], walls[w, 2], walls[w, 3],
-                               wall_l_u, wall_r_u)
+                               wall_l_u, wall_r_u, wall_p)
             fx += gx
             fy += gy
             c += 1
@@ -75,8 +76,9 @@ def _move_and_wall_forces(pos, direction, scale, move, weight, walls, wall_l_u, 
 
 
 @njit(**JIT)
-def _pair_forces(pos, pair_l_u, pair_r_u, row_start, nbr, force):
-    """Add the pair forces of the row list to force; returns (max|F| as forces.forces does, bad).
+def _pair_forces(pos, pair_l_u, pair_r_u, row_start, nbr, force, pair_p=1.0):
+    """Add the pair forces of the row list to force (pair law exponent pair_p); returns (max|F| as forces.forces
+    does, bad).
 
     bad: the first particle (cell order) whose position or force is NaN or
     infinite (then max|F| is NaN), else -1.  Positions are checked too: the
@@ -99,7 +101,7 @@ def _pair_forces(pos, pair_l_u, pair_r_u, row_start, nbr, force):
         fy = force[q, 1]
         for k in range(row_start[q], row_start[q + 1]):
             j = nbr[k]
-            gx, gy = pair_push(xi - pos[j, 0], yi - pos[j, 1], pair_l_u, pair_r_u)
+            gx, gy = pair_push(xi - pos[j, 0], yi - pos[j, 1], pair_l_u, pair_r_u, pair_p)
             fx += gx
             fy += gy
             force[j, 0] -= gx
@@ -197,19 +199,20 @@ def _fire_velocities(vel, force, rank, dt, dt_max, alpha, n_pos):
 
 @njit(**JIT)
 def relax(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pair_r_u, rule, du, f_ref,
-          dt_max, f_tol, n_steps, skin, force, fmax_hist):
+          dt_max, f_tol, n_steps, skin, force, fmax_hist, wall_p=1.0, pair_p=1.0):
     """One chunk from a fresh start (neighbour list built from pos, FIRE reset); see :func:`relax_resume`.
 
     Returns (steps_done, status, crossing).
     """
-    state = np.zeros(4)
+    state = np.zeros(5)
     return relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pair_r_u, rule, du, f_ref,
-                        dt_max, f_tol, n_steps, skin, force, fmax_hist, np.empty_like(pos), state, False)
+                        dt_max, f_tol, n_steps, skin, force, fmax_hist, np.empty_like(pos), state, False, wall_p,
+                        pair_p)
 
 
 @njit(**JIT)
 def relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pair_r_u, rule, du, f_ref,
-                 dt_max, f_tol, n_steps, skin, force, fmax_hist, pos_build, state, resume):
+                 dt_max, f_tol, n_steps, skin, force, fmax_hist, pos_build, state, resume, wall_p=1.0, pair_p=1.0):
     """Run up to n_steps relaxation steps in place; the whole loop is compiled.
 
     pos (N, 2) cm, vel (N, 2) (FIRE velocities), weight (N,) N, walls (W, 4) cm,
@@ -222,7 +225,10 @@ def relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pai
 
     Restart state (in and out): pos_build (N, 2) cm, the positions at the
     last list build, and state (4,) = (moved bound since that build [cm],
-    FIRE dt [s], alpha, n_pos).  resume=False is a fresh start: the list is
+    FIRE dt [s], alpha, n_pos); a fifth entry, if state has one, receives the
+    largest displacement component [cm] of any particle in any step of this
+    call (not restart state).  wall_p, pair_p: the force laws' exponents
+    (forces.law_over_d; 1 = linear).  resume=False is a fresh start: the list is
     built from pos, moved = 0 and FIRE is reset (dt = dt_max / 10).
     resume=True rebuilds the list from pos_build and continues with the
     given state, so a run split anywhere repeats the unsplit run bit for bit.
@@ -263,9 +269,10 @@ def relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pai
     else:
         moved, dt, alpha, n_pos = 0.0, 0.1 * dt_max, FIRE_ALPHA0, 0  # moved: bound on any displacement, cm
     _move_and_wall_forces(pos_c, force_c, 0.0, False, weight_c, walls, wall_l_u, wall_r_u, near_part, near_wall,
-                          force_c)
-    fmax, bad = _pair_forces(pos_c, pair_l_u, pair_r_u, row_start, nbr, force_c)
+                          force_c, wall_p)
+    fmax, bad = _pair_forces(pos_c, pair_l_u, pair_r_u, row_start, nbr, force_c, pair_p)
     status = RUNNING
+    step_move = 0.0
     crossing = -1
     done = n_steps
     for step in range(n_steps + 1):
@@ -295,10 +302,12 @@ def relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pai
                 scale = du / vmax
             direction = vel_c
             max_move = np.sqrt(2.0) * scale * vmax
+            step_move = max(step_move, scale * vmax)
         else:
             scale = du / fmax if rule == PAPER else du / max(fmax, f_ref)
             direction = force_c
             max_move = np.sqrt(2.0) * (scale * fmax)
+            step_move = max(step_move, scale * fmax)
         # refuse any move across a wall
         i, w = _first_crossing(pos_c, direction, scale, walls, order, near_part, not (moved + max_move < reach))
         if i >= 0:  # tested before any particle moved: the step is not taken
@@ -319,13 +328,15 @@ def relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pai
             near_part, near_wall = _near_walls(pos_c, walls, reach)
             moved = 0.0
             _move_and_wall_forces(pos_c, direction, scale, False, weight_c, walls, wall_l_u, wall_r_u, near_part,
-                                  near_wall, force_c)
+                                  near_wall, force_c, wall_p)
         else:
             _move_and_wall_forces(pos_c, direction, scale, True, weight_c, walls, wall_l_u, wall_r_u, near_part,
-                                  near_wall, force_c)
-        fmax, bad = _pair_forces(pos_c, pair_l_u, pair_r_u, row_start, nbr, force_c)
+                                  near_wall, force_c, wall_p)
+        fmax, bad = _pair_forces(pos_c, pair_l_u, pair_r_u, row_start, nbr, force_c, pair_p)
     _to_caller_order(order, pos_c, pos)
     _to_caller_order(order, vel_c, vel)
     _to_caller_order(order, force_c, force)
     state[0], state[1], state[2], state[3] = moved, dt, alpha, n_pos
+    if state.shape[0] > 4:
+        state[4] = step_move
     return done, status, crossing

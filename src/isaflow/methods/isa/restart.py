@@ -100,16 +100,20 @@ def _read_start(scene, ds, src, where, field):
     return pos, weight, steps, spacing, _restart_state(scene, ds, n, where)
 
 
-DYNAMICS = ("du", "f_tol", "f_ref", "dt_max", "skin", "chunk", "wall_l_u", "wall_r_u", "pair_l_u", "pair_r_u")
+DYNAMICS = ("du", "f_tol", "f_ref", "dt_max", "skin", "chunk", "wall_l_u", "wall_r_u", "pair_l_u", "pair_r_u",
+            "wall_p", "pair_p")
+OVERDAMPED_DYNAMICS = ("zeta", "lambda_max", "dt")
+LAW_DEFAULT = 1.0  # the law exponent of run files written before the law option (all linear)
 
 
 def _restart_state(scene, ds, n, where):
     """(state or None, why) of an open run file: its solver state if its dynamics equal this scene's."""
     s = settings(scene)
     differ = ["variant"] if ds.attrs.get("variant") != s["variant"] else []
-    for k in DYNAMICS + ("stop_on_cycle",):
+    keys = DYNAMICS + ("stop_on_cycle",) + (OVERDAMPED_DYNAMICS if s["variant"] == "overdamped" else ())
+    for k in keys:
         try:
-            if float(ds.attrs[k]) != float(s[k]):
+            if float(ds.attrs.get(k, LAW_DEFAULT) if k in ("wall_p", "pair_p") else ds.attrs[k]) != float(s[k]):
                 differ.append(k)
         except (KeyError, TypeError, ValueError):
             differ.append(k)

@@ -88,6 +88,26 @@ def rhombic_lattice(a, rows, row_lengths, center_x, bottom_y):
     return np.concatenate(pts)
 
 
+def square_lattice(a, rows, row_lengths, center_x, bottom_y):
+    """Square lattice (a named alternative to the rhombic one, not the paper's): (N, 2) positions [cm].
+
+    Row r sits at bottom_y + r a and holds row_lengths[r % len] particles a apart, centred on center_x.
+    With a = the rhomb side a_r / sqrt(2) it is the rhombic lattice turned by 45 degrees: the same nearest
+    distance and count of nearest neighbours, with no diagonal vertical.
+    """
+    pts = []
+    for r in range(rows):
+        n = row_lengths[r % len(row_lengths)]
+        x = center_x + (np.arange(n) - (n - 1) / 2) * a
+        pts.append(np.column_stack([x, np.full(n, bottom_y + r * a)]))
+    return np.concatenate(pts)
+
+
+def layer_pitch(lattice):
+    """Vertical pitch [cm] of a lattice's particle layers: a / 2 (rhombic), a (square)."""
+    return float(lattice["a"]) if lattice.get("kind", "rhombic") == "square" else float(lattice["a"]) / 2
+
+
 def _check_geometry(scene):
     """Physical checks the schema cannot express, and the memory the run needs, before any allocation."""
     from . import budget
@@ -129,7 +149,12 @@ def initial_positions(scene):
     part = scene.spec["particles"]
     if "lattice" in part:
         lat = part["lattice"]
-        return rhombic_lattice(lat["a"], lat["rows"], lat["row_lengths"], lat["center_x"], lat["bottom_y"])
+        build = square_lattice if lat.get("kind", "rhombic") == "square" else rhombic_lattice
+        pos = build(lat["a"], lat["rows"], lat["row_lengths"], lat["center_x"], lat["bottom_y"])
+        if lat.get("jitter", 0.0) > 0:  # a named alternative (disordered packing), not the paper's
+            rng = np.random.default_rng(int(lat.get("seed", 0)))
+            pos = pos + rng.uniform(-1.0, 1.0, pos.shape) * float(lat["jitter"]) * float(lat["a"])
+        return pos
     if "points" in part:
         return np.array(part["points"], float).reshape(-1, 2)
     raise SceneError(f"{scene.path}: field 'particles.from_run': positions come from a run file")

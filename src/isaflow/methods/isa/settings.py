@@ -8,13 +8,18 @@ leaves out is filled in by :func:`settings`.  This module imports no numerics
 
 import math
 
-RULE_IDS = {"paper": 0, "capped": 1, "fire": 2}  # relax.PAPER, CAPPED, FIRE
+from ...core.units import G  # cm/s^2 (a constants module: no numerics imported)
+
+RULE_IDS = {"paper": 0, "capped": 1, "fire": 2, "overdamped": 3}  # relax.PAPER, CAPPED, FIRE; dynamics.OVERDAMPED
 RULES = RULE_IDS
+# the force laws' shapes R(l) = r_u (1 - l / l_u)^p (forces.law_over_d): linear is the kept reading, the other
+# two are named options for the force_law_shape sweep (config/claims/papadopoulos2016.yaml), not the paper's
+LAW_EXPONENT = {"linear": 1.0, "power_1.5": 1.5, "quadratic": 2.0}
 
 _POS = {"type": "number", "exclusiveMinimum": 0}
 _OPT_POS = {"type": ["number", "null"], "exclusiveMinimum": 0}
 _COUNT = {"type": "integer", "minimum": 1, "maximum": 2147483647}
-_LAW = {"enum": ["linear"]}
+_LAW = {"enum": list(LAW_EXPONENT)}
 _HISTORY = {"type": "object", "additionalProperties": False, "properties": {
     "every": {"type": "integer", "minimum": 1, "maximum": 10**15},
     "walls": {"type": "boolean"}, "vessels": {"type": "boolean"},
@@ -29,6 +34,9 @@ VALUES = {
     "particles.lattice.row_lengths": {"type": "array", "items": _COUNT, "minItems": 1, "maxItems": 2},
     "particles.lattice.center_x": {"type": "number"},  # cm
     "particles.lattice.bottom_y": {"type": "number"},  # cm
+    "particles.lattice.kind": {"enum": ["rhombic", "square"]},
+    "particles.lattice.jitter": {"type": "number", "minimum": 0, "maximum": 0.25},  # fraction of a
+    "particles.lattice.seed": {"type": "integer", "minimum": 0, "maximum": 2**31 - 1},
     "forces.wall.law": _LAW, "forces.wall.l_u": _POS, "forces.wall.r_u": _POS,  # cm, N
     "forces.pair.law": _LAW, "forces.pair.l_u": _POS, "forces.pair.r_u": _POS,
     "solver.du": _POS,  # cm
@@ -38,6 +46,8 @@ VALUES = {
     "solver.chunk": {"type": "integer", "minimum": 100, "maximum": 10**12},
     "solver.stop_on_cycle": {"type": "boolean"},
     "solver.history": _HISTORY,
+    # the overdamped variant (dynamics.py): damping ratio zeta of the stiffest mode lambda_max [N/cm], time step [s]
+    "solver.zeta": _POS, "solver.lambda_max": _POS, "solver.dt": _OPT_POS,
 }
 # Defaults of the optional solver fields.  f_ref and dt_max depend on the
 # stiffness: both come from the Gershgorin bound lambda_max <= 2 k_b + 12 k_p
@@ -59,18 +69,49 @@ def fire_dt_max(k_wall, k_pair, factor=1.0):
     return factor / math.hypot(math.sqrt(2 * k_wall), math.sqrt(2 * PAIR_NEIGHBOURS * k_pair))
 
 
+OVERDAMPED_DT_SAFETY = 0.5  # fraction of the linear stability limit the overdamped time step may take at most
+OVERDAMPED_DT_RESOLUTION = 0.25  # radians of the stiffest mode per time step, times max(1, zeta)
+
+
+def overdamped_dt(weight, k_wall, k_pair, zeta, lambda_max, safety=OVERDAMPED_DT_SAFETY,
+                  resolution=OVERDAMPED_DT_RESOLUTION):
+    """Default time step [s] of the overdamped variant (dynamics.py) for particles of weight [N].
+
+    The update v' = (v + dt F / m) / (1 + dt c / m), x' = x + dt v' (damping implicit) follows a mode of
+    frequency w = sqrt(lam / m) and damping ratio z without oscillating only while dt w is small (at z = 1 its
+    discrete map has complex eigenvalues for every 0 < dt w < 4; at dt w = 0.25 they turn by 0.1 rad per step
+    and shrink by 0.82, so a critically damped mode released at rest overshoots by 0.16 % of its amplitude), and for
+    z >> 1 (the gradient-flow limit x' = F / c) while dt lam / c = dt w / (2 z) is small.  So dt w =
+    resolution x max(1, zeta) on the stiffest mode lambda_max (dt lam / c <= 0.125), and at most safety times
+    the linear stability limit dt w < 2 z + 2 sqrt(z^2 + 1) on the Gershgorin bound lam_G = 2 k_b + 12 k_p of
+    any state's stiffness (c fixed by zeta on lambda_max).
+    """
+    m = weight / G
+    lam_g = 2 * k_wall + 2 * PAIR_NEIGHBOURS * k_pair
+    omega_g = math.sqrt(lam_g / m)
+    z = zeta * math.sqrt(lambda_max / lam_g)
+    stable = safety * (2 * z + 2 * math.sqrt(z * z + 1)) / omega_g
+    return min(stable, resolution * max(1.0, zeta) / math.sqrt(lambda_max / m))
+
+
 def settings(scene):
     """{name: value} of every solver setting of an ISA scene, defaults resolved.
 
     Keys: variant, du (cm), f_tol (N), max_steps, f_ref (N), dt_max (s),
-    skin (cm), chunk, stop_on_cycle, accept, history, and the force laws
-    wall_l_u, wall_r_u, pair_l_u, pair_r_u (cm, N).
+    skin (cm), chunk, stop_on_cycle, accept, history, the force laws
+    wall_l_u, wall_r_u, pair_l_u, pair_r_u (cm, N) and their exponents wall_p,
+    pair_p (LAW_EXPONENT), and the overdamped variant's zeta (1), lambda_max
+    (N/cm), dt (s) and damping c = 2 zeta sqrt(m lambda_max) [N s/cm] of a
+    particle of the scene's weight (m = w / g).
     """
     s = {**DEFAULTS, **scene.spec["solver"]}
     wall_l_u, wall_r_u = scene.law("wall")
     pair_l_u, pair_r_u = scene.law("pair")
     k_wall, k_pair = wall_r_u / wall_l_u, pair_r_u / pair_l_u
     du = float(s["du"])
+    weight = float(scene.spec["particles"]["weight"])
+    zeta, lam = float(s.get("zeta", 1.0)), float(s.get("lambda_max", 2 * k_wall + 2 * PAIR_NEIGHBOURS * k_pair))
+    dt = float(s.get("dt", overdamped_dt(weight, k_wall, k_pair, zeta, lam)))
     return dict(
         variant=s["variant"], du=du, f_tol=float(s["f_tol"]), max_steps=int(s["max_steps"]),
         f_ref=float(s.get("f_ref", f_ref_default(du, k_wall, k_pair))),
@@ -78,4 +119,6 @@ def settings(scene):
         skin=float(s.get("skin", SKIN_FRACTION * pair_l_u)), chunk=int(s["chunk"]),
         stop_on_cycle=bool(s["stop_on_cycle"]), accept=list(s["accept"]), history=dict(s["history"]),
         wall_l_u=wall_l_u, wall_r_u=wall_r_u, pair_l_u=pair_l_u, pair_r_u=pair_r_u,
+        wall_p=LAW_EXPONENT[scene.spec["forces"]["wall"]["law"]], pair_p=LAW_EXPONENT[scene.spec["forces"]["pair"]["law"]],
+        zeta=zeta, lambda_max=lam, dt=dt, damping=2 * zeta * math.sqrt(weight / G * lam),
     )

@@ -1,5 +1,7 @@
 """Drive the compiled relaxation in chunks: progress, history, outcome -> contract.Result.
 
+The three update rules run relax.relax_resume; the overdamped variant (not the paper's) runs
+dynamics.overdamped_resume, whose ``converged`` also needs the liquid at rest (config/rest.yaml).
 Outcomes (contract.OUTCOMES): ``converged`` (max|F| < f_tol), ``cycle``
 (max|F| repeats with a fixed period: a limit cycle that can never converge),
 ``step_limit``, ``escaped`` (a step would carry a particle across a wall, or
@@ -10,8 +12,11 @@ import time
 
 import numpy as np
 
+from ... import rest as REST
 from ...contract import Result, wall_resultants
 from ...core.geometry import bounding_box, outside_box
+from ...core.units import G
+from . import dynamics as D
 from . import forces as F
 from . import relax as R
 from .settings import RULES, settings
@@ -50,7 +55,7 @@ def detect_cycle(h, window=CYCLE_WINDOW, max_period=CYCLE_MAX_PERIOD, rtol=CYCLE
 
 def contacts(pos, walls, s):
     """(particle, wall, point, force) wall contacts of positions under settings s."""
-    return F.wall_contacts(pos, walls, s["wall_l_u"], s["wall_r_u"])
+    return F.wall_contacts(pos, walls, s["wall_l_u"], s["wall_r_u"], s["wall_p"])
 
 
 def vessel_counts(pos, vessels):
@@ -64,9 +69,17 @@ def warm_up():
     walls = np.array([[0.0, 2.0, 0.0, 0.0], [0.0, 0.0, 2.0, 0.0], [2.0, 0.0, 2.0, 2.0]])
     box = np.array([0.0, 0.0, 2.0, 2.0])
     for rule in RULES.values():
-        R.relax(pos.copy(), np.zeros_like(pos), np.ones(2), walls, box, 0.5, 1.0, 0.7, 1.0, rule,
-                1e-3, 1.0, 0.1, 0.1, 2, 0.1, np.zeros_like(pos), np.zeros(2))
-    F.wall_contacts(pos, walls, 0.5, 1.0)
+        if rule == D.OVERDAMPED:
+            continue
+        for p in (1.0, 2.0):
+            R.relax_resume(pos.copy(), np.zeros_like(pos), np.ones(2), walls, box, 0.5, 1.0, 0.7, 1.0, rule,
+                           1e-3, 1.0, 0.1, 0.1, 2, 0.1, np.zeros_like(pos), np.zeros(2), pos.copy(), np.zeros(5),
+                           False, p, p)
+    for p in (1.0, 2.0):
+        D.overdamped_resume(pos.copy(), np.zeros_like(pos), np.ones(2), walls, box, 0.5, 1.0, 0.7, 1.0, 1e-3, 1.0,
+                            1.0, G, 0.1, 1e-5, 1.0, 1.0, 2, 0.1, np.zeros_like(pos), np.zeros(2), np.zeros(2),
+                            pos.copy(), np.array([0.0, 0.0, -1.0, 0.0, 0.0]), False, p, p)
+        F.wall_contacts(pos, walls, 0.5, 1.0, p)
 
 
 class _History:
@@ -79,17 +92,20 @@ class _History:
         self.vessels = vessels if hist.get("vessels") and vessels else None
         self.n_snap = hist.get("snapshots", 0)
         self.n_walls = n_walls
-        self.rec = {k: [] for k in ("hist_step", "hist_fmax", "hist_fmax_lo", "hist_fmax_hi",
+        self.rec = {k: [] for k in ("hist_step", "hist_fmax", "hist_fmax_lo", "hist_fmax_hi", "hist_energy",
                                     "sample_step", "hist_wall_resultant", "hist_vessel_count", "snap_step", "snap_pos")}
 
-    def steps(self, step, h, origin):
-        """Record h (max|F| before steps step, step + 1, ...) in strides counted from step origin <= step."""
+    def steps(self, step, h, origin, ke=None):
+        """Record h (max|F| before steps step, step + 1, ...) in strides counted from step origin <= step;
+        ke: the kinetic energies before the same steps (overdamped variant), recorded at the stride starts."""
         for k0 in range((origin - step) % self.every, len(h), self.every):
             seg = h[k0:k0 + self.every]
             self.rec["hist_step"].append(step + k0)
             self.rec["hist_fmax"].append(seg[0])
             self.rec["hist_fmax_lo"].append(seg.min())
             self.rec["hist_fmax_hi"].append(seg.max())
+            if ke is not None:
+                self.rec["hist_energy"].append(ke[k0])
 
     def chunk(self, step, pos, s, walls, snap):
         if self.walls:
@@ -111,6 +127,7 @@ class _History:
             "hist_fmax": (("record",), float, "N", "max|F| at hist_step"),
             "hist_fmax_lo": (("record",), float, "N", "smallest max|F| over the record stride"),
             "hist_fmax_hi": (("record",), float, "N", "largest max|F| over the record stride"),
+            "hist_energy": (("record",), float, "N cm", "kinetic energy at hist_step (overdamped variant)"),
             "sample_step": (("sample",), np.int64, "1", "algorithm step of diagnostic sample"),
             "hist_wall_resultant": (("sample", "wall", "xy"), float, "N", "resultant force of wall on liquid over the run"),
             "hist_vessel_count": (("sample", "vessel"), np.int64, "1", "particles per vessel"),
@@ -129,8 +146,8 @@ STATE_VARS = {  # restart state written to every run file: name -> (dims, units,
     "state_pos_build": (("particle", "xy"), "cm", "positions at the last neighbour-list build"),
     "state_chunk_start": (("particle", "xy"), "cm", "positions at the start of the last chunk (cycle test)"),
     "state_moved": ((), "cm", "bound on any displacement since the last neighbour-list build"),
-    "state_fire_dt": ((), "s", "FIRE time step"),
-    "state_fire_alpha": ((), "1", "FIRE mixing parameter alpha"),
+    "state_fire_dt": ((), "s", "FIRE time step (overdamped variant: the simulated time)"),
+    "state_fire_alpha": ((), "1", "FIRE mixing parameter alpha (overdamped variant: start of the quiet stretch, s)"),
     "state_fire_n_pos": ((), "1", "FIRE steps since the power was last negative"),
     "state_recent_fmax": (("cycle_window",), "N", "last max|F| values (cycle-detection window)"),
 }
@@ -143,11 +160,12 @@ def _state_fields(vel, pos_build, chunk_start, kernel, recent):
     return {k: (d, np.asarray(arrays[k]), u, ln) for k, (d, u, ln) in STATE_VARS.items()}
 
 
-def solve(scene, pos0, weight, start_step=0, progress=None, state=None):
+def solve(scene, pos0, weight, start_step=0, progress=None, state=None, rest_depth=float("nan")):
     """Relax ``pos0`` (N, 2) cm with per-particle ``weight`` (N,) N under an ISA scene.
 
     start_step: steps already taken (a continued run counts from there up to
     solver.max_steps).  progress(step, fmax) is called after each chunk.
+    rest_depth: depth h [cm] of the rest criterion's e = KE / (W h) (overdamped variant only).
     state: {STATE_VARS name: array} of the run this one continues (same
     scene dynamics), or None for a fresh start; with it the continued run
     repeats the uninterrupted one bit for bit, at any start_step.
@@ -165,8 +183,17 @@ def solve(scene, pos0, weight, start_step=0, progress=None, state=None):
     restored = state is not None
     vel = np.array(state["state_vel"], float) if restored else np.zeros_like(pos)
     pos_build = np.array(state["state_pos_build"], float) if restored else pos.copy()
+    overdamped = RULES[s["variant"]] == D.OVERDAMPED
     kernel = np.array([float(state[k]) for k in ("state_moved", "state_fire_dt", "state_fire_alpha",
-                                                 "state_fire_n_pos")]) if restored else np.zeros(4)
+                                                 "state_fire_n_pos")] + [0.0]) if restored else np.zeros(5)
+    if overdamped and not restored:
+        kernel[2] = -1.0  # no quiet stretch yet
+    rest_cfg = REST.load() if overdamped else None
+    e_norm = float(np.sum(weight)) * float(rest_depth)
+    if overdamped and not e_norm > 0:
+        raise ValueError(f"overdamped variant: the rest criterion needs a positive liquid depth (got {rest_depth})")
+    ke_buf = np.zeros(chunk) if overdamped else None
+    max_step_move = 0.0
     recent = np.array(state["state_recent_fmax"], float) if restored else np.zeros(0)
     resume = restored and start_step % chunk != 0  # inside a chunk: continue its list and FIRE state
     chunk_start = np.array(state["state_chunk_start"], float) if resume else pos.copy()
@@ -186,16 +213,24 @@ def solve(scene, pos0, weight, start_step=0, progress=None, state=None):
         origin = step - step % chunk if resume else step  # history strides count from here
         if not resume:
             chunk_start = pos.copy()
-        done, code, crossing = R.relax_resume(
-            pos, vel, weight, walls, box, s["wall_l_u"], s["wall_r_u"], s["pair_l_u"], s["pair_r_u"],
-            RULES[s["variant"]], s["du"], s["f_ref"], s["dt_max"], s["f_tol"], n, s["skin"], force, buf,
-            pos_build, kernel, resume,
-        )
+        if overdamped:
+            done, code, crossing = D.overdamped_resume(
+                pos, vel, weight, walls, box, s["wall_l_u"], s["wall_r_u"], s["pair_l_u"], s["pair_r_u"], s["dt"],
+                s["zeta"], s["lambda_max"], G, s["f_tol"], rest_cfg["energy_ratio"], e_norm, rest_cfg["window"], n,
+                s["skin"], force, buf, ke_buf, pos_build, kernel, resume, s["wall_p"], s["pair_p"],
+            )
+        else:
+            done, code, crossing = R.relax_resume(
+                pos, vel, weight, walls, box, s["wall_l_u"], s["wall_r_u"], s["pair_l_u"], s["pair_r_u"],
+                RULES[s["variant"]], s["du"], s["f_ref"], s["dt_max"], s["f_tol"], n, s["skin"], force, buf,
+                pos_build, kernel, resume, s["wall_p"], s["pair_p"],
+            )
         resume = False
+        max_step_move = max(max_step_move, float(kernel[4]))
         evals += done + 1  # one evaluation per step taken, plus the chunk's initial one
         h = buf[:done]
         if hist.every:
-            hist.steps(step, h, origin)
+            hist.steps(step, h, origin, ke_buf[:done] if overdamped else None)
         step += done
         n_chunk += 1
         recent = np.concatenate([recent, h])[-2000:]
@@ -227,7 +262,7 @@ def solve(scene, pos0, weight, start_step=0, progress=None, state=None):
             status = "escaped"
             message = f"{out.sum()} particle(s) left the walls' bounding box by step {step}"
             break
-        if s["stop_on_cycle"]:
+        if s["stop_on_cycle"] and not overdamped:
             period = detect_cycle(recent)
             # a cycle returns to its states: the net move over the chunk stays
             # within a few du, unlike a slow drift with a periodic max|F|
@@ -247,9 +282,25 @@ def solve(scene, pos0, weight, start_step=0, progress=None, state=None):
         message = f"max|F| = {fmax:.4g} N >= f_tol = {s['f_tol']:g} N after {step} steps"
     elif status == "converged":
         message = f"max|F| = {fmax:.4g} N < f_tol = {s['f_tol']:g} N after {step} steps"
+    sim_time = float("nan")
     part, wall, point, cforce = contacts(pos, walls, s)
-    params = {k: v for k, v in s.items() if k not in ("accept", "history", "variant", "stop_on_cycle")}
-    params.update(cycle_period=int(period), stop_on_cycle=int(s["stop_on_cycle"]), nonfinite_particle=int(bad_particle))
+    dynamic = ("zeta", "lambda_max", "dt", "damping")
+    params = {k: v for k, v in s.items() if k not in ("accept", "history", "variant", "stop_on_cycle")
+              and (overdamped or k not in dynamic)}
+    params.update(cycle_period=int(period), stop_on_cycle=int(s["stop_on_cycle"]), nonfinite_particle=int(bad_particle),
+                  max_step_move=max_step_move)
+    if overdamped:
+        sim_time = float(kernel[1])
+        ke = 0.5 * float(np.sum(weight / G * np.sum(vel * vel, axis=1)))
+        at_rest = kernel[2] >= 0 and sim_time - kernel[2] >= rest_cfg["window"] - 1e-12
+        params.update(rest_energy_ratio=rest_cfg["energy_ratio"], rest_window=rest_cfg["window"], rest_depth=rest_depth,
+                      final_energy_ratio=ke / e_norm, time_to_rest=float(kernel[2]) if at_rest else float("nan"),
+                      particle_mass=float(weight[0] / G) if len(weight) else float("nan"))
+        if status == "converged":
+            message += (f", at rest (e = KE / (W h) < {rest_cfg['energy_ratio']:g} since t = {kernel[2]:.4g} s); "
+                        f"t = {sim_time:.4g} s")
+        else:
+            message += f"; t = {sim_time:.4g} s, e = {ke / e_norm:.3g}"
     fields = {"force": (("particle", "xy"), force, "N", "final out-of-balance force on particle"),
               "contact_particle": (("contact",), part.astype(np.int32), "1", "particle index of wall contact")}
     fields.update(_state_fields(vel, pos_build, chunk_start, kernel, recent))
@@ -257,6 +308,6 @@ def solve(scene, pos0, weight, start_step=0, progress=None, state=None):
         method="isa", variant=s["variant"], pos0=np.array(pos0, float), pos=pos, weight=weight,
         contact_wall=wall, contact_point=point, contact_force=cforce, status=status, message=message,
         steps=step, start_step=start_step, wall_time=wall_time, force_evals=evals, residual=fmax,
-        residual_name="max|F|", residual_units="N",
+        residual_name="max|F|", residual_units="N", sim_time=sim_time,
         history=hist.variables(len(pos)), fields=fields, params=params,
     )

@@ -35,7 +35,7 @@ from .settings import material_units
 
 def num(entry, name):
     """A number of the entry's ``numbers`` (the paper's printed values): float or array."""
-    v = entry["numbers"][name]["value"]
+    v = C.number(entry, name)
     return np.asarray(v, float) if isinstance(v, list) else float(v)
 
 

@@ -5,7 +5,8 @@ from matplotlib.ticker import FuncFormatter
 
 from .. import metrics
 from ....runfile import read
-from .single import _contact_bars
+from ....theory import surface_profile
+from .single import _contact_bars, inferred_note
 from ....figures.style import (COMPUTED, LABEL_BOX, PAPER_EXPECTED, PAPER_LEVEL, THEORY, draw_walls, legend_below, nice_value,
                     plt, run_caption, save, scale_bar, state_phrase, surface_line)
 
@@ -68,8 +69,9 @@ def _surfaces(ax, ds):
         surface_line(ax, ds, name, color)
 
 
-def flow_incomplete_figure(inputs, outputs, paper=None):
-    """Paper Fig. 9: state at step 100,000 with boundary reactions and sum F_x."""
+def flow_incomplete_figure(inputs, outputs, paper=None, inferred=None):
+    """Paper Fig. 9: state at step 100,000 with boundary reactions and sum F_x; inferred: the footer naming the
+    inferred inputs (the second vessel's floor drop)."""
     ds = read(inputs[0])
     fig, ax = plt.subplots(figsize=(12, 6.2))
     fm = _state_axes(ax, ds)
@@ -89,19 +91,54 @@ def flow_incomplete_figure(inputs, outputs, paper=None):
     ax.set_xlim(-45, 355)
     ax.set_ylim(-78, 108)
     fig.suptitle(run_caption(ds), fontsize=8)
+    inferred_note(fig, inferred)
     save(fig, outputs)
 
 
-def flow_complete_figure(inputs, outputs, paper=None):
-    """Paper Fig. 10: final state, particles left, the measured surface in both vessels,
-    the paper's measured and expected levels, and the hydrostatic overlay on the second
-    vessel's walls."""
+def column_weights(ds, vessel):
+    """(C,) load [N] on each floor contact of a vessel from the weight of the liquid column above it, under the
+    vessel's own measured surface (top particle per strip of width a), scaled so the floor carries the vessel's
+    weight; NaN on every other contact.  What a heap at rest puts on its floor if no arch carries part of it
+    (no hydrostatic theory applies to a surface that is not level)."""
+    v = metrics.vessel_view(ds, vessel)
+    a = float(ds.attrs["spacing"])
+    x, top = surface_profile(ds["pos"].values, a, v["x_range"])
+    walls = ds["wall_segment"].values
+    cw = np.where(metrics.contact_in_vessel(ds, v["x_range"]), ds["contact_wall"].values, -1)
+    cp = ds["contact_point"].values
+    out = np.full(len(cw), np.nan)
+    floor = [w for w in range(len(walls)) if v["wall_in"][w] and v["horizontal"][w]
+             and np.isclose(walls[w, 1], v["floor_y"])]
+    if not floor or not len(x):
+        return out
+    idx = np.flatnonzero(cw == floor[0])
+    if not len(idx):
+        return out
+    xs = cp[idx, 0]
+    order = np.argsort(xs)
+    lo, hi = sorted(walls[floor[0], [0, 2]])
+    b = np.concatenate([[lo], 0.5 * (xs[order][1:] + xs[order][:-1]), [hi]])
+    height = np.interp(xs[order], x, top) - v["floor_y"]
+    col = np.clip(height, 0, None) * np.diff(b)
+    weight = float(ds["weight"].values[v["inside"]].sum())
+    out[idx[order]] = weight * col / col.sum()
+    return out
+
+
+def flow_complete_figure(inputs, outputs, paper=None, inferred=None):
+    """Paper Fig. 10: final state, particles left, the measured surface in both vessels, the paper's measured
+    and expected levels, and the loads of the second vessel against what this liquid is: a heap whose floor
+    carries the weight of the column above each contact (column_weights).  The paper's hydrostatic comparison
+    (a level liquid of the mean depth) is not drawn: a surface that falls by tens of cm is no liquid at rest,
+    and the side walls of a heap carry what its friction sets, which no hydrostatic line gives.
+    inferred: the footer naming the inferred inputs (the second vessel's floor drop)."""
     ds = read(inputs[0])
     paper = paper or {}
-    fig, ax = plt.subplots(figsize=(12, 6.6))
+    fig, ax = plt.subplots(figsize=(12, 6.9))
     fm = _state_axes(ax, ds)
     second = str(ds["vessel"].values[-1])
-    e, (_, _, mag, th) = metrics.contact_loads(ds, second, "level")
+    e, (_, _, mag, _) = metrics.contact_loads(ds, second, "level")
+    th = column_weights(ds, second)
     v = metrics.vessel_view(ds, second)
     bar_scale = 15.0 / np.nanmax(np.concatenate([mag, th]))
     _contact_bars(ax, ds, th, bar_scale)
@@ -115,21 +152,27 @@ def flow_complete_figure(inputs, outputs, paper=None):
         ax.plot([x0, x1], [fy + paper["level_expected"]] * 2, label=f"paper: level expected from the particles "
                 f"transferred, {paper['level_expected']:.1f} cm", **PAPER_EXPECTED)
     ax.plot([], [], color=COMPUTED, lw=2.2, label="computed reaction $R_b$")
-    ax.plot([], [], color=THEORY, lw=2.2, label="hydrostatic theory, second vessel (flat level at the mean depth)")
+    ax.plot([], [], color=THEORY, lw=2.2, label="second vessel's floor: weight of the column above each contact, under "
+                                                 "the heap's own surface (no hydrostatic line: the surface is not level)")
     b = nice_value(np.nanmax(mag))
     scale_bar(ax, (5, -35), b * bar_scale, f"{b:g} N (contact $R_b$)", color=COMPUTED, label_right=True)
     legend_below(ax, ncol=1)
     left = fm["particles_left"]
     n = ds.sizes["particle"]
     exp_ours = (n - left) / n * paper.get("level_first", np.nan) / 2
+    fin = np.isfinite(th)
+    dev = float(np.sqrt(np.mean((mag[fin] - th[fin]) ** 2))) if fin.any() else np.nan
+    rel = dev / float(np.mean(th[fin])) if fin.any() else np.nan
     ax.set_title(f"(Fig. 10) {state_phrase(ds)}: {left} particles left in the first vessel "
                  f"(paper {paper.get('particles_left', '?')})\nsecond vessel: mean depth {e['depth']:.1f} cm "
                  f"(paper {paper.get('level_second', np.nan):.1f} cm); from the particles transferred ((N - {left})/N) x "
-                 f"{paper.get('level_first', '?')}/2 = {exp_ours:.1f} cm\nsecond-vessel loads against hydrostatics: "
-                 f"floor {e.get('floor_err', np.nan):+.1%}, side walls {e['side_err']:+.1%}")
+                 f"{paper.get('level_first', '?')}/2 = {exp_ours:.1f} cm\nsecond vessel, a heap: floor contacts against the "
+                 f"column above them, RMS {dev:.0f} N ({rel:.0%} of their mean); no hydrostatic overlay (the surface is "
+                 f"not level)")
     ax.set_xlim(-15, 335)
     ax.set_ylim(-62, 108)
     fig.suptitle(run_caption(ds), fontsize=8)
+    inferred_note(fig, inferred)
     save(fig, outputs)
 
 

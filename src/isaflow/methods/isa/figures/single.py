@@ -5,6 +5,7 @@ import numpy as np
 from ....figures.style import case_name  # noqa: F401
 from .. import metrics, theory
 from ....runfile import read
+from ....theory import free_surface_level
 from ....figures.style import (CALIBRATED, COMPUTED, LABEL_BOX, OURS_LEVEL, PAPER_LEVEL, THEORY, draw_walls,
                     legend_below, literal_levels, nice_value, plt, run_caption, save, scale_bar, state_phrase)
 
@@ -26,8 +27,19 @@ def _law_axes(ax, l_u, r_u, sym, title, note=""):
     ax.set_ylim(0, 1.08 * r_u / 1000)
 
 
-def inputs_figure(inputs, outputs):
-    """Paper Figs. 5 / 7: initial lattice, rhombic element, both force laws."""
+def inferred_note(fig, note, width=150):
+    """The figure's inferred inputs (config/methods/isa_workflow.yaml 'inferred'), a red header line above the
+    title marked 'inferred' (the saved figure's tight box takes it in)."""
+    if note:
+        import textwrap
+
+        text = "\n".join(textwrap.wrap(f"inferred: {note}", width))
+        fig.text(0.5, 1.0, text, fontsize=8, color="tab:red", style="italic", ha="center", va="bottom")
+
+
+def inputs_figure(inputs, outputs, inferred=None):
+    """Paper Figs. 5 / 7: initial lattice, rhombic element, both force laws; inferred: the footer naming the
+    inferred inputs drawn (config/methods/isa_workflow.yaml)."""
     ds = read(inputs[0])
     a = float(ds.attrs["spacing"])
     pos = ds["pos0"].values
@@ -70,6 +82,7 @@ def inputs_figure(inputs, outputs):
     fig.subplots_adjust(hspace=0.3)
     fig.suptitle(f"Inputs of scene {case_name(ds)}: du = {ds.attrs['du'] * 10:g} mm, f_tol = {ds.attrs['f_tol']:g} N "
                  f"(solver: {ds.attrs['variant_label']})")
+    inferred_note(fig, inferred)
     save(fig, outputs)
 
 
@@ -91,8 +104,13 @@ def _contact_bars(ax, ds, th, scale):
             ax.plot([base[0], tip[0]], [base[1], tip[1]], color=color, lw=2.2, solid_capstyle="butt")
 
 
-def _level_lines(ax, x_span, level, paper_level, literal):
-    """Our level (solid blue) and the paper's (dashed red) across x_span, named in the legend only."""
+def _level_lines(ax, x_span, level, paper_level, literal, initial=None):
+    """Our level (solid blue), the initial (uncompacted) lattice's level (thin grey) and the paper's (dashed red)
+    across x_span, named in the legend only."""
+    if initial is not None:
+        ax.plot(x_span, [initial] * 2, color="0.45", ls=(0, (2, 2)), lw=1.1, zorder=3,
+                label=f"initial (uncompacted) lattice, same reading: {initial:.1f} cm ({1 - level / initial:.0%} "
+                      f"of the depth lost)")
     ours = f"our level {level:.1f} cm"
     if paper_level is not None:
         ours += f": {CALIBRATED}"
@@ -105,10 +123,12 @@ def _level_lines(ax, x_span, level, paper_level, literal):
                 **{**PAPER_LEVEL, "lw": 3.0, "alpha": 0.7})
 
 
-def single_vessel_figure(inputs, outputs, paper_level=None, calibration=None):
-    """Paper Figs. 6 / 8: final state, level, wall reactions vs hydrostatic theory.
+def single_vessel_figure(inputs, outputs, paper_level=None, calibration=None, inferred=None):
+    """Paper Figs. 6 / 8: final state, level (and the uncompacted initial lattice's), wall reactions vs
+    hydrostatic theory.
 
-    calibration: results/calibration.csv, for the level of the literal reading k_p = k_b / 2."""
+    calibration: results/calibration.csv, for the level of the literal reading k_p = k_b / 2; inferred: the
+    footer naming the inferred inputs the figure rests on."""
     ds = read(inputs[0])
     e, (_, _, _, th) = metrics.contact_loads(ds, None, "level")
     pos = ds["pos"].values
@@ -118,7 +138,8 @@ def single_vessel_figure(inputs, outputs, paper_level=None, calibration=None):
     draw_walls(ax, ds)
     ax.plot(pos[:, 0], pos[:, 1], "o", ms=3 if len(pos) < 300 else 1.6, color="k")
     x0, x1 = walls[:, [0, 2]].min(), walls[:, [0, 2]].max()
-    _level_lines(ax, (x0 - 28, x1 + 28), e["level"], paper_level, literal)
+    initial = initial_level(ds)
+    _level_lines(ax, (x0 - 28, x1 + 28), e["level"], paper_level, literal, initial)
     fmax = np.nanmax(np.concatenate([np.hypot(*ds["contact_force"].values.T), th]))
     scale = 25.0 / fmax
     _contact_bars(ax, ds, th, scale)
@@ -138,7 +159,14 @@ def single_vessel_figure(inputs, outputs, paper_level=None, calibration=None):
     ax.set_title(f"(a) {state_phrase(ds)}, and wall reactions\n{totals}")
     _pressure_panel(axp, ds, e, names, x0, x1)
     fig.suptitle(run_caption(ds), fontsize=8)
+    inferred_note(fig, inferred)
     save(fig, outputs)
+
+
+def initial_level(ds):
+    """Level [cm] of the run's initial lattice (pos0) read as the final one (top particle centres, strips of
+    width a): the uncompacted liquid's level."""
+    return float(free_surface_level(ds["pos0"].values, float(ds.attrs["spacing"]), metrics.vessel_view(ds)["x_range"]))
 
 
 def _pressure_panel(axp, ds, e, names, x0, x1):

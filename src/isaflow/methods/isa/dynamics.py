@@ -1,0 +1,158 @@
+"""The overdamped variant (not the paper's): the ISA particles as a damped dynamical system (numba).
+
+The same particles, weights and force laws as the paper's update, given masses m = w / g and a
+viscous drag on their absolute velocity:
+
+    m x'' = F(x) - c x',   c = 2 zeta sqrt(m lambda_max),
+
+F the out-of-balance force of the paper (weight + wall + pair laws, section 3), lambda_max [N/cm] the
+stiffest mode of the equilibrium and zeta its damping ratio (every softer mode is more than critically
+damped for zeta >= 1).  This is "dynamic behavior with strong damping" made explicit, so the paper's
+update (a static analysis said to approximate it, abstract and section 7) can be compared with it on a
+common normalised time axis.
+
+Integration (per step of dt [s]): v <- (v + dt F / m) / (1 + dt c / m) (the drag implicit, so a large
+zeta cannot destabilise it), x <- x + dt v; linearly stable on a mode of frequency w iff
+(dt w)^2 < 4 + 4 z dt w (settings.overdamped_dt takes half that limit on the Gershgorin bound).
+
+The stop: max|F| < f_tol (the paper's equilibrium criterion on the same forces) while the liquid is at
+rest by the project's one criterion (config/rest.yaml, isaflow.rest): e = KE / (W h) below
+``e_limit`` at every step of the last ``window`` seconds.
+
+The step loop reuses relax.py's kernels (cell-ordered pair rows, near-wall lists, the wall-crossing
+test), so forces are evaluated exactly as for the other update rules.  Units: cm, N, s; mass N s^2/cm.
+"""
+
+import numpy as np
+from numba import njit
+
+from ...core.neighbours import cell_rows
+from .relax import (CONVERGED, CROSSED, NONFINITE, RUNNING, _first_crossing, _move_and_wall_forces, _near_walls,
+                    _pair_forces, _to_caller_order, _to_cell_order)
+
+JIT = dict(cache=True, nogil=True)
+
+OVERDAMPED = 3  # settings.RULE_IDS["overdamped"]
+
+
+@njit(**JIT)
+def overdamped_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pair_r_u, dt, zeta, lambda_max,
+                      g, f_tol, e_limit, e_norm, window, n_steps, skin, force, fmax_hist, ke_hist, pos_build, state,
+                      resume, wall_p=1.0, pair_p=1.0):
+    """Run up to n_steps time steps of the overdamped dynamics in place (module docstring).
+
+    pos (N, 2) cm, vel (N, 2) cm/s, weight (N,) N (masses weight / g, g in cm/s^2), walls (W, 4) cm, box (4,)
+    cm of the cell grid; dt s; zeta, lambda_max N/cm set the drag c = 2 zeta sqrt(m lambda_max) N s/cm of each
+    particle; f_tol N; the rest test e = KE / e_norm < e_limit over window s (e_norm = W h, N cm).
+    force (N, 2) receives the final out-of-balance forces [N] (no drag); fmax_hist[k] and ke_hist[k] the max|F|
+    [N] and kinetic energy [N cm] *before* step k.
+
+    Restart state (in and out): pos_build (N, 2) cm, the positions at the last list build, and state (5,) =
+    (moved bound since that build [cm], simulated time t [s], start of the current quiet stretch [s] (-1: none),
+    unused, largest displacement component of any particle in any step of this call [cm]).  resume=False builds
+    the list from pos and sets moved = 0; t and the quiet stretch always continue from state.
+
+    Returns (steps_done, status, crossing) as relax.relax_resume.
+    """
+    n = pos.shape[0]
+    nw = walls.shape[0]
+    rc = pair_l_u + skin
+    reach = wall_l_u + skin
+    order = np.empty(n, np.int32)
+    rank = np.empty(n, np.int32)
+    row_start = np.empty(n + 1, np.int32)
+    pos_c = np.empty((n, 2))
+    vel_c = np.empty((n, 2))
+    force_c = np.empty((n, 2))
+    weight_c = np.empty(n)
+    if not resume:
+        pos_build[:, :] = pos
+    nbr, cstart = cell_rows(pos_build, box, rc, order, np.empty(1, np.int32), row_start,
+                            np.empty(4 * n + 16, np.int32))
+    _to_cell_order(pos_build, vel, weight, order, nbr, row_start[n], rank, pos_c, vel_c, weight_c)
+    near_part, near_wall = _near_walls(pos_c, walls, reach)
+    if resume:
+        for q in range(n):
+            pos_c[q, 0] = pos[order[q], 0]
+            pos_c[q, 1] = pos[order[q], 1]
+        moved = state[0]
+    else:
+        moved = 0.0
+    t = state[1]
+    quiet = state[2]
+    _move_and_wall_forces(pos_c, force_c, 0.0, False, weight_c, walls, wall_l_u, wall_r_u, near_part, near_wall,
+                          force_c, wall_p)
+    fmax, bad = _pair_forces(pos_c, pair_l_u, pair_r_u, row_start, nbr, force_c, pair_p)
+    ke = 0.0
+    for i in range(n):  # caller order, as the sums below
+        q = rank[i]
+        ke += 0.5 * weight_c[q] / g * (vel_c[q, 0] ** 2 + vel_c[q, 1] ** 2)
+    status = RUNNING
+    crossing = -1
+    done = n_steps
+    step_move = 0.0
+    for step in range(n_steps + 1):
+        if step < n_steps:
+            fmax_hist[step] = fmax
+            ke_hist[step] = ke
+        if bad >= 0:
+            status = NONFINITE
+            crossing = order[bad]
+            done = step
+            break
+        if step == n_steps:
+            break
+        if fmax < f_tol and quiet >= 0.0 and t - quiet >= window - 1e-12:
+            status = CONVERGED
+            done = step
+            break
+        vmax = 0.0
+        for q in range(n):
+            inv_m = g / weight_c[q]
+            damp = 1.0 + dt * 2.0 * zeta * np.sqrt(lambda_max * inv_m)  # 1 + dt c / m
+            vel_c[q, 0] = (vel_c[q, 0] + dt * inv_m * force_c[q, 0]) / damp
+            vel_c[q, 1] = (vel_c[q, 1] + dt * inv_m * force_c[q, 1]) / damp
+            vmax = max(vmax, abs(vel_c[q, 0]), abs(vel_c[q, 1]))
+        max_move = np.sqrt(2.0) * dt * vmax
+        step_move = max(step_move, dt * vmax)
+        i, w = _first_crossing(pos_c, vel_c, dt, walls, order, near_part, not (moved + max_move < reach))
+        if i >= 0:  # tested before any particle moved: the step is not taken
+            status = CROSSED
+            crossing = i * nw + w
+            done = step
+            break
+        moved += max_move
+        if moved > 0.5 * skin:
+            for q in range(n):
+                pos_c[q, 0] = pos_c[q, 0] + dt * vel_c[q, 0]
+                pos_c[q, 1] = pos_c[q, 1] + dt * vel_c[q, 1]
+            _to_caller_order(order, pos_c, pos)
+            _to_caller_order(order, vel_c, vel)
+            pos_build[:, :] = pos
+            nbr, cstart = cell_rows(pos, box, rc, order, cstart, row_start, nbr)
+            _to_cell_order(pos, vel, weight, order, nbr, row_start[n], rank, pos_c, vel_c, weight_c)
+            near_part, near_wall = _near_walls(pos_c, walls, reach)
+            moved = 0.0
+            _move_and_wall_forces(pos_c, vel_c, dt, False, weight_c, walls, wall_l_u, wall_r_u, near_part,
+                                  near_wall, force_c, wall_p)
+        else:
+            _move_and_wall_forces(pos_c, vel_c, dt, True, weight_c, walls, wall_l_u, wall_r_u, near_part,
+                                  near_wall, force_c, wall_p)
+        fmax, bad = _pair_forces(pos_c, pair_l_u, pair_r_u, row_start, nbr, force_c, pair_p)
+        t += dt
+        ke = 0.0
+        for i in range(n):
+            q = rank[i]
+            ke += 0.5 * weight_c[q] / g * (vel_c[q, 0] ** 2 + vel_c[q, 1] ** 2)
+        if ke / e_norm < e_limit:
+            if quiet < 0.0:
+                quiet = t
+        else:
+            quiet = -1.0
+    _to_caller_order(order, pos_c, pos)
+    _to_caller_order(order, vel_c, vel)
+    _to_caller_order(order, force_c, force)
+    state[0], state[1], state[2] = moved, t, quiet
+    if state.shape[0] > 4:
+        state[4] = step_move
+    return done, status, crossing
