@@ -1,4 +1,4 @@
-"""The compiled relaxation loop of incremental static analysis (numba).
+"""The compiled relaxation loop of incremental static analysis (numba), serial or parallel.
 
 Update rules (``rule`` argument of :func:`relax`):
 - PAPER  : x += du F / max|F|                      (paper section 3.3, literal)
@@ -10,21 +10,63 @@ Status codes: RUNNING, CONVERGED (max|F| < f_tol), NONFINITE (a position or
 force is NaN or infinite), CROSSED (a step would carry a particle across a
 wall; the step is not taken).  :func:`relax_resume` takes and returns the
 restart state (list-build positions, moved bound, FIRE dt/alpha/n_pos).
+
+Threads: the per-step passes run in ``threads`` blocks (argument; the
+solver passes the solve's thread count and sets numba's to it with
+``numba.set_num_threads``; reading numba's count inside compiled code would
+stop numba from caching the loop).  Every pass
+writes per-particle or per-pair results that do not depend on how the
+particles are split between threads, and its only reductions are a maximum
+and a first index (exact in any order), so 1 and 2 threads give the same
+bits.  The sums of pair forces are formed per particle by gathering (see
+:func:`_sum_range`) in the order of the serial scatter they replaced, so the
+results are also those of the plain loop "move; rebuild with build_pairs if
+due; forces.forces" to the last bit (tests/test_kernels_perf_equivalence.py).
+FIRE's power and norms are sums over all particles in the caller's order:
+they stay one serial loop (a split sum would round differently).
 """
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from ...core.geometry import crossed_wall, segment_closest
 from ...core.neighbours import cell_rows, push_pair
 from .forces import pair_push, track_max, wall_push
 
 JIT = dict(cache=True, nogil=True)
+PJIT = dict(cache=True, nogil=True, parallel=True)
+# no division-by-zero check (numpy's error model): lets LLVM vectorise the pair forces; every division in
+# these functions either has a non-zero divisor or its result is discarded
+NJIT = dict(cache=True, nogil=True, error_model="numpy")
 
 PAPER, CAPPED, FIRE = 0, 1, 2
 RUNNING, CONVERGED, NONFINITE, CROSSED = 0, 1, 2, 3
 # FIRE constants (Bitzek et al. 2006): N_min, f_inc, f_dec, alpha_start, f_alpha
 FIRE_N_MIN, FIRE_F_INC, FIRE_F_DEC, FIRE_ALPHA0, FIRE_F_ALPHA = 5, 1.1, 0.5, 0.1, 0.99
+# particles per thread below which a step runs serially: a parallel pass costs a fork and a join
+# (a few microseconds), more than it saves on fewer particles (benchmarks/bench_step.py)
+PAR_MIN_PER_THREAD = 2000
+CHUNK_ROWS = 128  # rows whose pair forces are computed together (vectorised) before the sweep adds them
+
+
+@njit(**NJIT)
+def _pair_forces_vec(gx, gy, l_u, r_u):
+    """In place: (gx[k], gy[k]) = separation x_i - x_j [cm] on entry, forces.pair_push's force [N] on i
+    on exit, by the same operations without branches, so that they vectorise (the division by a zero
+    distance is computed and discarded, hence numpy's error model).  Pass views gx[k0:k1]: indices
+    from 0 need no negative-index wraparound, which would stop the vectoriser."""
+    inv = 1.0 / l_u
+    lu2 = l_u * l_u
+    for k in range(gx.shape[0]):
+        dx = gx[k]
+        dy = gy[k]
+        d2 = dx * dx + dy * dy
+        d = np.sqrt(d2)
+        s = r_u * (1.0 / d - inv)
+        far = d2 >= lu2
+        zero = not d > 0.0
+        gx[k] = 0.0 if far else (r_u if zero else s * dx)
+        gy[k] = 0.0 if far else (0.0 if zero else s * dy)
 
 
 @njit(**JIT)
@@ -48,81 +90,202 @@ def _near_walls(pos, walls, reach):
 
 
 @njit(**JIT)
-def _move_and_wall_forces(pos, direction, scale, move, weight, walls, wall_l_u, wall_r_u, near_part, near_wall, force):
-    """If move: pos += scale * direction.  Then force = weight + wall forces at pos (one pass).
-
-    Walls are taken from the near-wall list only: the other walls would add
-    exact zeros, so force is the same as in forces.forces.
-    """
-    n = pos.shape[0]
-    c = 0
-    nc = near_part.shape[0]
+def _row_starts(keys, n, start):
+    """start (n + 1,) int32 of ascending keys (C,): entries start[q] <= c < start[q + 1] have keys[c] == q."""
+    start[:] = 0
+    for c in range(keys.shape[0]):
+        start[keys[c] + 1] += 1
     for q in range(n):
-        if move:
-            pos[q, 0] = pos[q, 0] + scale * direction[q, 0]
-            pos[q, 1] = pos[q, 1] + scale * direction[q, 1]
-        fx = 0.0
-        fy = -weight[q]
-        while c < nc and near_part[c] == q:
-            w = near_wall[c]
-            gx, gy = wall_push(pos[q, 0], pos[q, 1], walls[w, 0], walls[w, 1], walls[w, 2], walls[w, 3],
-                               wall_l_u, wall_r_u)
-            fx += gx
-            fy += gy
-            c += 1
-        force[q, 0] = fx
-        force[q, 1] = fy
+        start[q + 1] += start[q]
 
 
 @njit(**JIT)
-def _pair_forces(pos, pair_l_u, pair_r_u, row_start, nbr, force):
-    """Add the pair forces of the row list to force; returns (max|F| as forces.forces does, bad).
-
-    bad: the first particle (cell order) whose position or force is NaN or
-    infinite (then max|F| is NaN), else -1.  Positions are checked too: the
-    force laws return finite forces for NaN distances (their "coincident"
-    branch), so a force check alone would miss them.
-
-    Row q holds particle q's pairs (q, nbr[k]) for row_start[q] <= k <
-    row_start[q + 1], in the order of core.neighbours.build_pairs, so every
-    force component receives the same additions in the same order as in
-    forces.forces.  A row's particle is complete after its row (the rows that
-    reach it come from its own cell, earlier entries, and from the cells W,
-    SW, S, SE, which all come first), so max|F| is taken on the fly.
-    """
-    fmax = 0.0
-    bad = -1
-    for q in range(pos.shape[0]):
-        xi = pos[q, 0]
-        yi = pos[q, 1]
-        fx = force[q, 0]
-        fy = force[q, 1]
+def _pair_scratch(row_start, n, owner, gx, gy):
+    """(owner, gx, gy) for the row list row_start: owner[k] = the row of pair k (int32), gx, gy
+    scratch of the pair forces [N]; the arrays given are reused unless too small."""
+    m = row_start[n]
+    if owner.shape[0] < m:
+        owner = np.empty(m + m // 4 + 16, np.int32)
+        gx = np.empty(owner.shape[0])
+        gy = np.empty(owner.shape[0])
+    for q in range(n):
         for k in range(row_start[q], row_start[q + 1]):
+            owner[k] = q
+    return owner, gx, gy
+
+
+@njit(**JIT)
+def _halo_rows(row_start, nbr, n, nb, halo):
+    """halo (nb,) int64: the first row (cell order) with a pair whose partner lies in block b
+    (particles b n / nb <= j < (b + 1) n / nb) while the row itself lies before the block;
+    the block's first particle if there is none."""
+    for b in range(nb):
+        halo[b] = b * n // nb
+    for q in range(n):
+        for k in range(row_start[q], row_start[q + 1]):
+            b = (nbr[k] * nb + nb - 1) // n  # candidate block of the partner, corrected below
             j = nbr[k]
-            gx, gy = pair_push(xi - pos[j, 0], yi - pos[j, 1], pair_l_u, pair_r_u)
-            fx += gx
-            fy += gy
-            force[j, 0] -= gx
-            force[j, 1] -= gy
+            while b > 0 and j < b * n // nb:
+                b -= 1
+            while b < nb - 1 and j >= (b + 1) * n // nb:
+                b += 1
+            if q < halo[b]:
+                halo[b] = q
+
+
+@njit(**NJIT)
+def _forces_range(lo, hi, h, pos, new, direction, scale, move, weight, walls, wall_l_u, wall_r_u, near_start,
+                  near_wall, pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force, fire, order, vel, power, vnorm2,
+                  fnorm2):
+    """Move particles lo <= q < hi (cell order) and evaluate their forces; returns (max|F|, bad) of the range.
+
+    new[q] = pos[q] + scale direction[q] if move else pos[q] (cm); force[q] =
+    weight + wall forces at new[q] (walls of the near-wall rows only: the
+    others add exact zeros) + pair forces [N], summed in the serial order:
+    q's wall forces, then every pair (q', q) of an earlier row q' < q (rows in
+    order), then q's own row -- the order of the one-block sweep, where row q
+    adds its pairs to q and subtracts them from their partners.
+
+    Parallel blocks: a block's particles receive pairs from earlier rows that
+    belong to other blocks (rows h <= q' < lo, see :func:`_halo_rows`); the
+    block evaluates those pairs itself first, then sweeps its own rows,
+    subtracting only from partners inside the block.  A particle of another
+    block is placed by the same expression pos + scale direction, so it equals
+    that block's new[j] bit for bit without waiting for it (pos, direction are
+    read-only during the pass; force must not be direction).  bad: the first
+    particle of the range whose position or force is not finite (then max|F|
+    is NaN), else -1.  fire: also store FIRE's per-particle terms v.F, |v|^2,
+    |F|^2 at the caller's index order[q] (summed in that order by
+    :func:`_fire_step`).
+    """
+    for i in range(lo, hi):
+        q = np.uint64(i)  # unsigned: no negative-index wraparound
+        if move:
+            xi = pos[q, 0] + scale * direction[q, 0]
+            yi = pos[q, 1] + scale * direction[q, 1]
+        else:
+            xi = pos[q, 0]
+            yi = pos[q, 1]
+        new[q, 0] = xi
+        new[q, 1] = yi
+        fx = 0.0
+        fy = -weight[q]
+        for c in range(near_start[q], near_start[q + 1]):
+            w = near_wall[c]
+            ax, ay = wall_push(xi, yi, walls[w, 0], walls[w, 1], walls[w, 2], walls[w, 3], wall_l_u, wall_r_u)
+            fx += ax
+            fy += ay
         force[q, 0] = fx
         force[q, 1] = fy
-        fmax, finite = track_max(fx, fy, fmax, (abs(xi) < np.inf) & (abs(yi) < np.inf))
+    for q in range(h, lo):  # pairs of earlier blocks' rows with partners in this block
+        xi = pos[q, 0]
+        yi = pos[q, 1]
+        if move:
+            xi = xi + scale * direction[q, 0]
+            yi = yi + scale * direction[q, 1]
+        for k in range(row_start[q], row_start[q + 1]):
+            j = nbr[k]
+            if j >= lo and j < hi:
+                ax, ay = pair_push(xi - new[j, 0], yi - new[j, 1], pair_l_u, pair_r_u)
+                force[j, 0] -= ax
+                force[j, 1] -= ay
+    # the block's pairs: views from 0 and unsigned particle numbers need no negative-index wraparound
+    k0 = row_start[lo]
+    k1 = row_start[hi]
+    own = owner[k0:k1]
+    par = nbr[k0:k1]
+    bx = gx[k0:k1]
+    by = gy[k0:k1]
+    uhi = np.uint32(hi)
+    for k in range(own.shape[0]):  # separations
+        q = np.uint32(own[k])
+        j = np.uint32(par[k])
+        if j < uhi:
+            xj = new[j, 0]
+            yj = new[j, 1]
+        else:
+            xj = pos[j, 0]
+            yj = pos[j, 1]
+            if move:
+                xj = xj + scale * direction[j, 0]
+                yj = yj + scale * direction[j, 1]
+        bx[k] = new[q, 0] - xj
+        by[k] = new[q, 1] - yj
+    _pair_forces_vec(bx, by, pair_l_u, pair_r_u)
+    for k in range(own.shape[0]):  # the sweep: in pair order, each row adds to its particle, subtracts from partners
+        q = np.uint32(own[k])
+        j = np.uint32(par[k])
+        ax = bx[k]
+        ay = by[k]
+        force[q, 0] += ax
+        force[q, 1] += ay
+        if j < uhi:
+            force[j, 0] -= ax
+            force[j, 1] -= ay
+    fmax = 0.0
+    bad = -1
+    for i in range(lo, hi):
+        q = np.uint64(i)
+        fx = force[q, 0]
+        fy = force[q, 1]
+        fmax, finite = track_max(fx, fy, fmax, (abs(new[q, 0]) < np.inf) & (abs(new[q, 1]) < np.inf))
         if not finite and bad < 0:
-            bad = q
+            bad = i
+        if fire:
+            i = order[q]
+            power[i] = vel[q, 0] * fx + vel[q, 1] * fy
+            vnorm2[i] = vel[q, 0] ** 2 + vel[q, 1] ** 2
+            fnorm2[i] = fx ** 2 + fy ** 2
     if bad >= 0:
         return np.nan, bad
     return fmax, bad
 
 
+@njit(**PJIT)
+def _forces_par(nb, halo, pos, new, direction, scale, move, weight, walls, wall_l_u, wall_r_u, near_start,
+                near_wall, pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force, fire, order, vel, power, vnorm2, fnorm2,
+                fmax_b, bad_b):
+    """:func:`_forces_range` over nb blocks in parallel; (max|F|, bad) of block b in fmax_b[b], bad_b[b]."""
+    n = pos.shape[0]
+    for b in prange(nb):
+        fmax_b[b], bad_b[b] = _forces_range(b * n // nb, (b + 1) * n // nb, halo[b], pos, new, direction, scale,
+                                            move, weight, walls, wall_l_u, wall_r_u, near_start, near_wall,
+                                            pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force, fire, order, vel, power,
+                                            vnorm2, fnorm2)
+
+
 @njit(**JIT)
-def _first_crossing(pos, direction, scale, walls, order, near_part, test_all):
-    """(particle, wall) of the lowest-numbered particle whose move pos += scale * direction
-    crosses a wall, or (-1, -1).  Only near-wall particles are tested unless
-    test_all; particle numbers are the caller's (order[q])."""
+def _evaluate(nb, halo, pos, new, direction, scale, move, weight, walls, wall_l_u, wall_r_u, near_start, near_wall,
+              pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force, fire, order, vel, power, vnorm2, fnorm2, fmax_b, bad_b):
+    """Move (if move) into new and evaluate force there: returns (max|F| [N], bad) as forces.forces.
+
+    nb blocks of particles (nb <= 1: one serial pass).  The blocks' maxima
+    and first bad particles combine exactly, whatever nb.
+    """
+    n = pos.shape[0]
+    if nb <= 1:
+        return _forces_range(0, n, 0, pos, new, direction, scale, move, weight, walls, wall_l_u, wall_r_u,
+                             near_start, near_wall, pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force, fire, order, vel,
+                             power, vnorm2, fnorm2)
+    _forces_par(nb, halo, pos, new, direction, scale, move, weight, walls, wall_l_u, wall_r_u, near_start, near_wall,
+                pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force, fire, order, vel, power, vnorm2, fnorm2, fmax_b, bad_b)
+    fmax = 0.0
+    for b in range(nb):
+        if bad_b[b] >= 0:
+            return np.nan, bad_b[b]
+        fmax = max(fmax, fmax_b[b])
+    return fmax, -1
+
+
+@njit(**JIT)
+def _crossing_range(lo, hi, pos, direction, scale, walls, order, near_part, test_all):
+    """(particle, wall) of the lowest-numbered particle (caller's numbers, order[q]) among the
+    entries lo <= c < hi (particles if test_all, else near-wall rows) whose move pos +=
+    scale * direction crosses a wall, or (-1, -1)."""
     best = -1
     best_wall = -1
     last = -1
-    for c in range(pos.shape[0] if test_all else near_part.shape[0]):
+    for c in range(lo, hi):
         q = c if test_all else near_part[c]
         if q == last:
             continue
@@ -135,6 +298,33 @@ def _first_crossing(pos, direction, scale, walls, order, near_part, test_all):
         if w >= 0:
             best = i
             best_wall = w
+    return best, best_wall
+
+
+@njit(**PJIT)
+def _crossing_par(nb, pos, direction, scale, walls, order, near_part, best_b, wall_b):
+    """:func:`_crossing_range` over all particles in nb blocks in parallel."""
+    n = pos.shape[0]
+    for b in prange(nb):
+        best_b[b], wall_b[b] = _crossing_range(b * n // nb, (b + 1) * n // nb, pos, direction, scale, walls, order,
+                                               near_part, True)
+
+
+@njit(**JIT)
+def _first_crossing(nb, pos, direction, scale, walls, order, near_part, test_all, best_b, wall_b):
+    """(particle, wall) of the lowest-numbered particle whose move pos += scale * direction
+    crosses a wall, or (-1, -1).  Only near-wall particles are tested unless
+    test_all (then in nb parallel blocks if nb > 1; the lowest number is the same)."""
+    if not test_all or nb <= 1:
+        return _crossing_range(0, pos.shape[0] if test_all else near_part.shape[0], pos, direction, scale, walls,
+                               order, near_part, test_all)
+    _crossing_par(nb, pos, direction, scale, walls, order, near_part, best_b, wall_b)
+    best = -1
+    best_wall = -1
+    for b in range(nb):
+        if best_b[b] >= 0 and (best < 0 or best_b[b] < best):
+            best = best_b[b]
+            best_wall = wall_b[b]
     return best, best_wall
 
 
@@ -163,26 +353,50 @@ def _to_caller_order(order, src, dst):
 
 
 @njit(**JIT)
-def _fire_velocities(vel, force, rank, dt, dt_max, alpha, n_pos):
-    """One FIRE velocity update (Bitzek et al. 2006) in place; returns (dt, alpha, n_pos).
+def _fire_range(lo, hi, vel, force, mix, one_minus_alpha, c, dt):
+    """FIRE's velocity update of particles lo <= q < hi: v = (1 - alpha) v + c F if mix, else
+    v = 0; then v += dt F (semi-implicit Euler).  Returns max(|vx|, |vy|) over the range."""
+    vmax = 0.0
+    for q in range(lo, hi):
+        if mix:
+            vel[q, 0] = one_minus_alpha * vel[q, 0] + c * force[q, 0]
+            vel[q, 1] = one_minus_alpha * vel[q, 1] + c * force[q, 1]
+        else:
+            vel[q, 0] = 0.0
+            vel[q, 1] = 0.0
+        vel[q, 0] += dt * force[q, 0]
+        vel[q, 1] += dt * force[q, 1]
+        vmax = max(vmax, abs(vel[q, 0]), abs(vel[q, 1]))
+    return vmax
 
-    Power and norms are summed in the caller's particle order (rank maps it to
-    cell order), as in a plain loop over particles.
-    """
+
+@njit(**PJIT)
+def _fire_par(nb, vel, force, mix, one_minus_alpha, c, dt, vmax_b):
     n = vel.shape[0]
+    for b in prange(nb):
+        vmax_b[b] = _fire_range(b * n // nb, (b + 1) * n // nb, vel, force, mix, one_minus_alpha, c, dt)
+
+
+@njit(**JIT)
+def _fire_step(nb, vel, force, power_i, vnorm2_i, fnorm2_i, dt, dt_max, alpha, n_pos, vmax_b):
+    """One FIRE velocity update (Bitzek et al. 2006) followed by v += dt F, in place.
+
+    Returns (dt, alpha, n_pos, vmax).  Power and norms are summed over the
+    per-particle terms of :func:`_sum_range`, stored in the caller's particle
+    order, in that order (as a plain loop over particles), serially.
+    """
     power = 0.0
     vnorm2 = 0.0
     fnorm2 = 0.0
-    for i in range(n):
-        q = rank[i]
-        power += vel[q, 0] * force[q, 0] + vel[q, 1] * force[q, 1]
-        vnorm2 += vel[q, 0] ** 2 + vel[q, 1] ** 2
-        fnorm2 += force[q, 0] ** 2 + force[q, 1] ** 2
-    if power > 0.0:
+    for i in range(power_i.shape[0]):
+        power += power_i[i]
+        vnorm2 += vnorm2_i[i]
+        fnorm2 += fnorm2_i[i]
+    mix = power > 0.0
+    one_minus_alpha = 1.0 - alpha
+    c = 0.0
+    if mix:
         c = alpha * np.sqrt(vnorm2 / fnorm2)
-        for q in range(n):
-            vel[q, 0] = (1.0 - alpha) * vel[q, 0] + c * force[q, 0]
-            vel[q, 1] = (1.0 - alpha) * vel[q, 1] + c * force[q, 1]
         n_pos += 1
         if n_pos > FIRE_N_MIN:
             dt = min(FIRE_F_INC * dt, dt_max)
@@ -191,25 +405,40 @@ def _fire_velocities(vel, force, rank, dt, dt_max, alpha, n_pos):
         n_pos = 0
         dt *= FIRE_F_DEC
         alpha = FIRE_ALPHA0
-        vel[:, :] = 0.0
-    return dt, alpha, n_pos
+    if nb <= 1:
+        vmax = _fire_range(0, vel.shape[0], vel, force, mix, one_minus_alpha, c, dt)
+    else:
+        _fire_par(nb, vel, force, mix, one_minus_alpha, c, dt, vmax_b)
+        vmax = 0.0
+        for b in range(nb):
+            vmax = max(vmax, vmax_b[b])
+    return dt, alpha, n_pos, vmax
+
+
+@njit(**JIT)
+def blocks(n, threads):
+    """Blocks of particles a step is split into: 1 (serial) unless every thread gets at least
+    PAR_MIN_PER_THREAD particles; then one per thread."""
+    if threads <= 1 or n < threads * PAR_MIN_PER_THREAD:
+        return 1
+    return threads
 
 
 @njit(**JIT)
 def relax(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pair_r_u, rule, du, f_ref,
-          dt_max, f_tol, n_steps, skin, force, fmax_hist):
+          dt_max, f_tol, n_steps, skin, force, fmax_hist, threads=1):
     """One chunk from a fresh start (neighbour list built from pos, FIRE reset); see :func:`relax_resume`.
 
     Returns (steps_done, status, crossing).
     """
     state = np.zeros(4)
     return relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pair_r_u, rule, du, f_ref,
-                        dt_max, f_tol, n_steps, skin, force, fmax_hist, np.empty_like(pos), state, False)
+                        dt_max, f_tol, n_steps, skin, force, fmax_hist, np.empty_like(pos), state, False, threads)
 
 
 @njit(**JIT)
 def relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pair_r_u, rule, du, f_ref,
-                 dt_max, f_tol, n_steps, skin, force, fmax_hist, pos_build, state, resume):
+                 dt_max, f_tol, n_steps, skin, force, fmax_hist, pos_build, state, resume, threads):
     """Run up to n_steps relaxation steps in place; the whole loop is compiled.
 
     pos (N, 2) cm, vel (N, 2) (FIRE velocities), weight (N,) N, walls (W, 4) cm,
@@ -226,35 +455,59 @@ def relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pai
     built from pos, moved = 0 and FIRE is reset (dt = dt_max / 10).
     resume=True rebuilds the list from pos_build and continues with the
     given state, so a run split anywhere repeats the unsplit run bit for bit.
+    threads: how many blocks the passes may run in (:func:`blocks`; the
+    results do not depend on it).
 
     Implementation (results identical, to the last bit, to the plain loop
-    "move; rebuild with build_pairs if due; forces.forces"): the pair list is
-    build_pairs' list in the same order, stored by rows (core.neighbours.
-    cell_rows), and the state is kept in that cell order between builds, so
-    the passes stream through memory; the caller's arrays are written back on
-    return.  The move and the weight + wall forces share one pass; wall
-    forces and the crossing test only visit particles that were within
-    wall_l_u + skin of a wall at the last build (no other particle can come
-    within wall_l_u of a wall, or reach one, before the next build; if one
-    step could reach farther, every particle is tested).
+    "move; rebuild with build_pairs if due; forces.forces", for any number of
+    threads): the pair list is build_pairs' list in the same order, stored by
+    rows (core.neighbours.cell_rows), and the state is kept in that cell order
+    between builds, so the passes stream through memory; the caller's arrays
+    are written back on return.  A step is one pass over the particles
+    (:func:`_evaluate`): move, weight and wall forces, then the rows' pair
+    forces; positions and forces are double-buffered so that parallel blocks
+    read the previous step's only (:func:`_forces_range`).  Wall forces and the crossing test only visit particles that were
+    within wall_l_u + skin of a wall at the last build (no other particle can
+    come within wall_l_u of a wall, or reach one, before the next build; if
+    one step could reach farther, every particle is tested).  The passes run
+    in parallel blocks, one per thread (:func:`blocks`).
     """
     n = pos.shape[0]
     nw = walls.shape[0]
+    nb = blocks(n, threads)
+    fire = rule == FIRE
     rc = pair_l_u + skin
     reach = wall_l_u + skin
     order = np.empty(n, np.int32)  # order[q]: caller's index of the q-th particle in cell order
     rank = np.empty(n, np.int32)  # inverse of order
     row_start = np.empty(n + 1, np.int32)
+    near_start = np.empty(n + 1, np.int32)
     pos_c = np.empty((n, 2))
+    new_c = np.empty((n, 2))
     vel_c = np.empty((n, 2))
     force_c = np.empty((n, 2))
+    force_n = np.empty((n, 2))  # the next forces (force_c is the move direction of the paper/capped rules)
     weight_c = np.empty(n)
+    nf = n if fire else 0
+    power_i = np.empty(nf)
+    vnorm2_i = np.empty(nf)
+    fnorm2_i = np.empty(nf)
+    fmax_b = np.empty(nb)
+    bad_b = np.empty(nb, np.int64)
+    vmax_b = np.empty(nb)
+    best_b = np.empty(nb, np.int64)
+    wall_b = np.empty(nb, np.int64)
+    halo = np.empty(nb, np.int64)
     if not resume:
         pos_build[:, :] = pos
     nbr, cstart = cell_rows(pos_build, box, rc, order, np.empty(1, np.int32), row_start,
                             np.empty(4 * n + 16, np.int32))
     _to_cell_order(pos_build, vel, weight, order, nbr, row_start[n], rank, pos_c, vel_c, weight_c)
+    owner, gx, gy = _pair_scratch(row_start, n, np.empty(0, np.int32), np.empty(0), np.empty(0))
+    if nb > 1:
+        _halo_rows(row_start, nbr, n, nb, halo)
     near_part, near_wall = _near_walls(pos_c, walls, reach)
+    _row_starts(near_part, n, near_start)
     if resume:
         for q in range(n):
             pos_c[q, 0] = pos[order[q], 0]
@@ -262,9 +515,11 @@ def relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pai
         moved, dt, alpha, n_pos = state[0], state[1], state[2], int(state[3])
     else:
         moved, dt, alpha, n_pos = 0.0, 0.1 * dt_max, FIRE_ALPHA0, 0  # moved: bound on any displacement, cm
-    _move_and_wall_forces(pos_c, force_c, 0.0, False, weight_c, walls, wall_l_u, wall_r_u, near_part, near_wall,
-                          force_c)
-    fmax, bad = _pair_forces(pos_c, pair_l_u, pair_r_u, row_start, nbr, force_c)
+    fmax, bad = _evaluate(nb, halo, pos_c, new_c, force_c, 0.0, False, weight_c, walls, wall_l_u, wall_r_u,
+                          near_start, near_wall, pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force_n, fire, order, vel_c,
+                          power_i, vnorm2_i, fnorm2_i, fmax_b, bad_b)
+    pos_c, new_c = new_c, pos_c
+    force_c, force_n = force_n, force_c
     status = RUNNING
     crossing = -1
     done = n_steps
@@ -282,14 +537,10 @@ def relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pai
             status = CONVERGED
             done = step
             break
-        if rule == FIRE:
-            dt, alpha, n_pos = _fire_velocities(vel_c, force_c, rank, dt, dt_max, alpha, n_pos)
+        if fire:
+            dt, alpha, n_pos, vmax = _fire_step(nb, vel_c, force_c, power_i, vnorm2_i, fnorm2_i, dt, dt_max, alpha,
+                                                n_pos, vmax_b)
             # semi-implicit Euler with the step capped at du
-            vmax = 0.0
-            for q in range(n):
-                vel_c[q, 0] += dt * force_c[q, 0]
-                vel_c[q, 1] += dt * force_c[q, 1]
-                vmax = max(vmax, abs(vel_c[q, 0]), abs(vel_c[q, 1]))
             scale = dt
             if vmax * dt > du:
                 scale = du / vmax
@@ -300,13 +551,15 @@ def relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pai
             direction = force_c
             max_move = np.sqrt(2.0) * (scale * fmax)
         # refuse any move across a wall
-        i, w = _first_crossing(pos_c, direction, scale, walls, order, near_part, not (moved + max_move < reach))
+        i, w = _first_crossing(nb, pos_c, direction, scale, walls, order, near_part, not (moved + max_move < reach),
+                               best_b, wall_b)
         if i >= 0:  # tested before any particle moved: the step is not taken
             status = CROSSED
             crossing = i * nw + w
             done = step
             break
         moved += max_move
+        move = True
         if moved > 0.5 * skin:
             for q in range(n):
                 pos_c[q, 0] = pos_c[q, 0] + scale * direction[q, 0]
@@ -316,14 +569,18 @@ def relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pai
             pos_build[:, :] = pos
             nbr, cstart = cell_rows(pos, box, rc, order, cstart, row_start, nbr)
             _to_cell_order(pos, vel, weight, order, nbr, row_start[n], rank, pos_c, vel_c, weight_c)
+            owner, gx, gy = _pair_scratch(row_start, n, owner, gx, gy)
+            if nb > 1:
+                _halo_rows(row_start, nbr, n, nb, halo)
             near_part, near_wall = _near_walls(pos_c, walls, reach)
+            _row_starts(near_part, n, near_start)
             moved = 0.0
-            _move_and_wall_forces(pos_c, direction, scale, False, weight_c, walls, wall_l_u, wall_r_u, near_part,
-                                  near_wall, force_c)
-        else:
-            _move_and_wall_forces(pos_c, direction, scale, True, weight_c, walls, wall_l_u, wall_r_u, near_part,
-                                  near_wall, force_c)
-        fmax, bad = _pair_forces(pos_c, pair_l_u, pair_r_u, row_start, nbr, force_c)
+            move = False
+        fmax, bad = _evaluate(nb, halo, pos_c, new_c, direction, scale, move, weight_c, walls, wall_l_u, wall_r_u,
+                              near_start, near_wall, pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force_n, fire, order, vel_c,
+                              power_i, vnorm2_i, fnorm2_i, fmax_b, bad_b)
+        pos_c, new_c = new_c, pos_c
+        force_c, force_n = force_n, force_c
     _to_caller_order(order, pos_c, pos)
     _to_caller_order(order, vel_c, vel)
     _to_caller_order(order, force_c, force)
