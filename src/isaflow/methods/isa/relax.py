@@ -415,6 +415,14 @@ def _fire_step(nb, vel, force, power_i, vnorm2_i, fnorm2_i, dt, dt_max, alpha, n
     return dt, alpha, n_pos, vmax
 
 
+@njit(**PJIT)
+def start_threads(out):
+    """Touch numba's thread pool (out (T,) receives the block numbers): the first parallel call
+    starts the threads, which :func:`isaflow.methods.isa.solver.warm_up` keeps out of timings."""
+    for b in prange(out.shape[0]):
+        out[b] = b
+
+
 @njit(**JIT)
 def blocks(n, threads):
     """Blocks of particles a step is split into: 1 (serial) unless every thread gets at least
