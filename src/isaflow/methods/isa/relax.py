@@ -30,7 +30,7 @@ import numpy as np
 from numba import njit, prange
 
 from ...core.geometry import crossed_wall, segment_closest
-from ...core.neighbours import cell_rows, push_pair
+from .cells import cell_rows_par
 from .forces import pair_push, track_max, wall_push
 
 JIT = dict(cache=True, nogil=True)
@@ -70,23 +70,68 @@ def _pair_forces_vec(gx, gy, l_u, r_u):
 
 
 @njit(**JIT)
-def _near_walls(pos, walls, reach):
-    """(particle, wall) int32 pairs, ascending, with the particle closer than reach [cm] to the wall."""
-    n = pos.shape[0]
+def _near_range(lo, hi, pos, walls, r2, part, wall, c):
+    """Store (particle, wall) of particles lo <= i < hi within sqrt(r2) [cm] of a wall at part[c:],
+    wall[c:] (if part is long enough); returns the count of such pairs."""
     nw = walls.shape[0]
-    r2 = reach * reach
-    near_part = np.empty(64, np.int32)
-    near_wall = np.empty(64, np.int32)
-    c = 0
-    for i in range(n):
+    reach = np.sqrt(r2)
+    count = 0
+    for i in range(lo, hi):
         for w in range(nw):
+            # outside the wall's bounding box grown by reach: too far (a cheap test first)
+            if (pos[i, 0] < min(walls[w, 0], walls[w, 2]) - reach or pos[i, 0] > max(walls[w, 0], walls[w, 2]) + reach
+                    or pos[i, 1] < min(walls[w, 1], walls[w, 3]) - reach
+                    or pos[i, 1] > max(walls[w, 1], walls[w, 3]) + reach):
+                continue
             cx, cy = segment_closest(pos[i, 0], pos[i, 1], walls[w, 0], walls[w, 1], walls[w, 2], walls[w, 3])
             dx = pos[i, 0] - cx
             dy = pos[i, 1] - cy
             if dx * dx + dy * dy < r2:
-                near_part, near_wall = push_pair(near_part, near_wall, c, i, w)
-                c += 1
-    return near_part[:c], near_wall[:c]
+                if c + count < part.shape[0]:
+                    part[c + count] = i
+                    wall[c + count] = w
+                count += 1
+    return count
+
+
+@njit(**PJIT)
+def _near_count_par(nb, pos, walls, r2, counts):
+    n = pos.shape[0]
+    empty = np.empty(0, np.int32)
+    for b in prange(nb):
+        counts[b] = _near_range(b * n // nb, (b + 1) * n // nb, pos, walls, r2, empty, empty, 0)
+
+
+@njit(**PJIT)
+def _near_fill_par(nb, pos, walls, r2, starts, part, wall):
+    n = pos.shape[0]
+    for b in prange(nb):
+        _near_range(b * n // nb, (b + 1) * n // nb, pos, walls, r2, part, wall, starts[b])
+
+
+@njit(**JIT)
+def _near_walls(pos, walls, reach, nb):
+    """(particle, wall) int32 pairs, ascending, with the particle closer than reach [cm] to the wall
+    (nb > 1: counted, then stored, in nb parallel blocks; the same list)."""
+    n = pos.shape[0]
+    r2 = reach * reach
+    if nb <= 1:
+        c = _near_range(0, n, pos, walls, r2, np.empty(0, np.int32), np.empty(0, np.int32), 0)
+        part = np.empty(c, np.int32)
+        wall = np.empty(c, np.int32)
+        _near_range(0, n, pos, walls, r2, part, wall, 0)
+        return part, wall
+    counts = np.empty(nb, np.int64)
+    _near_count_par(nb, pos, walls, r2, counts)
+    starts = np.empty(nb, np.int64)
+    c = 0
+    for b in range(nb):
+        starts[b] = c
+        c += counts[b]
+    part = np.empty(c, np.int32)
+    wall = np.empty(c, np.int32)
+    _near_fill_par(nb, pos, walls, r2, starts, part, wall)
+    return part, wall
 
 
 @njit(**JIT)
@@ -118,19 +163,23 @@ def _pair_scratch(row_start, n, owner, gx, gy):
 def _halo_rows(row_start, nbr, n, nb, halo):
     """halo (nb,) int64: the first row (cell order) with a pair whose partner lies in block b
     (particles b n / nb <= j < (b + 1) n / nb) while the row itself lies before the block;
-    the block's first particle if there is none."""
-    for b in range(nb):
-        halo[b] = b * n // nb
+    the block's first particle if there is none.  Rows reach at most `span` particles ahead
+    (the largest nbr[k] - q of the list), so only the rows within span before a block are read."""
+    span = 0
     for q in range(n):
         for k in range(row_start[q], row_start[q + 1]):
-            b = (nbr[k] * nb + nb - 1) // n  # candidate block of the partner, corrected below
-            j = nbr[k]
-            while b > 0 and j < b * n // nb:
-                b -= 1
-            while b < nb - 1 and j >= (b + 1) * n // nb:
-                b += 1
-            if q < halo[b]:
-                halo[b] = q
+            span = max(span, nbr[k] - q)
+    for b in range(nb):
+        lo = b * n // nb
+        hi = (b + 1) * n // nb
+        halo[b] = lo
+        for q in range(max(0, lo - span), lo):
+            for k in range(row_start[q], row_start[q + 1]):
+                if nbr[k] >= lo and nbr[k] < hi:
+                    halo[b] = q
+                    break
+            if halo[b] < lo:
+                break
 
 
 @njit(**NJIT)
@@ -508,13 +557,13 @@ def relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pai
     halo = np.empty(nb, np.int64)
     if not resume:
         pos_build[:, :] = pos
-    nbr, cstart = cell_rows(pos_build, box, rc, order, np.empty(1, np.int32), row_start,
-                            np.empty(4 * n + 16, np.int32))
+    nbr, cstart = cell_rows_par(pos_build, box, rc, order, np.empty(1, np.int32), row_start,
+                                np.empty(4 * n + 16, np.int32), nb, 4.0)
     _to_cell_order(pos_build, vel, weight, order, nbr, row_start[n], rank, pos_c, vel_c, weight_c)
     owner, gx, gy = _pair_scratch(row_start, n, np.empty(0, np.int32), np.empty(0), np.empty(0))
     if nb > 1:
         _halo_rows(row_start, nbr, n, nb, halo)
-    near_part, near_wall = _near_walls(pos_c, walls, reach)
+    near_part, near_wall = _near_walls(pos_c, walls, reach, nb)
     _row_starts(near_part, n, near_start)
     if resume:
         for q in range(n):
@@ -575,12 +624,13 @@ def relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pai
             _to_caller_order(order, pos_c, pos)
             _to_caller_order(order, vel_c, vel)
             pos_build[:, :] = pos
-            nbr, cstart = cell_rows(pos, box, rc, order, cstart, row_start, nbr)
+            nbr, cstart = cell_rows_par(pos, box, rc, order, cstart, row_start, nbr, nb,
+                                        1.25 * row_start[n] / max(n, 1) + 2.0)
             _to_cell_order(pos, vel, weight, order, nbr, row_start[n], rank, pos_c, vel_c, weight_c)
             owner, gx, gy = _pair_scratch(row_start, n, owner, gx, gy)
             if nb > 1:
                 _halo_rows(row_start, nbr, n, nb, halo)
-            near_part, near_wall = _near_walls(pos_c, walls, reach)
+            near_part, near_wall = _near_walls(pos_c, walls, reach, nb)
             _row_starts(near_part, n, near_start)
             moved = 0.0
             move = False
