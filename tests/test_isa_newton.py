@@ -1,4 +1,4 @@
-"""The equilibrium solver (variant ``newton``, methods/isa/newton.py; not the paper's update):
+"""The equilibrium solver (variant ``newton_lm``, methods/isa/newton.py; not the paper's update):
 its energy, forces and Hessian against the force laws and finite differences, and its runs
 against the capped update's on the paper's scenes.  Units cm, N.
 
@@ -130,7 +130,7 @@ def run(tmp, name, scene, *sets):
 def singles(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("newton")
     return {(lat, v): run(tmp, f"{lat}_{v}", f"single_{lat}.yaml", f"solver.variant={v}")
-            for lat in ("coarse", "refined") for v in ("capped", "newton")}
+            for lat in ("coarse", "refined") for v in ("capped", "newton_lm")}
 
 
 def state_differences(a, b, vessel=None):
@@ -146,10 +146,10 @@ def state_differences(a, b, vessel=None):
 
 @pytest.mark.parametrize("lat", ["coarse", "refined"])
 def test_newton_converges_in_under_a_fiftieth_of_the_capped_evaluations(singles, lat):
-    capped, newton = singles[lat, "capped"], singles[lat, "newton"]
+    capped, newton = singles[lat, "capped"], singles[lat, "newton_lm"]
     for ds in (capped, newton):
         assert ds.attrs["status"] == "converged" and np.abs(ds["force"].values).max() < float(ds.attrs["f_tol"])
-    assert newton.attrs["variant"] == "newton" and int(newton["force_evals"]) == int(newton["steps"]) + 1
+    assert newton.attrs["variant"] == "newton_lm" and int(newton["force_evals"]) == int(newton["steps"]) + 1
     assert int(newton.attrs["hessian_assemblies"]) >= int(newton["steps"]) and int(newton.attrs["cg_iterations"]) > 0
     # measured: coarse 101 against 9,964; refined 167 against 20,053
     assert 50 * int(newton["force_evals"]) < int(capped["force_evals"])
@@ -160,18 +160,18 @@ def test_newton_converges_in_under_a_fiftieth_of_the_capped_evaluations(singles,
                    "phase faster (benchmarks/results/newton_evals.csv)")
 @pytest.mark.parametrize("lat", ["coarse", "refined"])
 def test_newton_needs_at_most_100_evaluations(singles, lat):
-    assert int(singles[lat, "newton"]["force_evals"]) <= 100
+    assert int(singles[lat, "newton_lm"]["force_evals"]) <= 100
 
 
 @pytest.mark.parametrize("lat", ["coarse", "refined"])
 def test_newton_level_is_the_capped_level_within_a_quarter_spacing(singles, lat):
-    diff, tol = state_differences(singles[lat, "capped"], singles[lat, "newton"])
+    diff, tol = state_differences(singles[lat, "capped"], singles[lat, "newton_lm"])
     assert abs(diff["level"]) < tol["level"]  # measured: coarse -0.003 cm of 2.5; refined -0.74 cm of 1.25
     assert abs(diff["floor"]) < tol["floor"]
 
 
 def test_newton_coarse_state_is_the_capped_state(singles):
-    diff, tol = state_differences(singles["coarse", "capped"], singles["coarse", "newton"])
+    diff, tol = state_differences(singles["coarse", "capped"], singles["coarse", "newton_lm"])
     assert abs(diff["side"]) < tol["side"]  # measured 0.0008 of 0.034
 
 
@@ -179,7 +179,7 @@ def test_newton_coarse_state_is_the_capped_state(singles):
                    "capped's 351,927 N cm): side walls loaded 23 % more (side_err +0.018 against -0.179, tolerance "
                    "0.0167); the end state is path-dependent")
 def test_newton_refined_side_loads_are_the_capped_ones(singles):
-    diff, tol = state_differences(singles["refined", "capped"], singles["refined", "newton"])
+    diff, tol = state_differences(singles["refined", "capped"], singles["refined", "newton_lm"])
     assert abs(diff["side"]) < tol["side"]
 
 
@@ -192,7 +192,7 @@ def flows(tmp_path_factory):
     app3 = run(tmp, "app3", "flow_step50.yaml", f"particles.from_run={app1}", "solver.max_steps=100000")
     start = f"particles.from_run={tmp / 'app3.nc'}"
     return (app3, run(tmp, "capped", "flow_step50.yaml", start, "solver.variant=capped"),
-            run(tmp, "newton", "flow_step50.yaml", start, "solver.variant=newton"))
+            run(tmp, "newton", "flow_step50.yaml", start, "solver.variant=newton_lm"))
 
 
 def test_newton_completes_the_flow_in_under_one_percent_of_the_capped_evaluations(flows):

@@ -159,7 +159,7 @@ import json, sys
 from isaflow import scene as S
 from isaflow.methods.isa import solver
 out = {}
-for variant in ("capped", "newton"):
+for variant in ("capped", "newton_lm"):
     sc = S.load(sys.argv[1], [f"solver.variant={variant}"])
     pos0, weight, _, _ = S.initial_state(sc)
     r = solver.solve(sc, pos0, weight, threads=1)
@@ -185,7 +185,7 @@ def test_solver_times_exclude_compilation():
                                  check=True)
             runs.append(json.loads(out.stdout.strip().splitlines()[-1]))
     cold, warm = runs
-    for variant in ("capped", "newton"):
+    for variant in ("capped", "newton_lm"):
         assert cold[variant][1] == warm[variant][1] == "converged"
         t_cold, t_warm = cold[variant][0], warm[variant][0]
         assert t_cold < 2 * t_warm and t_warm < 2 * t_cold, (variant, t_cold, t_warm)

@@ -2,7 +2,7 @@
 
 Modules: ``forces`` (force laws, plain force evaluation, wall contacts),
 ``relax`` (the compiled step loop of the three update rules), ``newton``
-(the equilibrium solver of the variant ``newton``), ``settings``
+(the equilibrium solver of the variant ``newton_lm``), ``settings``
 (solver settings with defaults), ``solver`` (chunks, history, outcome ->
 contract.Result).
 """
@@ -17,7 +17,7 @@ METHOD = Method(
         "paper": Variant("paper", "paper: x += du F / max|F| (section 3.3, literal)", "tab:blue", "o"),
         "capped": Variant("capped", "capped: x += du F / max(max|F|, f_ref) (variant, not in paper)", "tab:green", "s"),
         "fire": Variant("fire", "fire: FIRE relaxation, Bitzek et al. 2006 (variant, not in paper)", "tab:purple", "^"),
-        "newton": Variant("newton", "newton: energy minimisation, Levenberg-Marquardt with the contacts' Hessian "
+        "newton_lm": Variant("newton_lm", "newton_lm: energy minimisation, Newton-type (Levenberg-Marquardt) with the contacts' Hessian "
                           "(equilibrium solver, not in paper)", "tab:brown", "X"),
     },
     solver="isaflow.methods.isa.solver:solve",

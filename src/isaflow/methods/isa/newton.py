@@ -1,4 +1,4 @@
-"""An equilibrium solver for the static problem (variant ``newton``, not the paper's update; numba).
+"""An equilibrium solver for the static problem (variant ``newton_lm``, not the paper's update; numba).
 
 The ISA forces derive from the energy (cm, N, N cm)
 

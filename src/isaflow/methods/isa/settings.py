@@ -10,7 +10,7 @@ from . import relax as R
 from .newton import NEWTON
 
 # update rules: relax.relax_resume's rule codes, and the equilibrium solver (newton.newton_resume)
-RULES = {"paper": R.PAPER, "capped": R.CAPPED, "fire": R.FIRE, "newton": NEWTON}
+RULES = {"paper": R.PAPER, "capped": R.CAPPED, "fire": R.FIRE, "newton_lm": NEWTON}
 # Defaults of the optional solver fields.  f_ref and dt_max depend on the
 # stiffness: both come from the Gershgorin bound lambda_max <= 2 k_b + 12 k_p
 # (two walls, six neighbours) of the stiffness matrix.

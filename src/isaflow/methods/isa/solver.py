@@ -88,7 +88,7 @@ def warm_up(threads=1):
     the solve passes them, and start numba's threads, so that solver times exclude both.
 
     The timed loop calls relax.relax_resume for the three step rules and
-    newton.newton_resume for the newton variant: exactly those are called here
+    newton.newton_resume for the newton_lm variant: exactly those are called here
     (a function compiled only as another's callee, e.g. relax_resume inside
     relax, can be typed differently and be compiled again on its first direct
     call: Table 1 once timed a 1.6 s compile as solver time).
@@ -191,7 +191,7 @@ def solve(scene, pos0, weight, start_step=0, progress=None, state=None, threads=
     repeats the uninterrupted one bit for bit, at any start_step.
     threads: numba threads of the solve (None: numba's current number, i.e.
     NUMBA_NUM_THREADS or the machine's cores); the results do not depend on
-    it, and it is recorded in params['threads'].  The newton variant's loop is
+    it, and it is recorded in params['threads'].  The newton_lm variant's loop is
     serial.  Returns a contract.Result (method 'isa', variant = the update
     rule); its fields hold the restart state (STATE_VARS).
     """
@@ -209,7 +209,7 @@ def _solve(scene, pos0, weight, start_step, progress, state, threads):
     weight = np.ascontiguousarray(weight, float)
     force = np.zeros_like(pos)
     chunk = s["chunk"]
-    newton = s["variant"] == "newton"
+    newton = s["variant"] == "newton_lm"
     restored = state is not None and not newton  # newton keeps no state between runs (restart.py)
     vel = np.array(state["state_vel"], float, order="C") if restored else np.zeros_like(pos)
     pos_build = np.array(state["state_pos_build"], float, order="C") if restored else pos.copy()
