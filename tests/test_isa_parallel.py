@@ -108,13 +108,19 @@ def test_parallel_neighbour_list_equals_cell_rows(seed, nb):
         assert np.array_equal(nbr[:m], nbr_ref[:m])
 
 
-def test_near_wall_list_is_the_same_in_blocks():
+def test_near_wall_list_holds_exactly_the_particles_within_reach():
+    """The near-wall rows (with the bounding-box shortcut) against plain point-segment distances."""
     pos, walls, box = wide_vessel(n_row=60, seed=2, sigma=3.0)
-    ref = R._near_walls(pos, walls, L_B + 2.0, 1)
-    for nb in (2, 5):
-        got = R._near_walls(pos, walls, L_B + 2.0, nb)
-        assert set(ref[1]) == {0, 1, 2}  # particles near all three walls
-        assert all(np.array_equal(a, b) for a, b in zip(ref, got))
+    reach = L_B + 2.0
+    part, wall = R._near_walls(pos, walls, reach)
+    want = []
+    for i, p in enumerate(pos):
+        for w, (x0, y0, x1, y1) in enumerate(walls):
+            e = np.array([x1 - x0, y1 - y0])
+            t = np.clip((p - [x0, y0]) @ e / (e @ e), 0, 1)
+            if np.sum((p - [x0, y0] - t * e) ** 2) < reach * reach:
+                want.append((i, w))
+    assert set(wall) == {0, 1, 2} and list(zip(part, wall)) == want
 
 
 TINY = {

@@ -59,23 +59,14 @@ def _search_par(nb, n, xs, ys, order, cell_q, cstart, ncx, ncy, rc2, out, cap, r
                                   out, b * cap, cap, row_start)
 
 
-@njit(**PJIT)
-def _join_par(nb, n, out, cap, offsets, row_start, nbr):
-    for b in prange(nb):
+@njit(**JIT)
+def _join(nb, n, out, cap, offsets, row_start, nbr):
+    for b in range(nb):
         off = offsets[b]
         for q in range(b * n // nb, (b + 1) * n // nb):
             row_start[q] += off
         for k in range(offsets[b + 1] - off):
             nbr[off + k] = out[b * cap + k]
-
-
-@njit(**PJIT)
-def _gather_par(nb, pos, order, xs, ys):
-    n = pos.shape[0]
-    for b in prange(nb):
-        for q in range(b * n // nb, (b + 1) * n // nb):
-            xs[q] = pos[order[q], 0]
-            ys[q] = pos[order[q], 1]
 
 
 @njit(**JIT)
@@ -110,7 +101,9 @@ def cell_rows_par(pos, box, rc, order, cstart, row_start, nbr, nb, hint):
     cstart[0] = 0
     xs = np.empty(n)
     ys = np.empty(n)
-    _gather_par(nb, pos, order, xs, ys)
+    for q in range(n):
+        xs[q] = pos[order[q], 0]
+        ys[q] = pos[order[q], 1]
     cap = int(hint * (n // nb + 1)) + 64
     out = np.empty(nb * cap, np.int32)
     counts = np.empty(nb, np.int64)
@@ -124,6 +117,6 @@ def cell_rows_par(pos, box, rc, order, cstart, row_start, nbr, nb, hint):
     m = offsets[nb]
     if nbr.shape[0] < m:
         nbr = np.empty(2 * m + 16, np.int32)
-    _join_par(nb, n, out, cap, offsets, row_start, nbr)
+    _join(nb, n, out, cap, offsets, row_start, nbr)
     row_start[n] = m
     return nbr, cstart

@@ -94,43 +94,16 @@ def _near_range(lo, hi, pos, walls, r2, part, wall, c):
     return count
 
 
-@njit(**PJIT)
-def _near_count_par(nb, pos, walls, r2, counts):
-    n = pos.shape[0]
-    empty = np.empty(0, np.int32)
-    for b in prange(nb):
-        counts[b] = _near_range(b * n // nb, (b + 1) * n // nb, pos, walls, r2, empty, empty, 0)
-
-
-@njit(**PJIT)
-def _near_fill_par(nb, pos, walls, r2, starts, part, wall):
-    n = pos.shape[0]
-    for b in prange(nb):
-        _near_range(b * n // nb, (b + 1) * n // nb, pos, walls, r2, part, wall, starts[b])
-
-
 @njit(**JIT)
-def _near_walls(pos, walls, reach, nb):
+def _near_walls(pos, walls, reach):
     """(particle, wall) int32 pairs, ascending, with the particle closer than reach [cm] to the wall
-    (nb > 1: counted, then stored, in nb parallel blocks; the same list)."""
+    (counted, then stored)."""
     n = pos.shape[0]
     r2 = reach * reach
-    if nb <= 1:
-        c = _near_range(0, n, pos, walls, r2, np.empty(0, np.int32), np.empty(0, np.int32), 0)
-        part = np.empty(c, np.int32)
-        wall = np.empty(c, np.int32)
-        _near_range(0, n, pos, walls, r2, part, wall, 0)
-        return part, wall
-    counts = np.empty(nb, np.int64)
-    _near_count_par(nb, pos, walls, r2, counts)
-    starts = np.empty(nb, np.int64)
-    c = 0
-    for b in range(nb):
-        starts[b] = c
-        c += counts[b]
+    c = _near_range(0, n, pos, walls, r2, np.empty(0, np.int32), np.empty(0, np.int32), 0)
     part = np.empty(c, np.int32)
     wall = np.empty(c, np.int32)
-    _near_fill_par(nb, pos, walls, r2, starts, part, wall)
+    _near_range(0, n, pos, walls, r2, part, wall, 0)
     return part, wall
 
 
@@ -313,7 +286,8 @@ def _evaluate(nb, halo, pos, new, direction, scale, move, weight, walls, wall_l_
     """
     n = pos.shape[0]
     if nb <= 1:
-        return _forces_range(0, n, 0, pos, new, direction, scale, move, weight, walls, wall_l_u, wall_r_u,
+        zero = n - n  # not a literal 0: the same specialisation of _forces_range as the parallel blocks'
+        return _forces_range(zero, n, zero, pos, new, direction, scale, move, weight, walls, wall_l_u, wall_r_u,
                              near_start, near_wall, pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force, fire, order, vel,
                              power, vnorm2, fnorm2)
     _forces_par(nb, halo, pos, new, direction, scale, move, weight, walls, wall_l_u, wall_r_u, near_start, near_wall,
@@ -350,31 +324,12 @@ def _crossing_range(lo, hi, pos, direction, scale, walls, order, near_part, test
     return best, best_wall
 
 
-@njit(**PJIT)
-def _crossing_par(nb, pos, direction, scale, walls, order, near_part, best_b, wall_b):
-    """:func:`_crossing_range` over all particles in nb blocks in parallel."""
-    n = pos.shape[0]
-    for b in prange(nb):
-        best_b[b], wall_b[b] = _crossing_range(b * n // nb, (b + 1) * n // nb, pos, direction, scale, walls, order,
-                                               near_part, True)
-
-
 @njit(**JIT)
-def _first_crossing(nb, pos, direction, scale, walls, order, near_part, test_all, best_b, wall_b):
+def _first_crossing(pos, direction, scale, walls, order, near_part, test_all):
     """(particle, wall) of the lowest-numbered particle whose move pos += scale * direction
-    crosses a wall, or (-1, -1).  Only near-wall particles are tested unless
-    test_all (then in nb parallel blocks if nb > 1; the lowest number is the same)."""
-    if not test_all or nb <= 1:
-        return _crossing_range(0, pos.shape[0] if test_all else near_part.shape[0], pos, direction, scale, walls,
-                               order, near_part, test_all)
-    _crossing_par(nb, pos, direction, scale, walls, order, near_part, best_b, wall_b)
-    best = -1
-    best_wall = -1
-    for b in range(nb):
-        if best_b[b] >= 0 and (best < 0 or best_b[b] < best):
-            best = best_b[b]
-            best_wall = wall_b[b]
-    return best, best_wall
+    crosses a wall, or (-1, -1).  Only near-wall particles are tested unless test_all."""
+    return _crossing_range(0, pos.shape[0] if test_all else near_part.shape[0], pos, direction, scale, walls, order,
+                           near_part, test_all)
 
 
 @njit(**JIT)
@@ -419,15 +374,8 @@ def _fire_range(lo, hi, vel, force, mix, one_minus_alpha, c, dt):
     return vmax
 
 
-@njit(**PJIT)
-def _fire_par(nb, vel, force, mix, one_minus_alpha, c, dt, vmax_b):
-    n = vel.shape[0]
-    for b in prange(nb):
-        vmax_b[b] = _fire_range(b * n // nb, (b + 1) * n // nb, vel, force, mix, one_minus_alpha, c, dt)
-
-
 @njit(**JIT)
-def _fire_step(nb, vel, force, power_i, vnorm2_i, fnorm2_i, dt, dt_max, alpha, n_pos, vmax_b):
+def _fire_step(vel, force, power_i, vnorm2_i, fnorm2_i, dt, dt_max, alpha, n_pos):
     """One FIRE velocity update (Bitzek et al. 2006) followed by v += dt F, in place.
 
     Returns (dt, alpha, n_pos, vmax).  Power and norms are summed over the
@@ -454,13 +402,7 @@ def _fire_step(nb, vel, force, power_i, vnorm2_i, fnorm2_i, dt, dt_max, alpha, n
         n_pos = 0
         dt *= FIRE_F_DEC
         alpha = FIRE_ALPHA0
-    if nb <= 1:
-        vmax = _fire_range(0, vel.shape[0], vel, force, mix, one_minus_alpha, c, dt)
-    else:
-        _fire_par(nb, vel, force, mix, one_minus_alpha, c, dt, vmax_b)
-        vmax = 0.0
-        for b in range(nb):
-            vmax = max(vmax, vmax_b[b])
+    vmax = _fire_range(0, vel.shape[0], vel, force, mix, one_minus_alpha, c, dt)
     return dt, alpha, n_pos, vmax
 
 
@@ -481,16 +423,18 @@ def blocks(n, threads):
     return threads
 
 
-@njit(**JIT)
 def relax(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pair_r_u, rule, du, f_ref,
           dt_max, f_tol, n_steps, skin, force, fmax_hist, threads=1):
     """One chunk from a fresh start (neighbour list built from pos, FIRE reset); see :func:`relax_resume`.
 
-    Returns (steps_done, status, crossing).
+    Returns (steps_done, status, crossing).  A Python function: it calls the
+    compiled relax_resume with the argument types the solver passes, so that
+    there is one compiled specialisation (a compiled caller passing a literal
+    False would compile the whole loop a second time).
     """
-    state = np.zeros(4)
-    return relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pair_r_u, rule, du, f_ref,
-                        dt_max, f_tol, n_steps, skin, force, fmax_hist, np.empty_like(pos), state, False, threads)
+    return relax_resume(pos, vel, weight, walls, box, float(wall_l_u), float(wall_r_u), float(pair_l_u),
+                        float(pair_r_u), int(rule), float(du), float(f_ref), float(dt_max), float(f_tol), int(n_steps),
+                        float(skin), force, fmax_hist, np.empty_like(pos), np.zeros(4), False, int(threads))
 
 
 @njit(**JIT)
@@ -551,9 +495,6 @@ def relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pai
     fnorm2_i = np.empty(nf)
     fmax_b = np.empty(nb)
     bad_b = np.empty(nb, np.int64)
-    vmax_b = np.empty(nb)
-    best_b = np.empty(nb, np.int64)
-    wall_b = np.empty(nb, np.int64)
     halo = np.empty(nb, np.int64)
     if not resume:
         pos_build[:, :] = pos
@@ -563,7 +504,7 @@ def relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pai
     owner, gx, gy = _pair_scratch(row_start, n, np.empty(0, np.int32), np.empty(0), np.empty(0))
     if nb > 1:
         _halo_rows(row_start, nbr, n, nb, halo)
-    near_part, near_wall = _near_walls(pos_c, walls, reach, nb)
+    near_part, near_wall = _near_walls(pos_c, walls, reach)
     _row_starts(near_part, n, near_start)
     if resume:
         for q in range(n):
@@ -572,15 +513,20 @@ def relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pai
         moved, dt, alpha, n_pos = state[0], state[1], state[2], int(state[3])
     else:
         moved, dt, alpha, n_pos = 0.0, 0.1 * dt_max, FIRE_ALPHA0, 0  # moved: bound on any displacement, cm
-    fmax, bad = _evaluate(nb, halo, pos_c, new_c, force_c, 0.0, False, weight_c, walls, wall_l_u, wall_r_u,
-                          near_start, near_wall, pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force_n, fire, order, vel_c,
-                          power_i, vnorm2_i, fnorm2_i, fmax_b, bad_b)
-    pos_c, new_c = new_c, pos_c
-    force_c, force_n = force_n, force_c
     status = RUNNING
     crossing = -1
     done = n_steps
-    for step in range(n_steps + 1):
+    direction = force_c
+    scale = 0.0
+    move = n < 0  # False (the first evaluation is at pos), computed: a literal False would be a second specialisation
+    step = -1
+    while True:  # one call site of _evaluate (one compiled specialisation)
+        fmax, bad = _evaluate(nb, halo, pos_c, new_c, direction, scale, move, weight_c, walls, wall_l_u, wall_r_u,
+                              near_start, near_wall, pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force_n, fire,
+                              order, vel_c, power_i, vnorm2_i, fnorm2_i, fmax_b, bad_b)
+        pos_c, new_c = new_c, pos_c
+        force_c, force_n = force_n, force_c
+        step += 1
         if step < n_steps:
             fmax_hist[step] = fmax
         if bad >= 0:
@@ -595,8 +541,7 @@ def relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pai
             done = step
             break
         if fire:
-            dt, alpha, n_pos, vmax = _fire_step(nb, vel_c, force_c, power_i, vnorm2_i, fnorm2_i, dt, dt_max, alpha,
-                                                n_pos, vmax_b)
+            dt, alpha, n_pos, vmax = _fire_step(vel_c, force_c, power_i, vnorm2_i, fnorm2_i, dt, dt_max, alpha, n_pos)
             # semi-implicit Euler with the step capped at du
             scale = dt
             if vmax * dt > du:
@@ -608,8 +553,7 @@ def relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pai
             direction = force_c
             max_move = np.sqrt(2.0) * (scale * fmax)
         # refuse any move across a wall
-        i, w = _first_crossing(nb, pos_c, direction, scale, walls, order, near_part, not (moved + max_move < reach),
-                               best_b, wall_b)
+        i, w = _first_crossing(pos_c, direction, scale, walls, order, near_part, not (moved + max_move < reach))
         if i >= 0:  # tested before any particle moved: the step is not taken
             status = CROSSED
             crossing = i * nw + w
@@ -630,15 +574,10 @@ def relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pai
             owner, gx, gy = _pair_scratch(row_start, n, owner, gx, gy)
             if nb > 1:
                 _halo_rows(row_start, nbr, n, nb, halo)
-            near_part, near_wall = _near_walls(pos_c, walls, reach, nb)
+            near_part, near_wall = _near_walls(pos_c, walls, reach)
             _row_starts(near_part, n, near_start)
             moved = 0.0
             move = False
-        fmax, bad = _evaluate(nb, halo, pos_c, new_c, direction, scale, move, weight_c, walls, wall_l_u, wall_r_u,
-                              near_start, near_wall, pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force_n, fire, order, vel_c,
-                              power_i, vnorm2_i, fnorm2_i, fmax_b, bad_b)
-        pos_c, new_c = new_c, pos_c
-        force_c, force_n = force_n, force_c
     _to_caller_order(order, pos_c, pos)
     _to_caller_order(order, vel_c, vel)
     _to_caller_order(order, force_c, force)
