@@ -17,8 +17,8 @@ METHOD = Method(
         "paper": Variant("paper", "paper: x += du F / max|F| (section 3.3, literal)", "tab:blue", "o"),
         "capped": Variant("capped", "capped: x += du F / max(max|F|, f_ref) (variant, not in paper)", "tab:green", "s"),
         "fire": Variant("fire", "fire: FIRE relaxation, Bitzek et al. 2006 (variant, not in paper)", "tab:purple", "^"),
-        "newton_lm": Variant("newton_lm", "newton_lm: energy minimisation, Newton-type (Levenberg-Marquardt) with the contacts' Hessian "
-                          "(equilibrium solver, not in paper)", "tab:brown", "X"),
+        "newton_lm": Variant("newton_lm", "newton_lm: energy minimisation, Newton-type (Levenberg-Marquardt) with "
+                             "the contacts' Hessian (equilibrium solver, not in paper)", "tab:brown", "X"),
     },
     solver="isaflow.methods.isa.solver:solve",
 )

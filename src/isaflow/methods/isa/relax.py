@@ -265,20 +265,21 @@ def _forces_range(lo, hi, h, pos, new, direction, scale, move, weight, walls, wa
 
 @njit(**PJIT)
 def _forces_par(nb, halo, pos, new, direction, scale, move, weight, walls, wall_l_u, wall_r_u, near_start,
-                near_wall, pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force, fire, order, vel, power, vnorm2, fnorm2,
-                fmax_b, bad_b):
+                near_wall, pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force, fire, order, vel, power,
+                vnorm2, fnorm2, fmax_b, bad_b):
     """:func:`_forces_range` over nb blocks in parallel; (max|F|, bad) of block b in fmax_b[b], bad_b[b]."""
     n = pos.shape[0]
     for b in prange(nb):
         fmax_b[b], bad_b[b] = _forces_range(b * n // nb, (b + 1) * n // nb, halo[b], pos, new, direction, scale,
                                             move, weight, walls, wall_l_u, wall_r_u, near_start, near_wall,
-                                            pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force, fire, order, vel, power,
-                                            vnorm2, fnorm2)
+                                            pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force, fire, order,
+                                            vel, power, vnorm2, fnorm2)
 
 
 @njit(**JIT)
 def _evaluate(nb, halo, pos, new, direction, scale, move, weight, walls, wall_l_u, wall_r_u, near_start, near_wall,
-              pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force, fire, order, vel, power, vnorm2, fnorm2, fmax_b, bad_b):
+              pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force, fire, order, vel, power, vnorm2, fnorm2,
+              fmax_b, bad_b):
     """Move (if move) into new and evaluate force there: returns (max|F| [N], bad) as forces.forces.
 
     nb blocks of particles (nb <= 1: one serial pass).  The blocks' maxima
@@ -288,10 +289,11 @@ def _evaluate(nb, halo, pos, new, direction, scale, move, weight, walls, wall_l_
     if nb <= 1:
         zero = n - n  # not a literal 0: the same specialisation of _forces_range as the parallel blocks'
         return _forces_range(zero, n, zero, pos, new, direction, scale, move, weight, walls, wall_l_u, wall_r_u,
-                             near_start, near_wall, pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force, fire, order, vel,
-                             power, vnorm2, fnorm2)
+                             near_start, near_wall, pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force, fire,
+                             order, vel, power, vnorm2, fnorm2)
     _forces_par(nb, halo, pos, new, direction, scale, move, weight, walls, wall_l_u, wall_r_u, near_start, near_wall,
-                pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force, fire, order, vel, power, vnorm2, fnorm2, fmax_b, bad_b)
+                pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force, fire, order, vel, power, vnorm2, fnorm2,
+                fmax_b, bad_b)
     fmax = 0.0
     for b in range(nb):
         if bad_b[b] >= 0:
@@ -467,8 +469,9 @@ def relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pai
     are written back on return.  A step is one pass over the particles
     (:func:`_evaluate`): move, weight and wall forces, then the rows' pair
     forces; positions and forces are double-buffered so that parallel blocks
-    read the previous step's only (:func:`_forces_range`).  Wall forces and the crossing test only visit particles that were
-    within wall_l_u + skin of a wall at the last build (no other particle can
+    read the previous step's only (:func:`_forces_range`).  Wall forces and
+    the crossing test only visit particles that were within wall_l_u + skin
+    of a wall at the last build (no other particle can
     come within wall_l_u of a wall, or reach one, before the next build; if
     one step could reach farther, every particle is tested).  The passes run
     in parallel blocks, one per thread (:func:`blocks`).
