@@ -431,7 +431,8 @@ def newton_table(scenes, tmp):
             row.update({f"{key}_evals": r.force_evals, f"{key}_s": r.wall_time})
             if variant == "newton_lm":
                 row.update(particles=len(r.pos), newton_steps=r.steps,
-                           hessian_assemblies=r.params["hessian_assemblies"], cg_iterations=r.params["cg_iterations"], refused_steps=r.params["refused_steps"])
+                           hessian_assemblies=r.params["hessian_assemblies"],
+                           cg_iterations=r.params["cg_iterations"], refused_steps=r.params["refused_steps"])
             if variant == "capped":
                 row["capped_source"] = "this run"
             files[variant] = tmp / f"{name}_{variant}.nc"
@@ -610,7 +611,8 @@ def main():
         if len(threads) > 1:
             t2 = threads[-1]
             lines.append(f"N={int(r['N']):8d}: wall {r['wall_ns_1t']:.2f} ns (1 thread) vs "
-                         f"{r[f'wall_ns_{t2}t']:.2f} ns ({t2} threads): speed-up {r['speedup']:.2f}, parallel efficiency {r['efficiency']:.0%}; "
+                         f"{r[f'wall_ns_{t2}t']:.2f} ns ({t2} threads): speed-up {r['speedup']:.2f}, "
+                         f"parallel efficiency {r['efficiency']:.0%}; "
                          f"target <= {TARGET_NS_2T:g} ns at N >= 1e5: {r['target_2t_met']}")
     for r in nrows:
         lines.append(f"newton_lm {r['scene']}: {r['newton_evals']} force evaluations in {r['newton_s']:.3f} s "
