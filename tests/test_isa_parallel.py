@@ -86,6 +86,31 @@ def test_a_wall_crossing_is_found_at_the_same_particle_by_every_block_split():
         assert np.array_equal(ref[k], got[k]), k
 
 
+def test_a_crossing_near_the_walls_is_found_in_parallel_blocks_as_in_one():
+    """Two heavy particles 0.02 cm above the floor step through it (du = 0.05 cm, within the
+    near-wall reach, so only the near-wall rows are tested, in parallel blocks once there are
+    2 x PAR_MIN_PER_THREAD of them): the lower caller number and the floor are reported, and the
+    step is not taken, on 1 and 2 blocks alike."""
+    pos0, walls, box = wide_vessel(n_row=4400, seed=4, sigma=0.2)
+    heavy = [len(pos0) - 100, 7]  # the later-numbered one comes first in cell order
+    pos0[heavy] = [[box[2] - 30.0, 0.02], [30.0, 0.02]]
+    n = len(pos0)
+    outs = []
+    for threads in (1, 2):
+        pos, force, hist = pos0.copy(), np.zeros_like(pos0), np.zeros(3)
+        weight = np.full(n, 50.0)
+        weight[heavy] = 1e7
+        ret = R.relax(pos, np.zeros_like(pos), weight, walls, box, L_B, R_B, L_P, R_P, R.PAPER, 0.05, 50.0, 0.1,
+                      1e-30, 3, 0.3 * L_P, force, hist, threads)
+        outs.append((tuple(ret), pos, force, hist))
+    near = R._near_walls(pos0, walls, L_B + 0.3 * L_P)[0]
+    assert R.blocks(len(near), 2) == 2
+    assert outs[0][0] == (0, R.CROSSED, 7 * len(walls) + 1)  # particle 7, floor
+    for a, b in zip(outs[0], outs[1]):
+        assert np.array_equal(np.asarray(a), np.asarray(b))
+    assert np.array_equal(outs[0][1], pos0)
+
+
 @pytest.mark.parametrize("seed", [0, 1])
 @pytest.mark.parametrize("nb", [2, 3, 7])
 def test_parallel_neighbour_list_equals_cell_rows(seed, nb):

@@ -327,11 +327,57 @@ def _crossing_range(lo, hi, pos, direction, scale, walls, order, near_part, test
 
 
 @njit(**JIT)
-def _first_crossing(pos, direction, scale, walls, order, near_part, test_all):
+def _crossing_near(lo, hi, pos, direction, scale, walls, order, near_part, near_wall):
+    """(particle, wall), smallest as a pair (caller's particle number order[q], then wall), among the
+    near-wall rows lo <= c < hi whose particle's move pos += scale * direction crosses the row's wall;
+    (-1, -1) if none.  A particle's rows are in ascending wall order, and no other wall can be
+    reached before the next list build, so for the lowest-numbered crossing particle this is the
+    wall core.geometry.crossed_wall returns (the first one the move crosses)."""
+    best = -1
+    best_wall = -1
+    for c in range(lo, hi):
+        q = near_part[c]
+        i = order[q]
+        if best >= 0 and i >= best:  # a lower particle, or a lower wall of this one, already crosses
+            continue
+        w = near_wall[c]
+        if crossed_wall(pos[q, 0], pos[q, 1], pos[q, 0] + scale * direction[q, 0],
+                        pos[q, 1] + scale * direction[q, 1], walls[w:w + 1]) >= 0:
+            best = i
+            best_wall = w
+    return best, best_wall
+
+
+@njit(**PJIT)
+def _crossing_par(nb, pos, direction, scale, walls, order, near_part, near_wall, best_b, wall_b):
+    """:func:`_crossing_near` over nb blocks of the near-wall rows in parallel."""
+    m = near_part.shape[0]
+    for b in prange(nb):
+        best_b[b], wall_b[b] = _crossing_near(b * m // nb, (b + 1) * m // nb, pos, direction, scale, walls, order,
+                                              near_part, near_wall)
+
+
+@njit(**JIT)
+def _first_crossing(nb, pos, direction, scale, walls, order, near_part, near_wall, test_all, best_b, wall_b):
     """(particle, wall) of the lowest-numbered particle whose move pos += scale * direction
-    crosses a wall, or (-1, -1).  Only near-wall particles are tested unless test_all."""
-    return _crossing_range(0, pos.shape[0] if test_all else near_part.shape[0], pos, direction, scale, walls, order,
-                           near_part, test_all)
+    crosses a wall, and the first wall it crosses, or (-1, -1).  Only near-wall rows are
+    tested unless test_all (then every particle against every wall); the rows in nb parallel
+    blocks when there are enough of them (:func:`blocks`); the result is the same."""
+    if test_all:
+        return _crossing_range(0, pos.shape[0], pos, direction, scale, walls, order, near_part, True)
+    nbc = blocks(near_part.shape[0], nb)
+    if nbc <= 1:
+        zero = nb - nb  # not a literal 0 (one specialisation)
+        return _crossing_near(zero, near_part.shape[0], pos, direction, scale, walls, order, near_part, near_wall)
+    _crossing_par(nbc, pos, direction, scale, walls, order, near_part, near_wall, best_b, wall_b)
+    best = -1
+    best_wall = -1
+    for b in range(nbc):
+        i = best_b[b]
+        if i >= 0 and (best < 0 or i < best or (i == best and wall_b[b] < best_wall)):
+            best = i
+            best_wall = wall_b[b]
+    return best, best_wall
 
 
 @njit(**JIT)
@@ -497,6 +543,8 @@ def relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pai
     vnorm2_i = np.empty(nf)
     fnorm2_i = np.empty(nf)
     fmax_b = np.empty(nb)
+    best_b = np.empty(nb, np.int64)
+    wall_b = np.empty(nb, np.int64)
     bad_b = np.empty(nb, np.int64)
     halo = np.empty(nb, np.int64)
     if not resume:
@@ -556,7 +604,8 @@ def relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pai
             direction = force_c
             max_move = np.sqrt(2.0) * (scale * fmax)
         # refuse any move across a wall
-        i, w = _first_crossing(pos_c, direction, scale, walls, order, near_part, not (moved + max_move < reach))
+        i, w = _first_crossing(nb, pos_c, direction, scale, walls, order, near_part, near_wall,
+                               not (moved + max_move < reach), best_b, wall_b)
         if i >= 0:  # tested before any particle moved: the step is not taken
             status = CROSSED
             crossing = i * nw + w
