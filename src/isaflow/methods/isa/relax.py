@@ -254,10 +254,10 @@ def _forces_range(lo, hi, h, pos, new, direction, scale, move, weight, walls, wa
         if not finite and bad < 0:
             bad = i
         if fire:
-            i = order[q]
-            power[i] = vel[q, 0] * fx + vel[q, 1] * fy
-            vnorm2[i] = vel[q, 0] ** 2 + vel[q, 1] ** 2
-            fnorm2[i] = fx ** 2 + fy ** 2
+            ic = order[q]
+            power[ic] = vel[q, 0] * fx + vel[q, 1] * fy
+            vnorm2[ic] = vel[q, 0] ** 2 + vel[q, 1] ** 2
+            fnorm2[ic] = fx ** 2 + fy ** 2
     if bad >= 0:
         return np.nan, bad
     return fmax, bad
