@@ -515,7 +515,7 @@ def main():
         print(f"numpy reference == compiled forces (max|F| {fm:.4g} N): ok", flush=True)
 
     n_list = QUICK_N if args.quick else FULL_N
-    target = 3e6 if args.quick else 1e7  # particle-steps per timed call
+    target = 3e6 if args.quick else 2e7  # particle-steps per timed call (200 steps at N = 1e5)
     np_target = 2e5
     reps = 5
     relax_steps = 5000 if args.quick else RELAX_STEPS
