@@ -157,8 +157,8 @@ def _halo_rows(row_start, nbr, n, nb, halo):
 
 @njit(**NJIT)
 def _forces_range(lo, hi, h, pos, new, direction, scale, move, weight, walls, wall_l_u, wall_r_u, near_start,
-                  near_wall, pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force, fire, order, vel, power, vnorm2,
-                  fnorm2):
+                  near_part, near_wall, pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force, fire, order, vel,
+                  power, vnorm2, fnorm2):
     """Move particles lo <= q < hi (cell order) and evaluate their forces; returns (max|F|, bad) of the range.
 
     new[q] = pos[q] + scale direction[q] if move else pos[q] (cm); force[q] =
@@ -180,25 +180,29 @@ def _forces_range(lo, hi, h, pos, new, direction, scale, move, weight, walls, wa
     |F|^2 at the caller's index order[q] (summed in that order by
     :func:`_fire_step`).
     """
+    # move, and the weights (two plain loops that vectorise); then the walls of the near-wall rows,
+    # in their order (ascending particle, then wall): the additions forces.forces makes
+    if move:
+        for i in range(lo, hi):
+            q = np.uint64(i)  # unsigned: no negative-index wraparound
+            new[q, 0] = pos[q, 0] + scale * direction[q, 0]
+            new[q, 1] = pos[q, 1] + scale * direction[q, 1]
+    else:
+        for i in range(lo, hi):
+            q = np.uint64(i)
+            new[q, 0] = pos[q, 0]
+            new[q, 1] = pos[q, 1]
     for i in range(lo, hi):
-        q = np.uint64(i)  # unsigned: no negative-index wraparound
-        if move:
-            xi = pos[q, 0] + scale * direction[q, 0]
-            yi = pos[q, 1] + scale * direction[q, 1]
-        else:
-            xi = pos[q, 0]
-            yi = pos[q, 1]
-        new[q, 0] = xi
-        new[q, 1] = yi
-        fx = 0.0
-        fy = -weight[q]
-        for c in range(near_start[q], near_start[q + 1]):
-            w = near_wall[c]
-            ax, ay = wall_push(xi, yi, walls[w, 0], walls[w, 1], walls[w, 2], walls[w, 3], wall_l_u, wall_r_u)
-            fx += ax
-            fy += ay
-        force[q, 0] = fx
-        force[q, 1] = fy
+        q = np.uint64(i)
+        force[q, 0] = 0.0
+        force[q, 1] = -weight[q]
+    for c in range(near_start[lo], near_start[hi]):
+        q = near_part[c]
+        w = near_wall[c]
+        ax, ay = wall_push(new[q, 0], new[q, 1], walls[w, 0], walls[w, 1], walls[w, 2], walls[w, 3], wall_l_u,
+                           wall_r_u)
+        force[q, 0] += ax
+        force[q, 1] += ay
     for q in range(h, lo):  # pairs of earlier blocks' rows with partners in this block
         xi = pos[q, 0]
         yi = pos[q, 1]
@@ -265,19 +269,21 @@ def _forces_range(lo, hi, h, pos, new, direction, scale, move, weight, walls, wa
 
 @njit(**PJIT)
 def _forces_par(nb, halo, pos, new, direction, scale, move, weight, walls, wall_l_u, wall_r_u, near_start,
-                near_wall, pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force, fire, order, vel, power,
+                near_part, near_wall, pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force, fire, order, vel, power,
                 vnorm2, fnorm2, fmax_b, bad_b):
     """:func:`_forces_range` over nb blocks in parallel; (max|F|, bad) of block b in fmax_b[b], bad_b[b]."""
     n = pos.shape[0]
     for b in prange(nb):
         fmax_b[b], bad_b[b] = _forces_range(b * n // nb, (b + 1) * n // nb, halo[b], pos, new, direction, scale,
-                                            move, weight, walls, wall_l_u, wall_r_u, near_start, near_wall,
+                                            move, weight, walls, wall_l_u, wall_r_u, near_start, near_part,
+                                            near_wall,
                                             pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force, fire, order,
                                             vel, power, vnorm2, fnorm2)
 
 
 @njit(**JIT)
-def _evaluate(nb, halo, pos, new, direction, scale, move, weight, walls, wall_l_u, wall_r_u, near_start, near_wall,
+def _evaluate(nb, halo, pos, new, direction, scale, move, weight, walls, wall_l_u, wall_r_u, near_start,
+              near_part, near_wall,
               pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force, fire, order, vel, power, vnorm2, fnorm2,
               fmax_b, bad_b):
     """Move (if move) into new and evaluate force there: returns (max|F| [N], bad) as forces.forces.
@@ -289,9 +295,10 @@ def _evaluate(nb, halo, pos, new, direction, scale, move, weight, walls, wall_l_
     if nb <= 1:
         zero = n - n  # not a literal 0: the same specialisation of _forces_range as the parallel blocks'
         return _forces_range(zero, n, zero, pos, new, direction, scale, move, weight, walls, wall_l_u, wall_r_u,
-                             near_start, near_wall, pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force, fire,
-                             order, vel, power, vnorm2, fnorm2)
-    _forces_par(nb, halo, pos, new, direction, scale, move, weight, walls, wall_l_u, wall_r_u, near_start, near_wall,
+                             near_start, near_part, near_wall, pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy,
+                             force, fire, order, vel, power, vnorm2, fnorm2)
+    _forces_par(nb, halo, pos, new, direction, scale, move, weight, walls, wall_l_u, wall_r_u, near_start,
+                near_part, near_wall,
                 pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force, fire, order, vel, power, vnorm2, fnorm2,
                 fmax_b, bad_b)
     fmax = 0.0
@@ -573,8 +580,8 @@ def relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pai
     step = -1
     while True:  # one call site of _evaluate (one compiled specialisation)
         fmax, bad = _evaluate(nb, halo, pos_c, new_c, direction, scale, move, weight_c, walls, wall_l_u, wall_r_u,
-                              near_start, near_wall, pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy, force_n, fire,
-                              order, vel_c, power_i, vnorm2_i, fnorm2_i, fmax_b, bad_b)
+                              near_start, near_part, near_wall, pair_l_u, pair_r_u, row_start, nbr, owner, gx, gy,
+                              force_n, fire, order, vel_c, power_i, vnorm2_i, fnorm2_i, fmax_b, bad_b)
         pos_c, new_c = new_c, pos_c
         force_c, force_n = force_n, force_c
         step += 1
