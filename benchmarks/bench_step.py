@@ -406,9 +406,14 @@ def state_diff(capped_file, newton_file, vessel=None):
 
 
 def write_run(result, sc, path):
+    """The run file of an in-process solve (as cli.run writes it), for the metrics."""
     from isaflow import runfile
-    prov = {"scene_yaml": sc.text, "scene_overrides": "; ".join(sc.overrides) or "none", "restart": "benchmark"}
-    runfile.write(runfile.to_dataset(result, sc, prov, runfile.now(), runfile.now(), sc.spacing or np.nan), path)
+    start = sc.spec["particles"].get("from_run")
+    prov = runfile.provenance({"scene": sc.path, "config": None, "start": start})
+    prov.update(scene_yaml=sc.text, scene_overrides="; ".join(sc.overrides) or "none",
+                scene_resolved_sha256=sc.digest, restart="benchmark")
+    spacing = sc.spacing if sc.spacing is not None else (runfile.read(start).attrs["spacing"] if start else np.nan)
+    runfile.write(runfile.to_dataset(result, sc, prov, runfile.now(), runfile.now(), spacing), path)
 
 
 def newton_table(scenes, tmp):
