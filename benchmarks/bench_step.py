@@ -73,7 +73,7 @@ RELAX_STEPS = 20000
 HEAL_STEPS = 1000
 TARGET_NS_2T = 10.0  # issue 20: <= 10 ns per particle-step with 2 threads at N >= 1e5
 
-FULL_N = [1000, 10_000, 100_000]
+FULL_N = [1000, 10_000, 30_000, 100_000]
 QUICK_N = [1000, 10_000]
 THREADS = (1, 2)
 
