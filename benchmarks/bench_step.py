@@ -1,25 +1,42 @@
-"""Cost of one step of the paper's algorithm (compiled ``methods.isa.relax.relax``, variant PAPER) vs N.
+"""Cost of one step of the paper's algorithm on 1 and 2 threads, and the equilibrium solver's evaluation counts.
 
-Run: ``python benchmarks/bench_step.py [--quick]`` (a plain script, not a test).
+Run: ``python benchmarks/bench_step.py [--quick] [--finer]`` (a plain script, not a test).
 
-Scene (units cm, N): the paper's application-1 liquid made wide.  A rhombic
-lattice (``isaflow.scene.rhombic_lattice``, a = 10 cm) of 19 rows alternating
-n and n + 1 particles (N = 19 n + 9; n = 9 is the paper's 180-particle case) in
-a rectangular vessel of height 100 cm and width (n + 1) a, particle weight
-50 N, wall law l_u = 5 cm / r_u = 10 kN, pair law l_u = a / sqrt(2) /
-r_u = 500 l_u N, du = 0.01 cm, skin 0.3 l_u (the solver's default), f_tol
-1e-30 N so no run stops early.  The depth stays that of the paper and only
-the width grows, so the contact structure per particle is the same at every N.
+Step cost: compiled ``methods.isa.relax.relax_resume``, variant PAPER, vs N, on 1
+and 2 threads (``threads`` argument and ``numba.set_num_threads``; the results are
+the same bits on both, tests/test_isa_parallel.py).  Scene (units cm, N): the
+paper's application-1 liquid made wide.  A rhombic lattice
+(``isaflow.scene.rhombic_lattice``, a = 10 cm) of 19 rows alternating n and n + 1
+particles (N = 19 n + 9; n = 9 is the paper's 180-particle case) in a rectangular
+vessel of height 100 cm and width (n + 1) a, particle weight 50 N, wall law
+l_u = 5 cm / r_u = 10 kN, pair law l_u = a / sqrt(2) / r_u = 500 l_u N, du = 0.01
+cm, skin 0.3 l_u (the solver's default), f_tol 1e-30 N so no run stops early.  The
+depth stays that of the paper and only the width grows, so the contact structure
+per particle is the same at every N.  The liquid is relaxed before timing: the
+small case directly (20,000 steps), the large ones by tiling a relaxed
+1,890-particle vessel: its left 450 cm, k copies of its central 100 cm strip and
+its right 450 cm (particles chosen by their initial lattice x, so every tile holds
+whole lattice columns), then healed.  ns per particle-step: CPU time (one thread,
+``ns_per_particle_step``, as before) and wall time (both thread counts,
+step_threads.csv: the 2-thread figure is a wall time; the machine is shared with
+other jobs, so each figure is the median of reps calls and the load average is
+recorded).
 
-The liquid is relaxed before timing: the small cases directly (20,000 steps),
-the large ones by tiling a relaxed 1,890-particle vessel: its left 450 cm,
-k copies of its central 100 cm strip and its right 450 cm (particles chosen by
-their initial lattice x, so every tile holds whole lattice columns).
+Equilibrium solver (variant ``newton_lm``, methods/isa/newton.py): force
+evaluations, Hessian assemblies, CG iterations and solver time on the scenes
+single_coarse, single_refined, study_fine (study_finer with --finer: ~20 s) and the
+complete coarse flow (flow_step50 continued from application 3 at step 100,000),
+beside the capped update's and FIRE's (the study's best FIRE: du 100 x the scene's,
+dt_max = 2 / sqrt(2 k_b + 12 k_p)), and the differences of its final state from
+the capped one (metrics.load_errors; tolerances metrics.tolerances).  The capped
+runs of study_fine / study_finer (6 s / 136 s) are not rerun: their counts are
+deterministic (the same bits on every run) and are taken from REFERENCE_CAPPED.
 
-Outputs (benchmarks/results/, or results/quick/ with --quick): step_cost[_TAG].csv, compile[_TAG].csv,
-memory[_TAG].csv, summary[_TAG].txt, machine.txt, step_cost.png.
+Outputs (benchmarks/results/, or results/quick/ with --quick): step_cost[_TAG].csv
+(1 thread), step_threads.csv, newton_evals.csv, compile[_TAG].csv, memory[_TAG].csv,
+summary[_TAG].txt, machine.txt, step_cost.png.
 ``--kernels FILE --tag before`` times another single-file copy of the kernels (e.g. the
-version before optimisation, ``git show 09b8875:src/isaflow/kernels.py``).
+version before optimisation, ``git show 09b8875:src/isaflow/kernels.py``; 1 thread only).
 """
 
 import argparse
@@ -37,6 +54,7 @@ from pathlib import Path
 import numpy as np
 
 HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
 sys.path.insert(0, str(HERE))
 
 A = 10.0  # cm, lattice diagonal
@@ -52,10 +70,18 @@ F_TOL = 1e-30  # N: never converges
 BASE_N_ROW = 99  # base vessel for tiling: 1000 cm wide, N = 1890
 DIRECT_MAX_N_ROW = 300  # up to N = 5709 the vessel is relaxed directly
 RELAX_STEPS = 20000
-HEAL_STEPS = 2000
+HEAL_STEPS = 1000
+TARGET_NS_2T = 10.0  # issue 20: <= 10 ns per particle-step with 2 threads at N >= 1e5
 
-FULL_N = [180, 684, 3000, 10_000, 30_000, 100_000, 300_000, 1_000_000]
-QUICK_N = [180, 684, 3000, 10_000, 30_000]
+FULL_N = [1000, 10_000, 30_000, 100_000]
+QUICK_N = [1000, 10_000]
+THREADS = (1, 2)
+
+# capped update's force evaluations where the benchmark does not rerun it (deterministic counts: the same
+# bits on every run of the capped update; issue 20 and benchmarks/results of the landed workflow)
+REFERENCE_CAPPED = {"study_fine": 138_503, "study_finer": 809_157}
+SCENES = ["single_coarse", "single_refined", "study_fine"]
+FLOW_START_STEPS = 100_000  # application 3 ends here (config/config.yaml flow_incomplete)
 
 
 def load_kernels(path):
@@ -66,8 +92,9 @@ def load_kernels(path):
 
         from isaflow.core import neighbours
         from isaflow.methods.isa import forces, relax
-        return SimpleNamespace(relax=relax.relax, PAPER=relax.PAPER, RUNNING=relax.RUNNING,
-                               forces=forces.forces, build_pairs=neighbours.build_pairs)
+        return SimpleNamespace(relax=relax.relax, relax_resume=relax.relax_resume, PAPER=relax.PAPER,
+                               RUNNING=relax.RUNNING, forces=forces.forces, build_pairs=neighbours.build_pairs,
+                               threaded=True)
     path = Path(path).resolve()  # imported by name so numba's cache can find it again
     sys.path.insert(0, str(path.parent))
     return importlib.import_module(path.stem)
@@ -83,27 +110,28 @@ def lattice(n_row):
     return pos, walls, box
 
 
-def run_relax(K, pos, walls, box, n_steps):
-    """kernels.relax, variant PAPER, in place on pos; returns (steps, status, fmax_hist)."""
+def run_relax(K, pos, walls, box, n_steps, threads=1):
+    """kernels.relax, variant PAPER, in place on pos; returns (forces, fmax_hist)."""
     n = len(pos)
     f = np.zeros_like(pos)
     hist = np.zeros(max(n_steps, 1))
-    steps, status, _ = K.relax(pos, np.zeros_like(pos), np.full(n, WEIGHT), walls, box, WL_U, WR_U, PL_U, PR_U,
-                               K.PAPER, DU, 1.0, 0.1, F_TOL, n_steps, SKIN, f, hist)
+    args = (pos, np.zeros_like(pos), np.full(n, WEIGHT), walls, box, WL_U, WR_U, PL_U, PR_U, K.PAPER, DU, 1.0, 0.1,
+            F_TOL, n_steps, SKIN, f, hist)
+    steps, status, _ = K.relax(*args, threads) if getattr(K, "threaded", False) else K.relax(*args)
     assert status == K.RUNNING and steps == n_steps, (steps, status)
     return f, hist
 
 
-def relaxed_state(K, n_target, base_cache, relax_steps, heal_steps):
+def relaxed_state(K, n_target, base_cache, relax_steps, heal_steps, threads):
     """Relaxed wide-vessel state with about n_target particles: (pos, walls, box)."""
     n_row = max(9, round((n_target - 9) / ROWS))
     if n_row <= DIRECT_MAX_N_ROW:
         pos, walls, box = lattice(n_row)
-        run_relax(K, pos, walls, box, relax_steps)
+        run_relax(K, pos, walls, box, relax_steps, threads)
         return pos, walls, box
     if "base" not in base_cache:
         pos, walls, box = lattice(BASE_N_ROW)
-        run_relax(K, pos, walls, box, relax_steps)
+        run_relax(K, pos, walls, box, relax_steps, threads)
         base_cache["base"] = pos
     p = base_cache["base"]
     wb = (BASE_N_ROW + 1) * A
@@ -113,22 +141,38 @@ def relaxed_state(K, n_target, base_cache, relax_steps, heal_steps):
     width = k * wb
     walls = np.array([[0, HEIGHT, 0, 0], [0, 0, width, 0], [width, 0, width, HEIGHT]], float)
     box = np.array([0.0, 0.0, width, HEIGHT])
-    run_relax(K, pos, walls, box, heal_steps)  # close the seams where inner walls were removed
+    run_relax(K, pos, walls, box, heal_steps, threads)  # close the seams where inner walls were removed
     return pos, walls, box
 
 
-def time_numba(K, pos, walls, box, target, reps):
-    """Best and median ns per particle-step of relax over reps calls of n_steps each."""
+def time_numba(K, pos, walls, box, target, reps, threads):
+    """{t: (steps per call, CPU ns per particle-step best / median, wall ns best / median)} for every
+    thread count t, the calls interleaved (t1, t2, t1, t2, ...) so that the thread counts share the
+    machine's load alike."""
+    import numba
     n = len(pos)
-    n_steps = max(200, int(np.ceil(target / n)))
-    ts, tw = [], []
-    for _ in range(reps):
-        t0, w0 = time.process_time(), time.perf_counter()
-        run_relax(K, pos, walls, box, n_steps)
-        ts.append(time.process_time() - t0)
-        tw.append(time.perf_counter() - w0)
-    ts = np.array(ts) / (n_steps * n) * 1e9
-    return n_steps, ts.min(), float(np.median(ts)), min(tw) / (n_steps * n) * 1e9
+    n_steps = max(100, int(np.ceil(target / n)))
+    ts = {t: [] for t in threads}
+    tw = {t: [] for t in threads}
+    try:
+        for _ in range(reps):
+            for t in threads:
+                if getattr(K, "threaded", False):
+                    numba.set_num_threads(t)
+                p = pos.copy()
+                t0, w0 = time.process_time(), time.perf_counter()
+                run_relax(K, p, walls, box, n_steps, t)
+                ts[t].append(time.process_time() - t0)
+                tw[t].append(time.perf_counter() - w0)
+    finally:
+        if getattr(K, "threaded", False):
+            numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
+    out = {}
+    for t in threads:
+        c = np.array(ts[t]) / (n_steps * n) * 1e9
+        w = np.array(tw[t]) / (n_steps * n) * 1e9
+        out[t] = (n_steps, c.min(), float(np.median(c)), w.min(), float(np.median(w)))
+    return out
 
 
 def time_numpy(ref, pos, walls, box, target, reps):
@@ -150,7 +194,7 @@ def time_numpy(ref, pos, walls, box, target, reps):
 
 
 def check_numpy_equivalence(K, ref):
-    """NumPy reference forces == compiled forces on a perturbed small relaxed case; also one step."""
+    """NumPy reference forces == compiled forces on a perturbed small relaxed case; also five steps."""
     pos, walls, box = lattice(9)
     rng = np.random.default_rng(0)
     pos += rng.normal(0, 0.8, pos.shape)
@@ -163,8 +207,7 @@ def check_numpy_equivalence(K, ref):
     st = ref.NumpyRelax(pos, w, walls, box, WL_U, WR_U, PL_U, PR_U, DU, SKIN)
     np.testing.assert_allclose(np.column_stack([st.fx, st.fy]), f, rtol=1e-12, atol=1e-9)
     p1 = pos.copy()
-    K.relax(p1, np.zeros_like(p1), w, walls, box, WL_U, WR_U, PL_U, PR_U, K.PAPER, DU, 1.0, 0.1, F_TOL, 5,
-            SKIN, f, np.zeros(5))
+    f, _ = run_relax(K, p1, walls, box, 5)
     st.run(5)
     np.testing.assert_allclose(st.pos, p1, rtol=0, atol=1e-9)
     np.testing.assert_allclose(np.column_stack([st.fx, st.fy]), f, rtol=1e-10, atol=1e-7)
@@ -174,7 +217,7 @@ def check_numpy_equivalence(K, ref):
 # ---- subprocess probes ---------------------------------------------------------------------------------
 
 def probe_compile(kernels_path):
-    """First call of relax in this process (compile or cache load); prints JSON."""
+    """First call of the step loop in this process (compile or cache load); prints JSON."""
     t0 = time.perf_counter()
     K = load_kernels(kernels_path)
     t_import = time.perf_counter() - t0
@@ -185,7 +228,7 @@ def probe_compile(kernels_path):
     t0 = time.perf_counter()
     run_relax(K, pos, walls, box, 10)
     t_second = time.perf_counter() - t0
-    st = K.relax.stats
+    st = getattr(K, "relax_resume", K.relax).stats
     print(json.dumps(dict(import_s=t_import, first_call_s=t_first, second_call_s=t_second,
                           cache_hits=sum(st.cache_hits.values()), cache_misses=sum(st.cache_misses.values()))))
 
@@ -198,7 +241,7 @@ def status_kb(key):
 
 
 def probe_memory(kernels_path, npy):
-    """Peak RSS growth during relax on the state saved in npy; prints JSON."""
+    """Peak RSS growth during relax on the state saved in npy (1 thread); prints JSON."""
     K = load_kernels(kernels_path)
     p, walls, box = lattice(9)
     run_relax(K, p, walls, box, 2)  # compile / load before measuring
@@ -213,7 +256,8 @@ def probe_memory(kernels_path, npy):
     rss0 = status_kb("VmRSS")
     with open("/proc/self/clear_refs", "w") as fh:
         fh.write("5")  # reset the peak-RSS counter VmHWM
-    K.relax(pos, vel, weight, walls, box, WL_U, WR_U, PL_U, PR_U, K.PAPER, DU, 1.0, 0.1, F_TOL, 100, SKIN, f, hist)
+    args = (pos, vel, weight, walls, box, WL_U, WR_U, PL_U, PR_U, K.PAPER, DU, 1.0, 0.1, F_TOL, 100, SKIN, f, hist)
+    K.relax(*args, 1) if getattr(K, "threaded", False) else K.relax(*args)
     hwm = status_kb("VmHWM")
     print(json.dumps(dict(n=n, rss_before_kb=rss0, hwm_kb=hwm, kernel_bytes=(hwm - rss0) * 1024,
                           caller_bytes=caller)))
@@ -251,8 +295,16 @@ def machine_info():
         host = ll.get_host_cpu_name()
     except Exception:  # pragma: no cover
         host = "?"
+    try:
+        layer = numba.threading_layer()
+    except ValueError:
+        layer = "not initialised"
     lines = [f"cpu model (/proc/cpuinfo): {model}", f"llvm host cpu: {host}",
-             f"logical cores: {os.cpu_count()}", "numba threads used: 1 (kernels are not parallel)",
+             f"logical cores: {os.cpu_count()}", f"numba threads used: {', '.join(map(str, THREADS))} (step table); "
+             f"1 (equilibrium solver, serial); NUMBA_NUM_THREADS = {numba.config.NUMBA_NUM_THREADS}",
+             f"numba threading layer: {layer}",
+             "the machine is shared with other jobs: timings are medians of repeated calls; see the load averages "
+             "in summary.txt",
              f"python: {platform.python_version()} ({platform.python_implementation()})",
              f"numba: {numba.__version__}", f"numpy: {np.__version__}", f"platform: {platform.platform()}"]
     try:
@@ -263,6 +315,10 @@ def machine_info():
     return "\n".join(lines) + "\n"
 
 
+def load_average():
+    return " ".join(open("/proc/loadavg").read().split()[:3])
+
+
 def fit_exponent(ns, cost_per_step):
     ns, c = np.asarray(ns, float), np.asarray(cost_per_step, float)
     sel = ns >= 1e4
@@ -271,7 +327,7 @@ def fit_exponent(ns, cost_per_step):
     return float(np.polyfit(np.log(ns[sel]), np.log(c[sel]), 1)[0])
 
 
-def plot(outdir, tables):
+def plot(outdir, tables, threads_rows):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -282,13 +338,18 @@ def plot(outdir, tables):
         ns_ps = np.array([r["ns_per_particle_step"] for r in rows], float)
         p = fit_exponent(ns, ns_ps * ns)
         mk, col = styles.get(label, ("x-", None))
-        ax.loglog(ns, ns_ps, mk, color=col, label=f"{label}: cost/step ~ N^{p:.2f} (fit N >= 1e4)")
-    ax.axhline(20.0, color="k", lw=0.8, ls=":", label="target 20 ns")
+        ax.loglog(ns, ns_ps, mk, color=col, label=f"{label}, 1 thread (CPU): cost/step ~ N^{p:.2f} (fit N >= 1e4)")
+    if threads_rows:
+        ns = np.array([r["N"] for r in threads_rows], float)
+        for t, mk in zip(THREADS, ("D:", "v-")):
+            ax.loglog(ns, [r[f"wall_ns_{t}t"] for r in threads_rows], mk, color="C2" if t > 1 else "C9",
+                      label=f"numba, {t} thread{'s' if t > 1 else ''} (wall, median)")
+    ax.axhline(TARGET_NS_2T, color="k", lw=0.8, ls=":", label=f"target {TARGET_NS_2T:g} ns (2 threads, N >= 1e5)")
     ax.set_xlabel("N, particles [-]")
-    ax.set_ylabel("CPU time per particle-step [ns]")
-    ax.set_title("kernels.relax (PAPER) vs vectorised NumPy, 1 core")
+    ax.set_ylabel("time per particle-step [ns]")
+    ax.set_title("relax_resume (PAPER) vs vectorised NumPy; shared 2-core machine")
     ax.grid(True, which="both", lw=0.3)
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=7)
     fig.tight_layout()
     fig.savefig(outdir / "step_cost.png", dpi=150)
 
@@ -302,13 +363,138 @@ def read_csv(path):
     return rows
 
 
+def write_csv(path, rows, keys=None):
+    keys = keys or list(rows[0])
+    with open(path, "w", newline="") as fh:
+        wr = csv.DictWriter(fh, keys)
+        wr.writeheader()
+        for r in rows:
+            wr.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in r.items() if k in keys})
+
+
+# ---- equilibrium solver ------------------------------------------------------------------------------------
+
+def solve_scene(path, sets, threads=1):
+    """(Result, Scene) of one in-process solve (compile excluded: solver.solve warms up first)."""
+    from isaflow import scene as S
+    from isaflow.methods.isa import solver
+    sc = S.load(str(path), list(sets))
+    if "from_run" in sc.spec["particles"]:
+        st = S.start_file(sc)
+        pos0, weight, start, state = st["pos"], st["weight"], st["steps"], st["state"]
+    else:
+        pos0, weight, start, _ = S.initial_state(sc)
+        state = None
+    return solver.solve(sc, pos0, weight, start_step=start, state=state, threads=threads), sc
+
+
+def fire_sets(sc_path):
+    """The study's best FIRE: du = 100 x the scene's, dt_max = 2 / sqrt(2 k_b + 12 k_p)."""
+    from isaflow import scene as S
+    from isaflow.methods.isa.settings import fire_dt_max, settings
+    sc = S.load(str(sc_path), [])
+    du = settings(sc)["du"]
+    return ["solver.variant=fire", f"solver.du={100 * du!r}",
+            f"solver.dt_max={fire_dt_max(sc.stiffness('wall'), sc.stiffness('pair'), 2.0)!r}",
+            "solver.max_steps=2000000"]
+
+
+def state_diff(capped_file, newton_file, vessel=None):
+    """Level [cm] and side-load (relative) differences newton - capped, with the report's tolerances."""
+    from isaflow import metrics, runfile
+    a, b = runfile.read(capped_file), runfile.read(newton_file)
+    ea, eb = metrics.load_errors(a, vessel), metrics.load_errors(b, vessel)
+    view = metrics.vessel_view(a, vessel)
+    tol = metrics.tolerances(dict(depth=ea["depth"], weight=ea["weight"]), float(a.attrs["spacing"]),
+                             int(view["inside"].sum()), float(a.attrs["f_tol"]))
+    return dict(level_diff_cm=eb["level"] - ea["level"], level_tol_cm=tol["level"][0],
+                side_err_diff=eb["side_err"] - ea["side_err"], side_tol=tol["side"][0],
+                floor_err_diff=eb["floor_err"] - ea["floor_err"], floor_tol=tol["floor"][0])
+
+
+def write_run(result, sc, path):
+    """The run file of an in-process solve (as cli.run writes it), for the metrics."""
+    from isaflow import runfile
+    start = sc.spec["particles"].get("from_run")
+    prov = runfile.provenance({"scene": sc.path, "config": None, "start": start})
+    prov.update(scene_yaml=sc.text, scene_overrides="; ".join(sc.overrides) or "none",
+                scene_resolved_sha256=sc.digest, restart="benchmark")
+    spacing = sc.spacing if sc.spacing is not None else (runfile.read(start).attrs["spacing"] if start else np.nan)
+    runfile.write(runfile.to_dataset(result, sc, prov, runfile.now(), runfile.now(), spacing), path)
+
+
+def newton_table(scenes, tmp):
+    """Rows of newton_evals.csv: every scene with newton_lm, FIRE and (where cheap) capped."""
+    from isaflow import cli
+    rows = []
+    for name in scenes:
+        path = ROOT / "config" / "scenes" / f"{name}.yaml"
+        row = dict(scene=name)
+        files = {}
+        for variant, sets in (("newton_lm", ["solver.variant=newton_lm"]), ("fire", fire_sets(path)),
+                              ("capped", ["solver.variant=capped"])):
+            if variant == "capped" and name in REFERENCE_CAPPED:
+                row.update(capped_evals=REFERENCE_CAPPED[name], capped_s=float("nan"),
+                           capped_source="reference (deterministic count, not rerun)")
+                continue
+            r, sc = solve_scene(path, sets)
+            assert r.status == "converged", (name, variant, r.status, r.message)
+            key = {"newton_lm": "newton", "fire": "fire", "capped": "capped"}[variant]
+            row.update({f"{key}_evals": r.force_evals, f"{key}_s": r.wall_time})
+            if variant == "newton_lm":
+                row.update(particles=len(r.pos), newton_steps=r.steps,
+                           hessian_assemblies=r.params["hessian_assemblies"],
+                           cg_iterations=r.params["cg_iterations"], refused_steps=r.params["refused_steps"])
+            if variant == "capped":
+                row["capped_source"] = "this run"
+            files[variant] = tmp / f"{name}_{variant}.nc"
+            write_run(r, sc, files[variant])
+        if "capped" in files:
+            row.update(state_diff(files["capped"], files["newton_lm"]))
+        rows.append(row)
+    # the complete coarse flow: application 1 -> 3 (paper's update, to step 100,000) -> 4 (capped, newton_lm)
+    app1, app3 = tmp / "app1.nc", tmp / "app3.nc"
+    flow = ROOT / "config" / "scenes" / "flow_step50.yaml"
+    assert cli.run(str(ROOT / "config/scenes/single_coarse.yaml"), str(app1), [], quiet=True) == 0
+    assert cli.run(str(flow), str(app3), [f"particles.from_run={app1}", f"solver.max_steps={FLOW_START_STEPS}"],
+                   quiet=True) == 0
+    row = dict(scene="flow_step50 (complete, from step 100,000)")
+    files = {}
+    for variant, sets in (("newton_lm", ["solver.variant=newton_lm"]), ("fire", fire_sets(flow)),
+                          ("capped", ["solver.variant=capped"])):
+        r, sc = solve_scene(flow, [f"particles.from_run={app3}"] + sets)
+        key = {"newton_lm": "newton", "fire": "fire", "capped": "capped"}[variant]
+        row.update({f"{key}_evals": r.force_evals, f"{key}_s": r.wall_time, f"{key}_status": r.status})
+        if variant == "newton_lm":
+            row.update(particles=len(r.pos), newton_steps=r.steps - FLOW_START_STEPS,
+                       hessian_assemblies=r.params["hessian_assemblies"], cg_iterations=r.params["cg_iterations"],
+                       refused_steps=r.params["refused_steps"])
+        files[variant] = tmp / f"flow_{variant}.nc"
+        write_run(r, sc, files[variant])
+    row["capped_source"] = "this run"
+    row.update(state_diff(files["capped"], files["newton_lm"], "second"))
+    rows.append(row)
+    for r in rows:
+        r["newton_over_capped"] = r["newton_evals"] / r["capped_evals"]
+        r["newton_over_fire"] = r["newton_evals"] / r["fire_evals"]
+    return rows
+
+
+NEWTON_KEYS = ["scene", "particles", "newton_evals", "newton_steps", "hessian_assemblies", "cg_iterations",
+               "refused_steps", "newton_s", "capped_evals", "capped_s", "capped_source", "fire_evals", "fire_s",
+               "newton_over_capped", "newton_over_fire", "level_diff_cm", "level_tol_cm", "side_err_diff", "side_tol",
+               "floor_err_diff", "floor_tol", "newton_status", "capped_status", "fire_status"]
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--quick", action="store_true", help="reduced N list (< 60 s)")
+    ap.add_argument("--quick", action="store_true", help="reduced N list, no newton table (< 30 s)")
+    ap.add_argument("--finer", action="store_true", help="also study_finer in the newton table (~20 s more)")
     ap.add_argument("--kernels", help="time this copy of kernels.py instead of isaflow.methods.isa.relax")
     ap.add_argument("--tag", default="", help="suffix of the output files, e.g. 'before'")
     ap.add_argument("--no-numpy", action="store_true", help="skip the NumPy reference")
-    ap.add_argument("--out", help="output folder (default benchmarks/results, or benchmarks/results/quick with --quick)")
+    ap.add_argument("--out", help="output folder (default benchmarks/results, or benchmarks/results/quick "
+                                   "with --quick)")
     ap.add_argument("--probe-compile", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--probe-memory", help=argparse.SUPPRESS)
     args = ap.parse_args()
@@ -318,24 +504,22 @@ def main():
         return probe_memory(args.kernels, args.probe_memory)
 
     t_start = time.perf_counter()
+    load_start = load_average()
     out = Path(args.out or (HERE / "results" / "quick" if args.quick else HERE / "results"))
     out.mkdir(parents=True, exist_ok=True)
     sfx = f"_{args.tag}" if args.tag else ""
     kpath = str(Path(args.kernels).resolve()) if args.kernels else None
-    (out / "machine.txt").write_text(machine_info())
 
     # compile vs cache load, in fresh processes with a private cache directory
     comp = measure_compile(kpath)
-    with open(out / f"compile{sfx}.csv", "w", newline="") as fh:
-        wr = csv.DictWriter(fh, ["run", "import_s", "first_call_s", "second_call_s", "cache_hits", "cache_misses",
-                                 "files_in_cache"])
-        wr.writeheader()
-        wr.writerows(comp)
+    write_csv(out / f"compile{sfx}.csv", comp, ["run", "import_s", "first_call_s", "second_call_s", "cache_hits",
+                                                  "cache_misses", "files_in_cache"])
     for r in comp:
         print(f"compile: {r['run']:22s} first call {r['first_call_s']:.3f} s  (import {r['import_s']:.3f} s, "
               f"cache hits {r['cache_hits']}, misses {r['cache_misses']})", flush=True)
 
     K = load_kernels(kpath)
+    threads = THREADS if getattr(K, "threaded", False) else (1,)
     ref = None
     if not args.no_numpy:
         import numpy_reference as ref
@@ -343,39 +527,54 @@ def main():
         print(f"numpy reference == compiled forces (max|F| {fm:.4g} N): ok", flush=True)
 
     n_list = QUICK_N if args.quick else FULL_N
-    target = 2e6 if args.quick else 3e7  # particle-steps per timed call
-    np_target = 2e5 if args.quick else 1e6
-    reps = 3
+    target = 3e6 if args.quick else 2e7  # particle-steps per timed call (200 steps at N = 1e5)
+    np_target = 2e5
+    reps = 5
     relax_steps = 5000 if args.quick else RELAX_STEPS
     heal_steps = 500 if args.quick else HEAL_STEPS
     base = {}
-    rows = []
+    rows, trows = [], []
     big_state = None
     for n_target in n_list:
         t0 = time.perf_counter()
-        pos, walls, box = relaxed_state(K, n_target, base, relax_steps, heal_steps)
+        pos, walls, box = relaxed_state(K, n_target, base, relax_steps, heal_steps, max(threads))
         n = len(pos)
         t_prep = time.perf_counter() - t0
-        f, hist = run_relax(K, pos, walls, box, 1)
+        f, hist = run_relax(K, pos.copy(), walls, box, 1)
         pi, pj, m = K.build_pairs(pos, box, PL_U + SKIN)
         d = np.hypot(*(pos[pi[:m]] - pos[pj[:m]]).T)
         contacts = float((d < PL_U).sum()) * 2 / n
-        steps, best, med, wall = time_numba(K, pos, walls, box, target, reps)
-        row = dict(impl="numba", N=n, steps_per_call=steps, reps=reps, ns_per_particle_step=best,
-                   ns_median=med, ns_wall_best=wall, s_per_step=best * n * 1e-9, contacts_per_particle=contacts,
-                   list_pairs_per_particle=m / n, fmax_start=hist[0], prep_s=t_prep)
-        rows.append(row)
-        msg = (f"N={n:8d} numba {best:7.2f} ns/particle-step (median {med:.2f}, {steps} steps x {reps}); "
-               f"contacts/particle {contacts:.2f}, max|F| {hist[0]:.3g} N")
+        trow = dict(N=n)
+        timed = time_numba(K, pos, walls, box, target, reps, threads)
+        for t in threads:
+            steps, best, med, wbest, wmed = timed[t]
+            trow.update({f"cpu_ns_{t}t": med, f"wall_ns_{t}t": wmed, f"wall_ns_best_{t}t": wbest,
+                         "steps_per_call": steps})
+            if t == 1:
+                row = dict(impl="numba", threads=1, N=n, steps_per_call=steps, reps=reps, ns_per_particle_step=best,
+                           ns_median=med, ns_wall_best=wbest, s_per_step=best * n * 1e-9,
+                           contacts_per_particle=contacts, list_pairs_per_particle=m / n, fmax_start=hist[0],
+                           prep_s=t_prep)
+                rows.append(row)
+        msg = f"N={n:8d} " + "  ".join(f"{t} thread(s): {trow[f'wall_ns_{t}t']:6.2f} ns wall "
+                                       f"(cpu {trow[f'cpu_ns_{t}t']:.2f})" for t in threads)
+        if len(threads) > 1:
+            t2 = threads[-1]
+            trow["speedup"] = trow["wall_ns_1t"] / trow[f"wall_ns_{t2}t"]
+            trow["efficiency"] = trow["speedup"] / t2
+            trow["speedup_best"] = trow["wall_ns_best_1t"] / trow[f"wall_ns_best_{t2}t"]
+            trow["efficiency_best"] = trow["speedup_best"] / t2
+            msg += f"  speed-up {trow['speedup']:.2f}, efficiency {trow['efficiency']:.0%}"
+        trows.append(trow)
         if ref is not None:
-            nps, nbest, nmed, nwall, nbuild = time_numpy(ref, pos, walls, box, np_target, reps)
-            rows.append(dict(impl="numpy", N=n, steps_per_call=nps, reps=reps, ns_per_particle_step=nbest,
-                             ns_median=nmed, ns_wall_best=nwall, s_per_step=nbest * n * 1e-9, numpy_build_ns_per_particle=nbuild))
-            row["speedup_vs_numpy"] = nbest / best
-            msg += f" | numpy {nbest:8.1f} ns ({nps} steps) -> x{nbest / best:.1f}"
+            nps, nbest, nmed, nwall, nbuild = time_numpy(ref, pos, walls, box, np_target, 3)
+            rows.append(dict(impl="numpy", threads=1, N=n, steps_per_call=nps, reps=3, ns_per_particle_step=nbest,
+                             ns_median=nmed, ns_wall_best=nwall, s_per_step=nbest * n * 1e-9,
+                             numpy_build_ns_per_particle=nbuild))
+            row["speedup_vs_numpy"] = nbest / row["ns_per_particle_step"]
+            msg += f" | numpy {nbest:8.1f} ns ({nps} steps) -> x{row['speedup_vs_numpy']:.1f}"
         print(msg, flush=True)
-        if n_target == n_list[-1]:
-            big_state = (pos, walls, box)
+        big_state = (pos, walls, box)
 
     # memory at the largest N, in a fresh process
     with tempfile.TemporaryDirectory() as tmp:
@@ -386,37 +585,60 @@ def main():
     mem_row = dict(N=n_big, kernel_peak_bytes_per_particle=mem["kernel_bytes"] / n_big,
                    caller_state_bytes_per_particle=mem["caller_bytes"] / n_big,
                    total_bytes_per_particle=(mem["kernel_bytes"] + mem["caller_bytes"]) / n_big)
-    with open(out / f"memory{sfx}.csv", "w", newline="") as fh:
-        wr = csv.DictWriter(fh, list(mem_row))
-        wr.writeheader()
-        wr.writerow(mem_row)
+    write_csv(out / f"memory{sfx}.csv", [mem_row])
 
-    keys = ["impl", "N", "steps_per_call", "reps", "ns_per_particle_step", "ns_median", "ns_wall_best", "s_per_step",
-            "speedup_vs_numpy", "contacts_per_particle", "list_pairs_per_particle", "fmax_start", "prep_s",
-            "numpy_build_ns_per_particle"]
-    with open(out / f"step_cost{sfx}.csv", "w", newline="") as fh:
-        wr = csv.DictWriter(fh, keys)
-        wr.writeheader()
-        for r in rows:
-            wr.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in r.items()})
+    keys = ["impl", "threads", "N", "steps_per_call", "reps", "ns_per_particle_step", "ns_median", "ns_wall_best",
+            "s_per_step", "speedup_vs_numpy", "contacts_per_particle", "list_pairs_per_particle", "fmax_start",
+            "prep_s", "numpy_build_ns_per_particle"]
+    write_csv(out / f"step_cost{sfx}.csv", rows, keys)
+    if len(threads) > 1:
+        t2 = threads[-1]
+        for r in trows:
+            r["target_2t_met"] = (("yes" if r[f"wall_ns_{t2}t"] <= TARGET_NS_2T else "no") + " (median), "
+                                  + ("yes" if r[f"wall_ns_best_{t2}t"] <= TARGET_NS_2T else "no") + " (best)"
+                                  if r["N"] >= 1e5 else "n/a")
+        write_csv(out / f"step_threads{sfx}.csv", trows,
+                  ["N", "steps_per_call"]
+                  + [f"{k}_{t}t" for t in threads for k in ("wall_ns", "wall_ns_best", "cpu_ns")]
+                  + ["speedup", "efficiency", "speedup_best", "efficiency_best", "target_2t_met"])
+
+    nrows = []
+    if not args.quick and kpath is None:
+        with tempfile.TemporaryDirectory() as tmp:
+            nrows = newton_table(SCENES + (["study_finer"] if args.finer else []), Path(tmp))
+        write_csv(out / "newton_evals.csv", nrows, [k for k in NEWTON_KEYS if any(k in r for r in nrows)])
 
     nb = [r for r in rows if r["impl"] == "numba"]
     expo = fit_exponent([r["N"] for r in nb], [r["s_per_step"] for r in nb])
     lines = [f"kernels: {kpath or 'isaflow.methods.isa.relax'}", f"mode: {'quick' if args.quick else 'full'}",
+             f"load average (1, 5, 15 min) at start: {load_start}; at end: {load_average()} (2 cores, shared machine)",
              f"compile (cold cache) first call: {comp[0]['first_call_s']:.3f} s; "
              f"cache load (warm cache) first call: {comp[1]['first_call_s']:.3f} s "
              f"(hits {comp[1]['cache_hits']}, misses {comp[1]['cache_misses']})",
-             f"fitted exponent of cost per step vs N (N >= 1e4): {expo:.3f}",
+             f"fitted exponent of cost per step vs N (N >= 1e4, 1 thread): {expo:.3f}",
              f"memory at N = {n_big}: kernel peak {mem_row['kernel_peak_bytes_per_particle']:.1f} B/particle + "
              f"caller state {mem_row['caller_state_bytes_per_particle']:.1f} = "
              f"{mem_row['total_bytes_per_particle']:.1f} B/particle"]
     for r in nb:
-        s = f"N={int(r['N']):8d}: {r['ns_per_particle_step']:7.2f} ns/particle-step"
+        s = f"N={int(r['N']):8d}: {r['ns_per_particle_step']:7.2f} ns/particle-step (1 thread, CPU)"
         if "speedup_vs_numpy" in r:
             s += f", numpy x{r['speedup_vs_numpy']:.1f}"
         lines.append(s)
+    for r in trows:
+        if len(threads) > 1:
+            t2 = threads[-1]
+            lines.append(f"N={int(r['N']):8d}: wall median {r['wall_ns_1t']:.2f} ns (1 thread) vs "
+                         f"{r[f'wall_ns_{t2}t']:.2f} ns ({t2} threads): speed-up {r['speedup']:.2f}, "
+                         f"parallel efficiency {r['efficiency']:.0%} (best of {reps}: {r['wall_ns_best_1t']:.2f} vs "
+                         f"{r[f'wall_ns_best_{t2}t']:.2f} ns, {r['efficiency_best']:.0%}); "
+                         f"target <= {TARGET_NS_2T:g} ns at N >= 1e5: {r['target_2t_met']}")
+    for r in nrows:
+        lines.append(f"newton_lm {r['scene']}: {r['newton_evals']} force evaluations in {r['newton_s']:.3f} s "
+                     f"({r['hessian_assemblies']} Hessian assemblies, {r['cg_iterations']} CG iterations); capped "
+                     f"{r['capped_evals']} ({r['newton_over_capped']:.2%}), FIRE {r['fire_evals']}")
     lines.append(f"benchmark wall time: {time.perf_counter() - t_start:.1f} s")
     (out / f"summary{sfx}.txt").write_text("\n".join(lines) + "\n")
+    (out / "machine.txt").write_text(machine_info())
     print("\n".join(lines))
 
     tables = {}
@@ -430,7 +652,7 @@ def main():
         t = [r for r in read_csv(p) if r["impl"] == "numpy"]
         if t:
             tables["numpy"] = t
-    plot(out, tables)
+    plot(out, tables, trows if len(threads) > 1 else [])
 
 
 if __name__ == "__main__":

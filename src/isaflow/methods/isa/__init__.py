@@ -3,7 +3,7 @@
 Modules: ``forces`` (force laws, plain force evaluation, wall contacts),
 ``relax`` (the compiled step loop of the three update rules), ``dynamics`` (the
 compiled loop of the overdamped variant: the same particles with masses w/g),
-``settings``
+``newton`` (the equilibrium solver of the variant ``newton_lm``), ``settings``
 (solver settings with defaults), ``solver`` (chunks, history, outcome ->
 contract.Result).
 """
@@ -20,6 +20,8 @@ METHOD = Method(
         "fire": Variant("fire", "fire: FIRE relaxation, Bitzek et al. 2006 (variant, not in paper)", "tab:purple", "^"),
         "overdamped": Variant("overdamped", "overdamped: m x'' = F - c x', m = w/g, same laws (variant, not in paper)",
                               "tab:olive", "v"),
+        "newton_lm": Variant("newton_lm", "newton_lm: energy minimisation, Newton-type (Levenberg-Marquardt) with "
+                             "the contacts' Hessian (equilibrium solver, not in paper)", "tab:brown", "X"),
     },
     marker="o",
     paper_label="Papadopoulos, Koutitas & Lazaridis (2016), the paper replicated",

@@ -9,7 +9,7 @@ its neighbour's whole repulsion); :func:`cost` estimates particles, steps
 """
 
 from ... import budget
-from ...plausible import within
+from ...plausible import require, within
 
 NS_PER_PARTICLE_STEP = 20.0  # fastest measured relax step (benchmarks/), rounded down
 BYTES_PER_PARTICLE = 640  # solver + compiled loop + contacts + the run file's copy (measured order, rounded up)
@@ -31,6 +31,10 @@ def particle_count(part):
 def plausible(tank, s, stability=False):
     """Refuse implausible settings (InputError naming the file and the setting, with the reason)."""
     within(s.path, "solver.du", s["solver.du"], None, s["forces.pair.l_u"] / 2, DU, stability=stability)
+    if s.variant == "newton_lm":  # its energy and Hessian are the linear laws' (methods/isa/newton.py)
+        for side in ("wall", "pair"):
+            require(s[f"forces.{side}.law"] == "linear", s.path, f"forces.{side}.law",
+                    f"the newton_lm variant implements the linear law only, not '{s[f'forces.{side}.law']}'")
 
 
 def cost(tank, s, particles=None):

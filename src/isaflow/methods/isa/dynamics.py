@@ -27,8 +27,8 @@ import numpy as np
 from numba import njit
 
 from ...core.neighbours import cell_rows
-from .relax import (CONVERGED, CROSSED, NONFINITE, RUNNING, _first_crossing, _move_and_wall_forces, _near_walls,
-                    _pair_forces, _to_caller_order, _to_cell_order)
+from .relax import (CONVERGED, CROSSED, NONFINITE, RUNNING, _evaluate, _first_crossing, _near_walls, _pair_scratch,
+                    _row_starts, _to_caller_order, _to_cell_order)
 
 JIT = dict(cache=True, nogil=True)
 
@@ -61,16 +61,23 @@ def overdamped_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u
     order = np.empty(n, np.int32)
     rank = np.empty(n, np.int32)
     row_start = np.empty(n + 1, np.int32)
+    near_start = np.empty(n + 1, np.int32)
     pos_c = np.empty((n, 2))
+    new_c = np.empty((n, 2))
     vel_c = np.empty((n, 2))
     force_c = np.empty((n, 2))
+    force_n = np.empty((n, 2))
     weight_c = np.empty(n)
+    one = np.empty(1, np.int64)  # the serial pass's block scratch (relax._evaluate, _first_crossing with nb = 1)
+    one_b, one_w, one_bad, fmax_b, none = one.copy(), one.copy(), one.copy(), np.empty(1), np.empty(0)
     if not resume:
         pos_build[:, :] = pos
     nbr, cstart = cell_rows(pos_build, box, rc, order, np.empty(1, np.int32), row_start,
                             np.empty(4 * n + 16, np.int32))
     _to_cell_order(pos_build, vel, weight, order, nbr, row_start[n], rank, pos_c, vel_c, weight_c)
+    owner, gx, gy = _pair_scratch(row_start, n, np.empty(0, np.int32), np.empty(0), np.empty(0))
     near_part, near_wall = _near_walls(pos_c, walls, reach)
+    _row_starts(near_part, n, near_start)
     if resume:
         for q in range(n):
             pos_c[q, 0] = pos[order[q], 0]
@@ -80,9 +87,7 @@ def overdamped_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u
         moved = 0.0
     t = state[1]
     quiet = state[2]
-    _move_and_wall_forces(pos_c, force_c, 0.0, False, weight_c, walls, wall_l_u, wall_r_u, near_part, near_wall,
-                          force_c, wall_p)
-    fmax, bad = _pair_forces(pos_c, pair_l_u, pair_r_u, row_start, nbr, force_c, pair_p)
+    move = n < 0  # False, computed (relax_resume's one specialisation of _evaluate)
     ke = 0.0
     for i in range(n):  # caller order, as the sums below
         q = rank[i]
@@ -91,7 +96,14 @@ def overdamped_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u
     crossing = -1
     done = n_steps
     step_move = 0.0
-    for step in range(n_steps + 1):
+    step = -1
+    while True:  # evaluate at the new positions, then test and step
+        fmax, bad = _evaluate(1, one, pos_c, new_c, vel_c, dt, move, weight_c, walls, wall_l_u, wall_r_u, near_start,
+                              near_part, near_wall, pair_l_u, pair_r_u, wall_p, pair_p, row_start, nbr, owner, gx, gy,
+                              force_n, False, order, vel_c, none, none, none, fmax_b, one_bad)
+        pos_c, new_c = new_c, pos_c
+        force_c, force_n = force_n, force_c
+        step += 1
         if step < n_steps:
             fmax_hist[step] = fmax
             ke_hist[step] = ke
@@ -115,13 +127,25 @@ def overdamped_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u
             vmax = max(vmax, abs(vel_c[q, 0]), abs(vel_c[q, 1]))
         max_move = np.sqrt(2.0) * dt * vmax
         step_move = max(step_move, dt * vmax)
-        i, w = _first_crossing(pos_c, vel_c, dt, walls, order, near_part, not (moved + max_move < reach))
+        i, w = _first_crossing(1, pos_c, vel_c, dt, walls, order, near_part, near_wall,
+                               not (moved + max_move < reach), one_b, one_w)
         if i >= 0:  # tested before any particle moved: the step is not taken
             status = CROSSED
             crossing = i * nw + w
             done = step
             break
         moved += max_move
+        move = True
+        t += dt
+        ke = 0.0
+        for i in range(n):  # the step's kinetic energy (velocities are set before the move)
+            q = rank[i]
+            ke += 0.5 * weight_c[q] / g * (vel_c[q, 0] ** 2 + vel_c[q, 1] ** 2)
+        if ke / e_norm < e_limit:
+            if quiet < 0.0:
+                quiet = t
+        else:
+            quiet = -1.0
         if moved > 0.5 * skin:
             for q in range(n):
                 pos_c[q, 0] = pos_c[q, 0] + dt * vel_c[q, 0]
@@ -131,24 +155,11 @@ def overdamped_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u
             pos_build[:, :] = pos
             nbr, cstart = cell_rows(pos, box, rc, order, cstart, row_start, nbr)
             _to_cell_order(pos, vel, weight, order, nbr, row_start[n], rank, pos_c, vel_c, weight_c)
+            owner, gx, gy = _pair_scratch(row_start, n, owner, gx, gy)
             near_part, near_wall = _near_walls(pos_c, walls, reach)
+            _row_starts(near_part, n, near_start)
             moved = 0.0
-            _move_and_wall_forces(pos_c, vel_c, dt, False, weight_c, walls, wall_l_u, wall_r_u, near_part,
-                                  near_wall, force_c, wall_p)
-        else:
-            _move_and_wall_forces(pos_c, vel_c, dt, True, weight_c, walls, wall_l_u, wall_r_u, near_part,
-                                  near_wall, force_c, wall_p)
-        fmax, bad = _pair_forces(pos_c, pair_l_u, pair_r_u, row_start, nbr, force_c, pair_p)
-        t += dt
-        ke = 0.0
-        for i in range(n):
-            q = rank[i]
-            ke += 0.5 * weight_c[q] / g * (vel_c[q, 0] ** 2 + vel_c[q, 1] ** 2)
-        if ke / e_norm < e_limit:
-            if quiet < 0.0:
-                quiet = t
-        else:
-            quiet = -1.0
+            move = False
     _to_caller_order(order, pos_c, pos)
     _to_caller_order(order, vel_c, vel)
     _to_caller_order(order, force_c, force)

@@ -31,7 +31,7 @@ def check(tank, settings, variant, resolution, start=None):
 
 def warm_up(threads=None):
     """Compile (or load from numba's cache) every kernel a run times."""
-    solver.warm_up()
+    solver.warm_up(solver.thread_count(threads))
 
 
 def tank_difference(tank, pos0, weight, pitch, floor_y):
@@ -63,7 +63,7 @@ def solve(tank, settings, variant, resolution, start=None, progress=None, thread
         extra = dict(restart=st["restart"], start_sha256=st["sha256"], start_step=st["steps"])
     report = (lambda step, fmax: progress(step, "max|F|", fmax, "N")) if progress else None
     result = solver.solve(scene, pos0, weight, start_step=start_step, progress=report, state=state,
-                          rest_depth=tank.depth)
+                          rest_depth=tank.depth, threads=threads)
     result.spacing = spacing
     result.params.update(layer_pitch=pitch, held_weight=held, initial_depth=depth, tank_difference=diff, **extra)
     return result

@@ -95,7 +95,7 @@ def pair_increments(ds):
     for s in range(steps):
         before = pos.copy()
         done, status, _ = R.relax_resume(pos, vel, weight, walls, box, *args, force, h, pos_build, state,
-                                         s % chunk != 0, wp, pp)
+                                         s % chunk != 0, 1, wp, pp)
         if done != 1:
             break
         move = max(move, float(np.abs(pos - before).max()))

@@ -22,7 +22,7 @@ def start_file(scene):
     state is the solver's restart state (solver.STATE_VARS) when the run file
     was made under the same dynamics (walls, force laws, update rule and its
     numbers, chunk), so the continued run repeats the uninterrupted one bit
-    for bit; otherwise None (positions only: a new problem started from a
+    for bit; otherwise, and for the newton_lm variant, None (positions only: a new problem started from a
     previous state, e.g. application 3 from application 1), and restart
     says why.  Refused (SceneError naming 'particles.from_run' or the
     conflicting field): missing, a directory or other non-regular file, not
@@ -122,6 +122,8 @@ def _restart_state(scene, ds, n, where):
         differ.append("walls")
     if differ:
         return None, f"positions only (the run differs from this scene in {', '.join(differ)})"
+    if s["variant"] == "newton_lm":
+        return None, "positions only (the newton_lm variant keeps no state between runs: its damping starts afresh)"
     present = [k for k in solver.STATE_VARS if k in ds.variables]
     if not present:
         return None, "positions only (the run file holds no solver state)"

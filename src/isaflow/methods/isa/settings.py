@@ -10,7 +10,8 @@ import math
 
 from ...core.units import G  # cm/s^2 (a constants module: no numerics imported)
 
-RULE_IDS = {"paper": 0, "capped": 1, "fire": 2, "overdamped": 3}  # relax.PAPER, CAPPED, FIRE; dynamics.OVERDAMPED
+RULE_IDS = {"paper": 0, "capped": 1, "fire": 2, "overdamped": 3, "newton_lm": 4}  # relax.PAPER, CAPPED, FIRE;
+# dynamics.OVERDAMPED; newton.NEWTON (tested equal)
 RULES = RULE_IDS
 # the force laws' shapes R(l) = r_u (1 - l / l_u)^p (forces.law_over_d): linear is the kept reading, the other
 # two are named options for the force_law_shape sweep (config/claims/papadopoulos2016.yaml), not the paper's

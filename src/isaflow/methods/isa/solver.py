@@ -9,7 +9,9 @@ a particle left the walls' bounding box), ``nonfinite``.
 """
 
 import time
+from contextlib import contextmanager
 
+import numba
 import numpy as np
 
 from ... import rest as REST
@@ -18,16 +20,17 @@ from ...core.geometry import bounding_box, outside_box
 from ...core.units import G
 from . import dynamics as D
 from . import forces as F
+from . import newton as NW
 from . import relax as R
 from .settings import RULES, settings
 
 CYCLE_WINDOW, CYCLE_MAX_PERIOD, CYCLE_RTOL = 400, 50, 1e-6
 # where each outcome is detected (for the report)
 DETECTED_BY = {
-    "converged": "the compiled loop, before every step (relax.relax)",
+    "converged": "the compiled loop, before every step (relax.relax_resume, newton.newton_resume)",
     "cycle": f"detect_cycle on the last {CYCLE_WINDOW + CYCLE_MAX_PERIOD} max|F| values at every chunk end, "
              f"periods 2-{CYCLE_MAX_PERIOD}, while the particles stay put",
-    "step_limit": "the solver, at solver.max_steps",
+    "step_limit": "the solver, at solver.max_steps (newton: also when no step lowers the energy)",
     "escaped": "the compiled loop (every move is tested against the walls, core.geometry.crossed_wall) and "
                "the solver (walls' bounding box at every chunk end)",
     "nonfinite": "the compiled loop, before every step",
@@ -63,23 +66,57 @@ def vessel_counts(pos, vessels):
     return np.array([np.count_nonzero((pos[:, 0] >= a) & (pos[:, 0] < b)) for _, (a, b) in vessels])
 
 
-def warm_up():
-    """Compile (or load from numba's cache) the kernels so timings exclude it."""
+def thread_count(threads=None):
+    """The number of threads a solve runs on: ``threads``, or numba's current number
+    (NUMBA_NUM_THREADS, else the machine's cores) when None.  Refused (ValueError) outside
+    1 ... numba.config.NUMBA_NUM_THREADS."""
+    t = numba.get_num_threads() if threads is None else threads
+    if isinstance(t, bool) or not isinstance(t, (int, np.integer)) or not 1 <= t <= numba.config.NUMBA_NUM_THREADS:
+        raise ValueError(f"threads: {threads!r} is not a whole number from 1 to {numba.config.NUMBA_NUM_THREADS} "
+                         f"(NUMBA_NUM_THREADS)")
+    return int(t)
+
+
+@contextmanager
+def numba_threads(threads):
+    """Run the enclosed code on ``threads`` numba threads, restoring the previous number after."""
+    before = numba.get_num_threads()
+    numba.set_num_threads(threads)
+    try:
+        yield threads
+    finally:
+        numba.set_num_threads(before)
+
+
+def warm_up(threads=1):
+    """Compile (or load from numba's cache) every kernel a solve times, with the argument types
+    the solve passes them, and start numba's threads, so that solver times exclude both.
+
+    The timed loop calls relax.relax_resume for the three step rules and
+    newton.newton_resume for the newton_lm variant: exactly those are called here
+    (a function compiled only as another's callee, e.g. relax_resume inside
+    relax, can be typed differently and be compiled again on its first direct
+    call: Table 1 once timed a 1.6 s compile as solver time).
+    """
     pos = np.array([[1.0, 1.0], [1.5, 1.0]])
     walls = np.array([[0.0, 2.0, 0.0, 0.0], [0.0, 0.0, 2.0, 0.0], [2.0, 0.0, 2.0, 2.0]])
     box = np.array([0.0, 0.0, 2.0, 2.0])
     for rule in RULES.values():
-        if rule == D.OVERDAMPED:
+        if rule in (D.OVERDAMPED, NW.NEWTON):
             continue
         for p in (1.0, 2.0):
-            R.relax_resume(pos.copy(), np.zeros_like(pos), np.ones(2), walls, box, 0.5, 1.0, 0.7, 1.0, rule,
-                           1e-3, 1.0, 0.1, 0.1, 2, 0.1, np.zeros_like(pos), np.zeros(2), pos.copy(), np.zeros(5),
-                           False, p, p)
+            for resume in (False, True):
+                R.relax_resume(pos.copy(), np.zeros_like(pos), np.ones(2), walls, box, 0.5, 1.0, 0.7, 1.0, rule,
+                               1e-3, 1.0, 0.1, 0.1, 2, 0.1, np.zeros_like(pos), np.zeros(2), pos.copy(), np.zeros(5),
+                               resume, threads, p, p)
     for p in (1.0, 2.0):
         D.overdamped_resume(pos.copy(), np.zeros_like(pos), np.ones(2), walls, box, 0.5, 1.0, 0.7, 1.0, 1e-3, 1.0,
                             1.0, G, 0.1, 1e-5, 1.0, 1.0, 2, 0.1, np.zeros_like(pos), np.zeros(2), np.zeros(2),
                             pos.copy(), np.array([0.0, 0.0, -1.0, 0.0, 0.0]), False, p, p)
         F.wall_contacts(pos, walls, 0.5, 1.0, p)
+    NW.warm_up(threads)
+    if threads > 1:
+        R.start_threads(np.zeros(threads, np.int64))
 
 
 class _History:
@@ -160,7 +197,7 @@ def _state_fields(vel, pos_build, chunk_start, kernel, recent):
     return {k: (d, np.asarray(arrays[k]), u, ln) for k, (d, u, ln) in STATE_VARS.items()}
 
 
-def solve(scene, pos0, weight, start_step=0, progress=None, state=None, rest_depth=float("nan")):
+def solve(scene, pos0, weight, start_step=0, progress=None, state=None, rest_depth=float("nan"), threads=None):
     """Relax ``pos0`` (N, 2) cm with per-particle ``weight`` (N,) N under an ISA scene.
 
     start_step: steps already taken (a continued run counts from there up to
@@ -169,20 +206,30 @@ def solve(scene, pos0, weight, start_step=0, progress=None, state=None, rest_dep
     state: {STATE_VARS name: array} of the run this one continues (same
     scene dynamics), or None for a fresh start; with it the continued run
     repeats the uninterrupted one bit for bit, at any start_step.
-    Returns a contract.Result (method 'isa', variant = the update rule);
-    its fields hold the restart state (STATE_VARS).
+    threads: numba threads of the solve (None: numba's current number, i.e.
+    NUMBA_NUM_THREADS or the machine's cores); the results do not depend on
+    it, and it is recorded in params['threads'].  The newton_lm variant's loop is
+    serial.  Returns a contract.Result (method 'isa', variant = the update
+    rule); its fields hold the restart state (STATE_VARS).
     """
+    threads = thread_count(threads)
+    with numba_threads(threads):
+        return _solve(scene, pos0, weight, start_step, progress, state, rest_depth, threads)
+
+
+def _solve(scene, pos0, weight, start_step, progress, state, rest_depth, threads):
     s = settings(scene)
-    walls = scene.walls
+    walls = np.ascontiguousarray(scene.walls, float)
     box = bounding_box(walls)
     vessels = [(v["name"], v["x"]) for v in scene.spec.get("vessels", [])]
-    pos = np.array(pos0, float, copy=True)
-    weight = np.asarray(weight, float)
+    pos = np.array(pos0, float, copy=True, order="C")
+    weight = np.ascontiguousarray(weight, float)
     force = np.zeros_like(pos)
     chunk = s["chunk"]
-    restored = state is not None
-    vel = np.array(state["state_vel"], float) if restored else np.zeros_like(pos)
-    pos_build = np.array(state["state_pos_build"], float) if restored else pos.copy()
+    newton = s["variant"] == "newton_lm"
+    restored = state is not None and not newton  # newton keeps no state between runs (restart.py)
+    vel = np.array(state["state_vel"], float, order="C") if restored else np.zeros_like(pos)
+    pos_build = np.array(state["state_pos_build"], float, order="C") if restored else pos.copy()
     overdamped = RULES[s["variant"]] == D.OVERDAMPED
     kernel = np.array([float(state[k]) for k in ("state_moved", "state_fire_dt", "state_fire_alpha",
                                                  "state_fire_n_pos")] + [0.0]) if restored else np.zeros(5)
@@ -200,7 +247,9 @@ def solve(scene, pos0, weight, start_step=0, progress=None, state=None, rest_dep
     buf = np.zeros(chunk)
     hist = _History(s["history"], len(walls), vessels)
     snap_every = max(1, round((s["max_steps"] - start_step) / max(hist.n_snap, 1) / chunk))
-    warm_up()
+    nstate = np.zeros(2)  # newton: (mu, nu) between chunks
+    counts = np.zeros(4, np.int64)  # newton: Hessian assemblies, CG iterations, refused crossings, evaluations
+    warm_up(threads)
     step = start_step
     status, message, period, bad_particle = "step_limit", "", 0, -1
     evals = 0
@@ -219,15 +268,23 @@ def solve(scene, pos0, weight, start_step=0, progress=None, state=None, rest_dep
                 s["zeta"], s["lambda_max"], G, s["f_tol"], rest_cfg["energy_ratio"], e_norm, rest_cfg["window"], n,
                 s["skin"], force, buf, ke_buf, pos_build, kernel, resume, s["wall_p"], s["pair_p"],
             )
+            evals += done + 1
+        elif newton:
+            done, code, crossing = NW.newton_resume(
+                pos, weight, walls, box, s["wall_l_u"], s["wall_r_u"], s["pair_l_u"], s["pair_r_u"], s["f_tol"], n,
+                s["skin"], force, buf, nstate, counts)
+            evals = int(counts[3])  # the chunk's first evaluation and every trial step
+            code = {NW.CONVERGED: R.CONVERGED, NW.NONFINITE: R.NONFINITE, NW.STALLED: NW.STALLED}.get(code, R.RUNNING)
         else:
             done, code, crossing = R.relax_resume(
                 pos, vel, weight, walls, box, s["wall_l_u"], s["wall_r_u"], s["pair_l_u"], s["pair_r_u"],
                 RULES[s["variant"]], s["du"], s["f_ref"], s["dt_max"], s["f_tol"], n, s["skin"], force, buf,
-                pos_build, kernel, resume, s["wall_p"], s["pair_p"],
+                pos_build, kernel, resume, threads, s["wall_p"], s["pair_p"],
             )
+            evals += done + 1  # one evaluation per step taken, plus the chunk's initial one
         resume = False
-        max_step_move = max(max_step_move, float(kernel[4]))
-        evals += done + 1  # one evaluation per step taken, plus the chunk's initial one
+        if not newton:
+            max_step_move = max(max_step_move, float(kernel[4]))
         h = buf[:done]
         if hist.every:
             hist.steps(step, h, origin, ke_buf[:done] if overdamped else None)
@@ -257,12 +314,16 @@ def solve(scene, pos0, weight, start_step=0, progress=None, state=None, rest_dep
             message = (f"particle {i} at ({pos[i, 0]:.4g}, {pos[i, 1]:.4g}) cm would cross wall "
                        f"'{scene.wall_names[w]}' at step {step}; step refused, run stopped")
             break
+        if newton and code == NW.STALLED:
+            message = (f"max|F| = {np.abs(force).max():.4g} N >= f_tol = {s['f_tol']:g} N after {step} steps: no step "
+                       f"lowers the energy (Levenberg-Marquardt mu {nstate[0]:.3g} N/cm)")
+            break
         out = outside_box(pos, box)
         if out.any():
             status = "escaped"
             message = f"{out.sum()} particle(s) left the walls' bounding box by step {step}"
             break
-        if s["stop_on_cycle"] and not overdamped:
+        if s["stop_on_cycle"] and not (overdamped or newton):
             period = detect_cycle(recent)
             # a cycle returns to its states: the net move over the chunk stays
             # within a few du, unlike a slow drift with a periodic max|F|
@@ -278,7 +339,7 @@ def solve(scene, pos0, weight, start_step=0, progress=None, state=None, rest_dep
             break
     wall_time = time.perf_counter() - t0
     fmax = float(np.abs(force).max()) if len(force) else 0.0
-    if status == "step_limit":
+    if status == "step_limit" and not message:
         message = f"max|F| = {fmax:.4g} N >= f_tol = {s['f_tol']:g} N after {step} steps"
     elif status == "converged":
         message = f"max|F| = {fmax:.4g} N < f_tol = {s['f_tol']:g} N after {step} steps"
@@ -301,6 +362,10 @@ def solve(scene, pos0, weight, start_step=0, progress=None, state=None, rest_dep
                         f"t = {sim_time:.4g} s")
         else:
             message += f"; t = {sim_time:.4g} s, e = {ke / e_norm:.3g}"
+    if newton:
+        pos_build = pos.copy()
+        params.update(hessian_assemblies=int(counts[0]), cg_iterations=int(counts[1]), refused_steps=int(counts[2]))
+    params["threads"] = threads
     fields = {"force": (("particle", "xy"), force, "N", "final out-of-balance force on particle"),
               "contact_particle": (("contact",), part.astype(np.int32), "1", "particle index of wall contact")}
     fields.update(_state_fields(vel, pos_build, chunk_start, kernel, recent))
