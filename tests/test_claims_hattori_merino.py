@@ -118,7 +118,8 @@ def test_one_mps_step_satisfies_eqs_1_2_at_u_star_and_not_at_u_new():
     assert st["res1_star"] < 1e-12 and st["res2"] < 1e-9
     assert st["res1_new"] > 1e-6  # the gradient moves with U[n+1] - U* = dt^2 grad P / rho0
     assert mps_claims.measure_mps_step(FakeContext(ds), REGISTRY["prj-hat-mps-step"]).passed
-    assert mps_claims.measure_eq5_implicit(FakeContext(ds), REGISTRY["hat-eq5-implicit"]).passed
+    # the printed eqs. (5)-(6) are inconsistent with the step: the quoted claim does not hold
+    assert mps_claims.measure_eq5_implicit(FakeContext(ds), REGISTRY["hat-eq5-implicit"]).passed is False
 
 
 # --- Merino-Alonso: a small synthetic sweep with known classes ----------------------------------------------

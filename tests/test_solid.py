@@ -6,7 +6,6 @@ forces by O(strain) relative; the rest criterion (tol = 1e-6 of the largest
 link force) leaves a stress error of at most n_links x 1e-6.
 """
 
-import csv
 from pathlib import Path
 
 import numpy as np
@@ -164,6 +163,7 @@ def test_claims_table(tmp_path):
     """The solid claims table (methods.solid.report): the registry's marko2017 rows measured on the run files,
     judged by isaflow.claims; rows whose runs were not made are untestable, never given a verdict."""
     from isaflow import claims as verdicts
+    from isaflow import claims_registry
     from isaflow.methods.solid import outputs, report
 
     for case in ["bar_tension", "bar_compression", "shear", "hertz", "hertz_dt15ns", "hertz_dt56ns"]:
@@ -180,10 +180,13 @@ def test_claims_table(tmp_path):
         if (tmp_path / "rigid").mkdir() is None else None
     outputs.write_run(cfg, "floor_sph", "oneway", tmp_path / "floor_sph_oneway.nc", loads=rigid)
     runs = sorted(tmp_path.glob("*.nc"))
-    report.claims_and_report(runs, [tmp_path / "claims.csv", tmp_path / "65_solid.md", tmp_path / "timing.md"])
-    rows = list(csv.DictReader(open(tmp_path / "claims.csv")))
-    assert list(rows[0]) == report.COLUMNS
-    by = {r["claim"].rsplit("[", 1)[-1].rstrip("]"): r for r in rows}
+    entries = [c for c in claims_registry.load() if c["id"] in claims.MEASURES]
+    df = verdicts.judge(verdicts.Context({f"solid:{p.stem}": str(p) for p in runs}), entries)
+    df.to_csv(tmp_path / "marko2017.csv", index=False)  # as the claims rule writes it
+    report.report(runs, tmp_path / "marko2017.csv", [tmp_path / "65_solid.md", tmp_path / "timing.md"])
+    rows = df.fillna("").to_dict("records")
+    assert list(df.columns) == verdicts.COLUMNS
+    by = {r["id"]: r for r in rows}
     assert set(by) == set(claims.MEASURES)
     s44 = [r for k, r in by.items() if k in ("mar-4.4-settle", "mar-4.4-outward", "mar-4.4-inputs")]
     assert len(s44) == 3 and all(verdicts.verdict_class(r["verdict"]) != "not testable here" for r in s44)

@@ -12,6 +12,10 @@ holding one of its own); :func:`verdict` turns that into the verdict:
   to match it (``calibrated_against`` in the registry's inputs);
 - ``reproduced`` / ``not reproduced``: the test passed / failed.
 
+A measure's ``passed`` always says whether the *quoted claim* holds.  For a ``paper inconsistency`` row
+the registry's test reads "inconsistent if ..."; when it finds the inconsistency the claim does not hold
+(the paper's own statements contradict it), so the row is ``not reproduced`` and says why.
+
 Units: cm, N, s.
 """
 

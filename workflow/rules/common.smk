@@ -34,16 +34,15 @@ TANK_METHODS = [name for name, m in REGISTRY.items() if m.tank]
 
 # What each rules file contributes, read lazily by `rule all` and the report (input functions run
 # after every file is included, so include order does not matter): targets; report fragments
-# results/report/NN_name.md (assembled in NN order); claims-table CSVs; timing fragments
+# results/report/NN_name.md (assembled in NN order); timing fragments
 # results/timing/NN_name.md (everything that changes from run to run goes there, never into
 # docs/replication.md).
-TARGETS = {"targets": [], "report": [], "claims": [], "timing": []}
+TARGETS = {"targets": [], "report": [], "timing": []}
 
 
-def register(targets=(), report=(), claims=(), timing=()):
+def register(targets=(), report=(), timing=()):
     TARGETS["targets"].extend(targets)
     TARGETS["report"].extend(report)
-    TARGETS["claims"].extend(claims)
     TARGETS["timing"].extend(timing)
 
 

@@ -22,7 +22,8 @@ rule report_inferred:
 rule replication_report:
     input:
         parts=lambda wc: sorted(TARGETS["report"], key=lambda p: p.rsplit("/", 1)[-1]),
-        claims=lambda wc: sorted(TARGETS["claims"]),
+        claims=[f"results/claims/registry/{p}.csv" for p in CLAIM_PAPERS],
+        counts="results/claims/registry/counts.csv",
         findings="results/report/findings.md",
         code=code("report"),
     output:

@@ -4,7 +4,7 @@ Each method lives in its own sub-package ``isaflow.methods.<name>`` whose
 ``__init__`` defines ``METHOD`` (a :class:`Method`) and imports nothing heavy,
 so the workflow reads the registry while it is parsed.  Add a new method's
 package name to ``PACKAGES``; nothing outside ``methods/`` names a method or
-a variant: labels, colours, markers, papers, settings files, claims files and
+a variant: labels, colours, markers, papers, settings files, claims modules and
 report fragments all come from here.
 
 A *tank method* (``tank=True``) runs on the shared tanks: its ``entry``
@@ -47,7 +47,6 @@ class Method:
     values: str = ""  # "module:attribute" of the settings values schema (tank methods)
     settings: str = ""  # default settings file, relative to the project root
     report: str = ""  # the method's report fragment, results/report/NN_name.md
-    claims: str = ""  # its claims table, results/claims/<name>.csv
     timing: str = ""  # its timing fragment, results/timing/NN_name.md
 
     def entry_module(self):

@@ -95,4 +95,4 @@ rule mps_report:
 
 
 register(MPS_FILES + ["results/mps/summary.csv"] + figure("mps_wall_loads") + figure("mps_flow") + figure("mps_rest"),
-         ["results/report/55_mps.md"], [], ["results/timing/55_mps.md"])
+         ["results/report/55_mps.md"], timing=["results/timing/55_mps.md"])

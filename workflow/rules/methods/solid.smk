@@ -51,7 +51,7 @@ SOLID_CLAIM_RUNS = [f"results/solid/{r}.nc" for r in SOLID_CLAIM_RUN_IDS]
 SOLID_CLAIM_CASES = sorted({r.rsplit("_", 1)[0] for r in SOLID_CLAIM_RUN_IDS})
 
 register(SOLID_RUNS + SOLID_NEW_RUNS + SOLID_CLAIM_RUNS + SOLID_FIGURES, ["results/report/65_solid.md"],
-         ["results/claims/solid.csv"], ["results/timing/65_solid.md"])
+         timing=["results/timing/65_solid.md"])
 
 
 rule solid_run:
@@ -165,21 +165,20 @@ rule solid_figures:
         "../../scripts/call.py"
 
 
-rule solid_claims:
+rule solid_report:
     input:
         runs=SOLID_RUNS + SOLID_NEW_RUNS + SOLID_CLAIM_RUNS,
-        registry=sorted(glob.glob("config/claims/*.yaml")),
+        claims="results/claims/registry/marko2017.csv",
         code=code("methods/solid/report"),
     output:
-        "results/claims/solid.csv",
         "results/report/65_solid.md",
         "results/timing/65_solid.md",
     params:
-        func="methods.solid.report.claims_and_report",
+        func="methods.solid.report.report",
     conda:
         "../../envs/isaflow.yaml"
     log:
-        "logs/solid/claims.log",
+        "logs/solid/report.log",
     script:
         "../../scripts/call.py"
 

@@ -10,8 +10,8 @@ SPH1D_FIGURES = [f for name in ("error_vs_n", "maps", "variants") for f in figur
 SPH1D_REPORT_FIGURES = [f for name in ("error_vs_n", "maps", "variants")
                         for f in report_figure(f"sph1d_{name}", "sph1d_figure", "Methods compared")]
 
-register(SPH1D_FIGURES + ["results/sph1d/summary.csv"], ["results/report/60_sph1d.md"], [],
-         ["results/timing/60_sph1d.md"])
+register(SPH1D_FIGURES + ["results/sph1d/summary.csv"], ["results/report/60_sph1d.md"],
+         timing=["results/timing/60_sph1d.md"])
 
 
 rule sph1d_sweep:

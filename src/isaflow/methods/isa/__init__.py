@@ -31,6 +31,5 @@ METHOD = Method(
     values="isaflow.methods.isa.settings:VALUES",
     settings="config/methods/isa.yaml",
     report="results/report/10_isa.md",
-    claims="results/claims/papadopoulos2016.csv",
     timing="results/timing/10_isa.md",
 )

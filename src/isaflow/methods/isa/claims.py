@@ -21,7 +21,7 @@ Units: cm, N, s.
 """
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import lru_cache
 
 import numpy as np
@@ -264,7 +264,10 @@ def _word(passed):
 def measure(evidence=""):
     """Decorator: a core measure -> a MEASURES function (kept value, evidence of the runs read, sensitivity)."""
 
-    def deco(core):
+    def deco(test):
+        def core(view, entry):  # the claim's outcome: a paper-inconsistency test passes when it finds one
+            return _claim_outcome(test(view, entry), entry)
+
         def fn(ctx, entry):
             view = View(ctx)
             out = core(view, entry)
@@ -278,6 +281,16 @@ def measure(evidence=""):
         return fn
 
     return deco
+
+
+def _claim_outcome(out, entry):
+    """Out of the quoted claim: a 'paper inconsistency' row's test ('inconsistent if ...') passing means the
+    paper's own statements contradict the claim, so the claim fails (isaflow.claims.verdict's convention:
+    passed = the quoted claim holds)."""
+    if entry["kind"] != "paper inconsistency" or out.passed is None:
+        return out
+    found = bool(out.passed)
+    return replace(out, passed=not found, why=f"the paper's own statements contradict it: {out.measured}" if found else "")
 
 
 def _path(ctx, key):

@@ -32,6 +32,5 @@ METHOD = Method(
     settings="config/methods/solid.yaml",
     checks="isaflow.methods.solid.settings",
     report="results/report/65_solid.md",
-    claims="results/claims/solid.csv",
     timing="results/timing/65_solid.md",
 )

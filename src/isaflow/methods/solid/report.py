@@ -1,8 +1,8 @@
-"""The solid method's claims table, report fragment 65 and timing fragment, from run files.
+"""The solid method's report fragment 65 and timing fragment, from run files and the judged claims.
 
-The claims table holds marko2017's registry rows measured here (methods.solid.claims.MEASURES), judged by
-isaflow.claims (the one verdict function); the report fragment counts them by kind and verdict class,
-keeping the printed method's own numerical results apart.  Units: cm, N, s.
+The claims are marko2017's registry rows measured here (methods.solid.claims.MEASURES), judged by the
+claims rule (isaflow.claims, the one verdict function); the fragment counts them by kind and verdict
+class.  Units: cm, N, s.
 """
 
 from pathlib import Path
@@ -10,35 +10,17 @@ from pathlib import Path
 import pandas as pd
 
 from isaflow import claims as C
-from isaflow import claims_registry
 
 from .claims import MEASURES
 from .figures import read_runs
 
-PAPER_TEXT = "marko2017_lagrangian_solid_sph.txt"
-COLUMNS = ["paper", "section", "kind", "claim", "measured", "verdict", "evidence", "why", "margin", "sensitivity"]
 
 
-def judged(run_paths, registry=claims_registry.DEFAULT_DIRECTORY):
-    """DataFrame (isaflow.claims.COLUMNS) of the registry rows this package measures, on the given run files
-    ('solid:<file stem>')."""
-    entries = [c for c in claims_registry.load(registry) if c["id"] in MEASURES]
-    inputs = {i["id"]: i for lst in claims_registry.inputs(registry).values() for i in lst}
-    ctx = C.Context({f"solid:{Path(p).stem}": str(p) for p in run_paths})
-    return C.judge(ctx, entries, inputs, MEASURES)
-
-
-def write_claims(run_paths, out, registry=claims_registry.DEFAULT_DIRECTORY):
-    """results/claims/solid.csv: one row per measured registry entry (the report's claims-table columns)."""
-    df = judged(run_paths, registry)
-    table = pd.DataFrame({
-        "paper": PAPER_TEXT, "section": df["section"], "kind": df["kind"],
-        "claim": [f"{q} [{i}]" if q else i for q, i in zip(df["claim"].fillna(""), df["id"])],
-        "measured": df["measured"], "verdict": df["verdict"], "evidence": df["evidence"], "why": df["why"],
-        "margin": df["margin"], "sensitivity": df["sensitivity"]}, columns=COLUMNS)
-    Path(out).parent.mkdir(parents=True, exist_ok=True)
-    table.to_csv(out, index=False)
-    return table
+def measured_here(claims):
+    """The rows of the registry's judged marko2017 table (results/claims/registry/marko2017.csv, the claims
+    rule's) that this package measures (methods.solid.claims.MEASURES)."""
+    table = pd.read_csv(claims)
+    return table[table["id"].isin(MEASURES)]
 
 
 def counts_text(table):
@@ -98,10 +80,8 @@ def write_timing(run_paths, out):
     Path(out).write_text("\n".join(lines + [""]))
 
 
-def claims_and_report(runs, outputs, registry=None):
-    """Claims CSV, report fragment and timing fragment, outputs[0:3] (workflow entry point); registry: the
-    registry files (their folder is read)."""
-    folder = str(Path(registry[0]).parent) if registry else claims_registry.DEFAULT_DIRECTORY
-    table = write_claims(runs, outputs[0], folder)
-    write_report(table, runs, outputs[1])
-    write_timing(runs, outputs[2])
+def report(runs, claims, outputs):
+    """Report fragment and timing fragment, outputs[0:2] (workflow entry point); claims: the judged
+    marko2017 table of the claims rule."""
+    write_report(measured_here(claims), runs, outputs[0])
+    write_timing(runs, outputs[1])

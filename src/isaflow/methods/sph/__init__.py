@@ -32,6 +32,5 @@ METHOD = Method(
     values="isaflow.methods.sph.settings:VALUES",
     settings="config/methods/sph.yaml",
     report="results/report/50_sph.md",
-    claims="results/claims/sph.csv",
     timing="results/timing/50_sph.md",
 )

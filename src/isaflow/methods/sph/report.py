@@ -1,35 +1,13 @@
-"""Claims table and report fragment of the SPH runs, generated from results/sph/summary.csv."""
+"""Report fragment and timing fragment of the SPH runs, generated from results/sph/summary.csv (its claims are
+the registry's, judged by the claims rule)."""
 
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 
-PAPER = "papadopoulos2016"
-
-
 def _fmt(x, f=".3g"):
     return "n/a" if x is None or (isinstance(x, float) and not np.isfinite(x)) else format(x, f)
-
-
-def claims(df):
-    """Rows (paper, section, claim, measured, verdict, evidence): the paper's claim about SPH itself.  Claims
-    about the paper's own method are judged on its own runs (report.claims) and, where a liquid is the
-    reference, once in the methods comparison (report.methods); SPH's flow numbers are in the fragment."""
-    stab = df[df.case == "stab"].set_index("stability_case")
-    rows = []
-    if "low_viscosity" in stab.index:
-        s = stab.loc["low_viscosity"]
-        rows.append(dict(
-            section="7", claim="artificial high frequency oscillations are suppressed. And there is no more need for an "
-                               "additional technique to suppress them (see SPH_Smoothed Particle Hydrodynamics)",
-            measured=f"SPH with artificial viscosity alpha = 0.02: {s.status}, rms speed {s.rms_speed_cm_s:.2g} cm/s "
-                     f"at t = {s.sim_time_s:.1f} s; with alpha = 0.1 the column comes to rest",
-            verdict="reproduced" if s.status != "converged" else "not reproduced",
-            evidence="SPH needs an added damping (artificial viscosity) to come to rest: stability case low_viscosity, "
-                     "results/sph/summary.csv"))
-    return pd.DataFrame([{"paper": PAPER, **r} for r in rows],
-                        columns=["paper", "section", "claim", "measured", "verdict", "evidence"])
 
 
 def fragment(df):
@@ -91,12 +69,11 @@ def timing(df):
 
 
 def write(summary, outputs):
-    """outputs: the claims CSV, the report fragment and the timing fragment, from the summary table."""
+    """outputs: the report fragment and the timing fragment, from the summary table."""
     df = pd.read_csv(summary)
-    claims_out, report_out, timing_out = outputs
+    report_out, timing_out = outputs
     Path(timing_out).parent.mkdir(parents=True, exist_ok=True)
     Path(timing_out).write_text(timing(df))
     for path in outputs:
         Path(path).parent.mkdir(parents=True, exist_ok=True)
-    claims(df).to_csv(claims_out, index=False)
     Path(report_out).write_text(fragment(df))
