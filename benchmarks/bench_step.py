@@ -6,7 +6,7 @@ Step cost: compiled ``methods.isa.relax.relax_resume``, variant PAPER, vs N, on 
 and 2 threads (``threads`` argument and ``numba.set_num_threads``; the results are
 the same bits on both, tests/test_isa_parallel.py).  Scene (units cm, N): the
 paper's application-1 liquid made wide.  A rhombic lattice
-(``isaflow.scene.rhombic_lattice``, a = 10 cm) of 19 rows alternating n and n + 1
+(``isaflow.methods.isa.scene.rhombic_lattice``, a = 10 cm) of 19 rows alternating n and n + 1
 particles (N = 19 n + 9; n = 9 is the paper's 180-particle case) in a rectangular
 vessel of height 100 cm and width (n + 1) a, particle weight 50 N, wall law
 l_u = 5 cm / r_u = 10 kN, pair law l_u = a / sqrt(2) / r_u = 500 l_u N, du = 0.01
@@ -23,12 +23,16 @@ other jobs, so each figure is the median of reps calls and the load average is
 recorded).
 
 Equilibrium solver (variant ``newton_lm``, methods/isa/newton.py): force
-evaluations, Hessian assemblies, CG iterations and solver time on the scenes
-single_coarse, single_refined, study_fine (study_finer with --finer: ~20 s) and the
-complete coarse flow (flow_step50 continued from application 3 at step 100,000),
-beside the capped update's and FIRE's (the study's best FIRE: du 100 x the scene's,
-dt_max = 2 / sqrt(2 k_b + 12 k_p)), and the differences of its final state from
-the capped one (metrics.load_errors; tolerances metrics.tolerances).  The capped
+evaluations, Hessian assemblies, CG iterations and solver time on the single vessel
+(tank single) at the resolutions coarse, refined and fine of config/methods/isa.yaml
+(rows single_coarse, single_refined, study_fine; study_finer, resolution finer, with
+--finer: ~20 s) and the complete coarse flow (tank flow_step50 continued from
+application 3 at step 100,000: runs single_coarse, flow_incomplete, then
+flow_complete_capped's settings), beside the capped update's and FIRE's (the study's
+best FIRE: du 100 x the resolution's, dt_max = 2 / sqrt(2 k_b + 12 k_p)), and the
+differences of its final state from the capped one (metrics.load_errors against the
+top-centre level; tolerances methods.isa.metrics.tolerances).  Every solve goes through
+isaflow.run (prepare, solve, write: the command line's path).  The capped
 runs of study_fine / study_finer (6 s / 136 s) are not rerun: their counts are
 deterministic (the same bits on every run) and are taken from REFERENCE_CAPPED.
 
@@ -81,7 +85,11 @@ THREADS = (1, 2)
 # bits on every run of the capped update; issue 20 and benchmarks/results of the landed workflow)
 REFERENCE_CAPPED = {"study_fine": 138_503, "study_finer": 809_157}
 SCENES = ["single_coarse", "single_refined", "study_fine"]
-FLOW_START_STEPS = 100_000  # application 3 ends here (config/config.yaml flow_incomplete)
+# row name -> (tank of config/tanks, resolution of config/methods/isa.yaml)
+CASES = {"single_coarse": ("single", "coarse"), "single_refined": ("single", "refined"),
+         "study_fine": ("single", "fine"), "study_finer": ("single", "finer")}
+ISA_SETTINGS = ROOT / "config" / "methods" / "isa.yaml"
+FLOW_START_STEPS = 100_000  # application 3 ends here (config/methods/isa.yaml, run flow_incomplete)
 
 
 def load_kernels(path):
@@ -102,7 +110,7 @@ def load_kernels(path):
 
 def lattice(n_row):
     """Initial (N, 2) positions [cm], walls (3, 4) [cm] and box of the vessel with rows of n_row / n_row + 1."""
-    from isaflow.scene import rhombic_lattice
+    from isaflow.methods.isa.scene import rhombic_lattice
     width = (n_row + 1) * A
     pos = rhombic_lattice(A, ROWS, [n_row, n_row + 1], width / 2, 5.0)
     walls = np.array([[0, HEIGHT, 0, 0], [0, 0, width, 0], [width, 0, width, HEIGHT]], float)
@@ -374,70 +382,69 @@ def write_csv(path, rows, keys=None):
 
 # ---- equilibrium solver ------------------------------------------------------------------------------------
 
-def solve_scene(path, sets, threads=1):
-    """(Result, Scene) of one in-process solve (compile excluded: solver.solve warms up first)."""
-    from isaflow import scene as S
-    from isaflow.methods.isa import solver
-    sc = S.load(str(path), list(sets))
-    if "from_run" in sc.spec["particles"]:
-        st = S.start_file(sc)
-        pos0, weight, start, state = st["pos"], st["weight"], st["steps"], st["state"]
-    else:
-        pos0, weight, start, _ = S.initial_state(sc)
-        state = None
-    return solver.solve(sc, pos0, weight, start_step=start, state=state, threads=threads), sc
+def leaf(value, why):
+    return {"value": value, "source": f"inferred: benchmark, {why}"}
 
 
-def fire_sets(sc_path):
-    """The study's best FIRE: du = 100 x the scene's, dt_max = 2 / sqrt(2 k_b + 12 k_p)."""
-    from isaflow import scene as S
+def declared_sets(run_id):
+    """The overrides of a run declared in config/methods/isa.yaml ({key: {value, source}})."""
+    from isaflow import settings as S
+    from isaflow.methods.isa.settings import VALUES
+    return dict(S.read(ISA_SETTINGS, VALUES)["runs"][run_id].get("set", {}))
+
+
+def solve_run(tank, resolution, variant, out, sets=None, start=None, threads=1):
+    """Result of one run through isaflow.run (checks, warm-up outside the solver time, solve), its
+    run file written to out (the metrics read it)."""
+    from isaflow import run
+    p = run.prepare("isa", str(ROOT / "config" / "tanks" / f"{tank}.yaml"), variant, resolution, str(out),
+                    str(ISA_SETTINGS), sets or {}, None if start is None else str(start),
+                    ("converged", "cycle", "step_limit"), threads)
+    result, started, finished = run.solve(p, log=lambda msg: None)
+    run.write(p, result, started, finished)
+    return result
+
+
+def fire_sets(tank, resolution):
+    """The study's best FIRE: du = 100 x the resolution's, dt_max = 2 / sqrt(2 k_b + 12 k_p)."""
+    from isaflow.methods.isa import scene as S
     from isaflow.methods.isa.settings import fire_dt_max, settings
-    sc = S.load(str(sc_path), [])
+    sc = S.of_run(tank, resolution, "fire", (), str(ISA_SETTINGS))
     du = settings(sc)["du"]
-    return ["solver.variant=fire", f"solver.du={100 * du!r}",
-            f"solver.dt_max={fire_dt_max(sc.stiffness('wall'), sc.stiffness('pair'), 2.0)!r}",
-            "solver.max_steps=2000000"]
+    return {"solver.du": leaf(100 * du, "du 100 x the resolution's (the study's best FIRE)"),
+            "solver.dt_max": leaf(fire_dt_max(sc.stiffness("wall"), sc.stiffness("pair"), 2.0),
+                                  "2 / sqrt(2 k_b + 12 k_p) (the study's best FIRE)"),
+            "solver.max_steps": leaf(2_000_000, "FIRE's step limit")}
 
 
 def state_diff(capped_file, newton_file, vessel=None):
     """Level [cm] and side-load (relative) differences newton - capped, with the report's tolerances."""
     from isaflow import metrics, runfile
+    from isaflow.methods.isa.metrics import tolerances
     a, b = runfile.read(capped_file), runfile.read(newton_file)
-    ea, eb = metrics.load_errors(a, vessel), metrics.load_errors(b, vessel)
+    ea, eb = metrics.load_errors(a, vessel, "level"), metrics.load_errors(b, vessel, "level")
     view = metrics.vessel_view(a, vessel)
-    tol = metrics.tolerances(dict(depth=ea["depth"], weight=ea["weight"]), float(a.attrs["spacing"]),
-                             int(view["inside"].sum()), float(a.attrs["f_tol"]))
+    tol = tolerances(dict(depth=ea["depth"], weight=ea["weight"]), float(a.attrs["spacing"]),
+                     int(view["inside"].sum()), float(a.attrs["f_tol"]))
     return dict(level_diff_cm=eb["level"] - ea["level"], level_tol_cm=tol["level"][0],
                 side_err_diff=eb["side_err"] - ea["side_err"], side_tol=tol["side"][0],
                 floor_err_diff=eb["floor_err"] - ea["floor_err"], floor_tol=tol["floor"][0])
 
 
-def write_run(result, sc, path):
-    """The run file of an in-process solve (as cli.run writes it), for the metrics."""
-    from isaflow import runfile
-    start = sc.spec["particles"].get("from_run")
-    prov = runfile.provenance({"scene": sc.path, "config": None, "start": start})
-    prov.update(scene_yaml=sc.text, scene_overrides="; ".join(sc.overrides) or "none",
-                scene_resolved_sha256=sc.digest, restart="benchmark")
-    spacing = sc.spacing if sc.spacing is not None else (runfile.read(start).attrs["spacing"] if start else np.nan)
-    runfile.write(runfile.to_dataset(result, sc, prov, runfile.now(), runfile.now(), spacing), path)
-
-
 def newton_table(scenes, tmp):
     """Rows of newton_evals.csv: every scene with newton_lm, FIRE and (where cheap) capped."""
-    from isaflow import cli
     rows = []
     for name in scenes:
-        path = ROOT / "config" / "scenes" / f"{name}.yaml"
+        tank, res = CASES[name]
         row = dict(scene=name)
         files = {}
-        for variant, sets in (("newton_lm", ["solver.variant=newton_lm"]), ("fire", fire_sets(path)),
-                              ("capped", ["solver.variant=capped"])):
+        for variant, sets in (("newton_lm", {}), ("fire", fire_sets(tank, res)), ("capped", {})):
             if variant == "capped" and name in REFERENCE_CAPPED:
                 row.update(capped_evals=REFERENCE_CAPPED[name], capped_s=float("nan"),
                            capped_source="reference (deterministic count, not rerun)")
                 continue
-            r, sc = solve_scene(path, sets)
+            files[variant] = tmp / f"{name}_{variant}.nc"
+            r = solve_run(tank, res, variant, files[variant], sets)
             assert r.status == "converged", (name, variant, r.status, r.message)
             key = {"newton_lm": "newton", "fire": "fire", "capped": "capped"}[variant]
             row.update({f"{key}_evals": r.force_evals, f"{key}_s": r.wall_time})
@@ -447,30 +454,26 @@ def newton_table(scenes, tmp):
                            cg_iterations=r.params["cg_iterations"], refused_steps=r.params["refused_steps"])
             if variant == "capped":
                 row["capped_source"] = "this run"
-            files[variant] = tmp / f"{name}_{variant}.nc"
-            write_run(r, sc, files[variant])
         if "capped" in files:
             row.update(state_diff(files["capped"], files["newton_lm"]))
         rows.append(row)
     # the complete coarse flow: application 1 -> 3 (paper's update, to step 100,000) -> 4 (capped, newton_lm)
     app1, app3 = tmp / "app1.nc", tmp / "app3.nc"
-    flow = ROOT / "config" / "scenes" / "flow_step50.yaml"
-    assert cli.run(str(ROOT / "config/scenes/single_coarse.yaml"), str(app1), [], quiet=True) == 0
-    assert cli.run(str(flow), str(app3), [f"particles.from_run={app1}", f"solver.max_steps={FLOW_START_STEPS}"],
-                   quiet=True) == 0
+    solve_run("single", "coarse", "paper", app1)
+    solve_run("flow_step50", "coarse", "paper", app3, declared_sets("flow_incomplete"), start=app1)
     row = dict(scene="flow_step50 (complete, from step 100,000)")
     files = {}
-    for variant, sets in (("newton_lm", ["solver.variant=newton_lm"]), ("fire", fire_sets(flow)),
-                          ("capped", ["solver.variant=capped"])):
-        r, sc = solve_scene(flow, [f"particles.from_run={app3}"] + sets)
+    flow_sets = declared_sets("flow_complete_capped")  # to step 300,000, flow records
+    for variant, sets in (("newton_lm", flow_sets), ("fire", {**flow_sets, **fire_sets("flow_step50", "coarse")}),
+                          ("capped", flow_sets)):
+        files[variant] = tmp / f"flow_{variant}.nc"
+        r = solve_run("flow_step50", "coarse", variant, files[variant], sets, start=app3)
         key = {"newton_lm": "newton", "fire": "fire", "capped": "capped"}[variant]
         row.update({f"{key}_evals": r.force_evals, f"{key}_s": r.wall_time, f"{key}_status": r.status})
         if variant == "newton_lm":
             row.update(particles=len(r.pos), newton_steps=r.steps - FLOW_START_STEPS,
                        hessian_assemblies=r.params["hessian_assemblies"], cg_iterations=r.params["cg_iterations"],
                        refused_steps=r.params["refused_steps"])
-        files[variant] = tmp / f"flow_{variant}.nc"
-        write_run(r, sc, files[variant])
     row["capped_source"] = "this run"
     row.update(state_diff(files["capped"], files["newton_lm"], "second"))
     rows.append(row)

@@ -46,16 +46,17 @@ def run_isa(out, tank="single", resolution="coarse", variant="paper", overrides=
                    list(overrides), None if start is None else str(start), accept, log=lambda m: None)
 
 
-def run_declared(out, run_id, start=None, overrides=()):
+def run_declared(out, run_id, start=None, overrides=(), variant=None):
     """Run a run declared in config/methods/isa.yaml (its tank, rule, resolution, overrides) into ``out``,
-    continuing ``start``; extra overrides ('key=value') after the declaration's; returns the exit code."""
+    continuing ``start``; extra overrides ('key=value') after the declaration's; variant: another update
+    rule than the declaration's (None: its own); returns the exit code."""
     from isaflow import settings as S
     from isaflow.methods.isa.settings import VALUES
 
     decl = S.read(ISA_SETTINGS, VALUES)["runs"][run_id]
     sets = {**decl.get("set", {}), **dict(S._parse(o, "test", "override") for o in overrides)}
-    return run.run("isa", str(TANKS / f"{decl['tank']}.yaml"), decl["variant"], decl["resolution"], str(out),
-                   str(ISA_SETTINGS), sets, None if start is None else str(start),
+    return run.run("isa", str(TANKS / f"{decl['tank']}.yaml"), variant or decl["variant"], decl["resolution"],
+                   str(out), str(ISA_SETTINGS), sets, None if start is None else str(start),
                    ("converged", "cycle", "step_limit"), log=lambda m: None)
 
 
@@ -96,7 +97,8 @@ def settings_spec(spec):
                                                        ("chunk", 1000), ("stop_on_cycle", True), ("history", {}),
                                                        ("zeta", 1.0), ("lambda_max", 3176.4), ("dt", None))},
         "resolutions": {"r": {"source": src, "set": {}}},
-        "variants": {"paper": {"set": {}}, "capped": {"set": {}}, "fire": {"set": {}}, "overdamped": {"set": {}}},
+        "variants": {"paper": {"set": {}}, "capped": {"set": {}}, "fire": {"set": {}}, "overdamped": {"set": {}},
+                     "newton_lm": {"set": {}}},
     }
 
 

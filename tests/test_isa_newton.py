@@ -3,22 +3,25 @@ its energy, forces and Hessian against the force laws and finite differences, an
 against the capped update's on the paper's scenes.  Units cm, N.
 
 Tolerances: the final states are compared with the report's own measures and tolerances
-(metrics.load_errors, metrics.tolerances: level a / 4, side load (a / 4) / h); finite
-differences use steps whose truncation and rounding errors are stated at each test.
+(metrics.load_errors against the top-centre level, methods.isa.metrics.tolerances: level a / 4,
+side load (a / 4) / h); finite differences use steps whose truncation and rounding errors are
+stated at each test.  Runs go through isaflow.run (tests/conftest.py run_isa, run_declared).
 """
-
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-from isaflow import cli, metrics, runfile
+from isaflow import metrics, runfile
 from isaflow.core import neighbours as NB
+from isaflow.methods.isa import dynamics as D
 from isaflow.methods.isa import forces as F
+from isaflow.methods.isa import metrics as IM
 from isaflow.methods.isa import newton as NW
+from isaflow.methods.isa import relax as R
+from isaflow.methods.isa import settings as ST
 
-ROOT = Path(__file__).resolve().parents[1]
-SCENES = ROOT / "config" / "scenes"
+from conftest import run_declared, run_isa
+
 A = 10.0
 L_P, R_P = A / np.sqrt(2.0), 500.0 * A / np.sqrt(2.0)  # pair law: cm, N
 L_B, R_B = 5.0, 10000.0  # wall law: cm, N
@@ -120,25 +123,32 @@ def test_cg_solves_a_positive_definite_system():
     assert not NW.pcg(diag, blk, pi, pj, m, 0.0, b, x, 1e-9, 10000, *scratch)[1]
 
 
-def run(tmp, name, scene, *sets):
-    out = tmp / f"{name}.nc"
-    assert cli.run(str(SCENES / scene), str(out), list(sets), quiet=True) == 0
-    return runfile.read(out)
+def test_rule_codes_are_the_kernels_own():
+    """settings.RULE_IDS (the variant -> rule code table) against the codes the kernels test."""
+    assert ST.RULE_IDS == {"paper": R.PAPER, "capped": R.CAPPED, "fire": R.FIRE, "overdamped": D.OVERDAMPED,
+                           "newton_lm": NW.NEWTON}
+    assert len(set(ST.RULE_IDS.values())) == len(ST.RULE_IDS)
 
 
 @pytest.fixture(scope="module")
 def singles(tmp_path_factory):
+    """Both paper lattices (tank single, resolutions coarse and refined) with the capped update and newton."""
     tmp = tmp_path_factory.mktemp("newton")
-    return {(lat, v): run(tmp, f"{lat}_{v}", f"single_{lat}.yaml", f"solver.variant={v}")
-            for lat in ("coarse", "refined") for v in ("capped", "newton_lm")}
+    out = {}
+    for lat in ("coarse", "refined"):
+        for v in ("capped", "newton_lm"):
+            path = tmp / f"{lat}_{v}.nc"
+            assert run_isa(path, "single", lat, v) == 0
+            out[lat, v] = runfile.read(path)
+    return out
 
 
 def state_differences(a, b, vessel=None):
     """(differences, tolerances) of level [cm] and side load (relative) of run b against run a."""
-    ea, eb = metrics.load_errors(a, vessel), metrics.load_errors(b, vessel)
+    ea, eb = metrics.load_errors(a, vessel, "level"), metrics.load_errors(b, vessel, "level")
     view = metrics.vessel_view(a, vessel)
-    tol = metrics.tolerances(dict(depth=ea["depth"], weight=ea["weight"]), float(a.attrs["spacing"]),
-                             int(view["inside"].sum()), float(a.attrs["f_tol"]))
+    tol = IM.tolerances(dict(depth=ea["depth"], weight=ea["weight"]), float(a.attrs["spacing"]),
+                        int(view["inside"].sum()), float(a.attrs["f_tol"]))
     diff = dict(level=eb["level"] - ea["level"], side=eb["side_err"] - ea["side_err"],
                 floor=eb["floor_err"] - ea["floor_err"])
     return diff, {k: tol[k][0] for k in diff}
@@ -185,14 +195,15 @@ def test_newton_refined_side_loads_are_the_capped_ones(singles):
 
 @pytest.fixture(scope="module")
 def flows(tmp_path_factory):
-    """Application 1 -> 3 (paper's update) -> 4 with capped and with newton."""
+    """Application 1 -> 3 (paper's update; runs single_coarse, flow_incomplete of config/methods/isa.yaml)
+    -> 4 (run flow_complete_capped: to step 300,000, flow records) with capped and with newton."""
     tmp = tmp_path_factory.mktemp("newton_flow")
-    app1 = tmp / "app1.nc"
-    assert cli.run(str(SCENES / "single_coarse.yaml"), str(app1), [], quiet=True) == 0
-    app3 = run(tmp, "app3", "flow_step50.yaml", f"particles.from_run={app1}", "solver.max_steps=100000")
-    start = f"particles.from_run={tmp / 'app3.nc'}"
-    return (app3, run(tmp, "capped", "flow_step50.yaml", start, "solver.variant=capped"),
-            run(tmp, "newton", "flow_step50.yaml", start, "solver.variant=newton_lm"))
+    paths = {k: tmp / f"{k}.nc" for k in ("app1", "app3", "capped", "newton")}
+    assert run_declared(paths["app1"], "single_coarse") == 0
+    assert run_declared(paths["app3"], "flow_incomplete", start=paths["app1"]) == 0
+    for v, name in (("capped", "capped"), ("newton_lm", "newton")):
+        assert run_declared(paths[name], "flow_complete_capped", start=paths["app3"], variant=v) == 0
+    return tuple(runfile.read(paths[k]) for k in ("app3", "capped", "newton"))
 
 
 def test_newton_completes_the_flow_in_under_one_percent_of_the_capped_evaluations(flows):

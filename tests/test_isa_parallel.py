@@ -18,10 +18,10 @@ import numba
 import numpy as np
 import pytest
 
-from isaflow import scene as S
 from isaflow.core import neighbours as NB
 from isaflow.methods.isa import cells as C
 from isaflow.methods.isa import relax as R
+from isaflow.methods.isa import scene as S
 from isaflow.methods.isa import solver
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -51,7 +51,7 @@ def run_relax(pos0, walls, box, rule, du, n_steps, threads, split=None):
     for lo, hi, resume in ((0, split or n_steps, False), (split or n_steps, n_steps, True)):
         if hi > lo:
             rets.append(R.relax_resume(pos, vel, weight, *args, hi - lo, 0.3 * L_P, force, hist[lo:], pos_build,
-                                       state, resume, threads))
+                                       state, resume, threads, 1.0, 1.0))  # linear laws (exponents 1)
     return dict(ret=np.array(rets), pos=pos, vel=vel, force=force, hist=hist, pos_build=pos_build, state=state)
 
 
@@ -158,15 +158,13 @@ TINY = {
     "solver": {"variant": "paper", "du": 0.01, "f_tol": 0.1, "max_steps": 1500, "chunk": 1000,
                "accept": ["step_limit"], "history": {"every": 7}},
 }
+SETTINGS = str(ROOT / "config" / "methods" / "isa.yaml")
 
 
 @pytest.mark.parametrize("variant", ["paper", "fire"])
-def test_solve_records_its_threads_and_gives_the_same_run_on_one_and_two(tmp_path, variant):
-    import yaml
-
-    path = tmp_path / "wide.yaml"
-    path.write_text(yaml.safe_dump(TINY))
-    sc = S.load(str(path), [f"solver.variant={variant}"] + (["solver.du=0.1"] if variant == "fire" else []))
+def test_solve_records_its_threads_and_gives_the_same_run_on_one_and_two(variant):
+    sc = S.from_spec({**TINY, "solver": {**TINY["solver"], "variant": variant,
+                                         **({"du": 0.1} if variant == "fire" else {})}})
     pos0, weight, _, _ = S.initial_state(sc)
     one = solver.solve(sc, pos0, weight, threads=1)
     two = solver.solve(sc, pos0, weight, threads=min(2, numba.config.NUMBA_NUM_THREADS))
@@ -187,11 +185,11 @@ def test_a_thread_count_outside_the_machine_is_refused(bad):
 
 COLD_PROBE = """
 import json, sys
-from isaflow import scene as S
+from isaflow.methods.isa import scene as S
 from isaflow.methods.isa import solver
 out = {}
 for variant in ("capped", "newton_lm"):
-    sc = S.load(sys.argv[1], [f"solver.variant={variant}"])
+    sc = S.of_run("single", "refined", variant, (), sys.argv[1])
     pos0, weight, _, _ = S.initial_state(sc)
     r = solver.solve(sc, pos0, weight, threads=1)
     out[variant] = [r.wall_time, r.status]
@@ -202,18 +200,18 @@ print(json.dumps(out))
 def test_solver_times_exclude_compilation():
     """The same case in a fresh process with an empty numba cache (everything compiled) and again
     with the cache filled (loaded): the solver times agree within a factor of 2.  The compile of
-    the ISA kernels takes tens of seconds; solving single_refined takes about 0.25 s (capped)
-    and 0.1 s (newton), so any compile inside the timed loop would break the factor.  Timing
-    noise of a shared machine is well inside 2x at these durations."""
+    the ISA kernels takes tens of seconds; solving the refined single vessel (tank single,
+    resolution refined) takes about 0.25 s (capped) and 0.1 s (newton), so any compile inside
+    the timed loop would break the factor.  Timing noise of a shared machine is well inside 2x
+    at these durations."""
     import tempfile
 
-    scene = str(ROOT / "config/scenes/single_refined.yaml")
     with tempfile.TemporaryDirectory() as cache:
         env = {**os.environ, "NUMBA_CACHE_DIR": cache, "PYTHONPATH": str(ROOT / "src")}
         runs = []
         for _ in ("cold", "warm"):
-            out = subprocess.run([sys.executable, "-c", COLD_PROBE, scene], env=env, capture_output=True, text=True,
-                                 check=True)
+            out = subprocess.run([sys.executable, "-c", COLD_PROBE, SETTINGS], env=env, cwd=ROOT, capture_output=True,
+                                 text=True, check=True)
             runs.append(json.loads(out.stdout.strip().splitlines()[-1]))
     cold, warm = runs
     for variant in ("capped", "newton_lm"):
