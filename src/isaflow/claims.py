@@ -26,6 +26,7 @@ from pathlib import Path
 import pandas as pd
 
 from . import claims_registry, methods, runfile
+from .report import page
 
 VERDICTS = ("reproduced", "reproduced only after calibrating", "not reproduced", "not testable here")
 COLUMNS = ["id", "paper", "section", "kind", "half", "claim", "measured", "tolerance", "verdict", "evidence", "why",
@@ -185,10 +186,22 @@ def write(outputs, registry, runs=None, tables=None, run_files=(), registry_file
     run_files, registry_files: the same files as the rule's inputs (what it depends on)."""
     inputs = {i["id"]: i for lst in claims_registry.inputs(registry).values() for i in lst}
     df = judge(Context(runs, tables), claims_registry.load(registry), inputs)
-    *papers, summary = outputs
+    *papers, summary = [str(o) for o in outputs if not str(o).endswith(".html")]
+    pages = {str(o) for o in outputs if str(o).endswith(".html")}
     for out in papers:
         paper = Path(out).stem
         Path(out).parent.mkdir(parents=True, exist_ok=True)
         df[df["paper"] == paper].to_csv(out, index=False)
+        page = str(Path(out).with_suffix(".html"))
+        if page in pages:
+            Path(page).write_text(html_table(df[df["paper"] == paper], paper))
     counts(df).to_csv(summary, index=False)
     return df
+
+
+def html_table(df, title):
+    """A self-contained HTML page of one paper's judged claims (read in a browser, e.g. the Snakemake report)."""
+    cols = ["id", "section", "kind", "claim", "measured", "verdict", "tolerance", "why", "margin", "evidence",
+            "sensitivity"]
+    body = df[cols].fillna("").to_html(index=False, escape=True, border=0)
+    return page(f"Claims: {title}", f"<h2>Claims of {title}: {len(df)} rows</h2>{body}")

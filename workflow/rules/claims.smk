@@ -8,7 +8,8 @@ rule claims:
         code=code("claims", *[f"methods.{m}.claims" for m in _methods.PACKAGES
                               if os.path.exists(f"src/isaflow/methods/{m}/claims.py")]),
     output:
-        [f"results/claims/registry/{p}.csv" for p in CLAIM_PAPERS] + ["results/claims/registry/counts.csv"],
+        [f"results/claims/registry/{p}.csv" for p in CLAIM_PAPERS] + ["results/claims/registry/counts.csv"]
+        + [report_file(f"results/claims/registry/{p}.html", "claims", "Claims", CLAIM_LABELS[p]) for p in CLAIM_PAPERS],
     params:
         func="claims.write",
         kw=lambda wc: {"registry": "config/claims", "runs": claim_runs()},

@@ -145,6 +145,7 @@ def report_figure(name, caption, category, subcategory=None):
 
 # the claims (claims.smk)
 CLAIM_PAPERS = list(_methods.papers())
+CLAIM_LABELS = _methods.papers()  # {paper id: label}
 # run files outside the tank methods' runs, by '<method>:<run id>' (the solid and 1D methods register theirs)
 OTHER_RUN_FILES = {}
 # groups of runs, by '<method>:<group>' (ISA's study groups, calibration)

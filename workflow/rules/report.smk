@@ -28,6 +28,7 @@ rule replication_report:
         code=code("report"),
     output:
         "docs/replication.md",
+        report_file("results/report/replication.html", "replication", "Report"),
     params:
         func="report.assemble",
     log:

@@ -10,6 +10,7 @@ from pathlib import Path
 
 import numpy as np
 
+from .. import claims_registry
 from ..methods import papers
 
 
@@ -111,8 +112,6 @@ def summary(df):
 def changes(df, registry=None):
     """Markdown list: every registry entry that replaces a row of the former 42-row table ('was'), with what
     changed and its verdict now."""
-    from .. import claims_registry
-
     now = dict(zip(df["id"], df["verdict"]))
     out = []
     for e in claims_registry.load(registry or claims_registry.DEFAULT_DIRECTORY):
@@ -157,5 +156,27 @@ def assemble(parts, claims, counts, findings, outputs):
         head += moved + [""]
     head += [Path(findings).read_text().strip(), ""]
     body = [Path(f).read_text() for f in sorted(parts, key=lambda p: Path(p).name)]
+    text = "\n".join(head + body)
     Path(outputs[0]).parent.mkdir(parents=True, exist_ok=True)
-    Path(outputs[0]).write_text("\n".join(head + body))
+    Path(outputs[0]).write_text(text)
+    if len(outputs) > 1:  # the same report as an HTML page (the Snakemake report shows it inline)
+        write_html(text, outputs[1], "Replication report")
+
+
+def write_html(markdown_text, out, title):
+    """A self-contained HTML page of a Markdown text (tables rendered)."""
+    import markdown
+
+    Path(out).parent.mkdir(parents=True, exist_ok=True)
+    Path(out).write_text(page(title, markdown.markdown(markdown_text, extensions=["tables"])))
+
+
+STYLE = ("<style>body{font-family:sans-serif;font-size:13px} table{border-collapse:collapse} "
+         "td,th{border:1px solid #bbb;padding:3px 6px;vertical-align:top;text-align:left} "
+         "th{background:#eee;position:sticky;top:0}</style>")
+
+
+def page(title, body):
+    """A self-contained HTML page (readable in a browser and inside the Snakemake report)."""
+    return (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{title}</title>{STYLE}</head>"
+            f"<body>{body}</body></html>\n")
