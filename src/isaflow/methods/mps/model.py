@@ -1,5 +1,6 @@
 """The stages of one MPS time step (numba): explicit step, collision model, free surface, source term,
-pressure-equation assembly, pressure correction, particle shifting and the wall-crossing check.
+pressure-equation assembly, pressure correction, particle shifting, the penetration guard (reflect) and the
+wall-crossing check.
 
 Koshizuka & Oka (1996), as the public MPS-Basic code implements it (github.com/MPS-Basic/MPS-Basic,
 src/mps.cpp, src/pressure_calculator/implicit.cpp), with the named options of config/methods/mps.yaml.

@@ -13,7 +13,8 @@ Neighbours are full per-particle lists (CSR: start (N+1,), nbr (M,)), built and 
 pass computes particle i's value from its own row in a fixed order, so the loops over particles run in
 parallel (numba prange) and give bit-identical results for any thread count.  Visibility across thin walls
 (a dividing wall with particles behind both faces, boundary.py): a thin wall's face particles are seen only
-from their own side of the wall, and no pair sees across a thin wall segment.
+from their own side of the wall (and, with walls.thin_line_of_sight, only where the wall stands between), and
+no pair sees across a thin wall segment.
 Units: cm, s, density N s^2 / cm^4 (2D), pressure N / cm^2.
 """
 

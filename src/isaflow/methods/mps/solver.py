@@ -1,8 +1,9 @@
 """MPS time stepping on a tank: solve(tank, settings, variant, spacing, ...) -> contract.Result.
 
 Per step (model.py, numba, every particle loop a gather run in parallel): neighbour list, explicit step,
-collision model, free surface and source term, pressure equation (pressure.py), pressure correction,
-particle shifting, wall-crossing check.  The step loop runs in Python around compiled stages.
+collision model, penetration guard (walls.reflect: a move across a wall line mirrored back), free surface and
+source term, pressure equation (pressure.py), pressure correction, particle shifting, penetration guard,
+wall-crossing check.  The step loop runs in Python around compiled stages.
 Rest: isaflow.rest (one criterion for every dynamic method).  Units: cm, N, s; pressure N/cm^2
 (2D, per cm of thickness).
 """
