@@ -453,6 +453,34 @@ def test_a_particle_beside_the_thin_wall_end_does_not_change_side_within_a_step(
         assert s.pos[0, 0] < 100.0 and s.p[0] > 1e3
 
 
+@pytest.mark.parametrize("line_of_sight", [False, True])
+def test_below_the_thin_wall_end_the_face_particles_are_seen_only_through_the_wall(line_of_sight):
+    """walls.thin_line_of_sight: a liquid particle just below right1's lower end (first vessel's side) sees only
+    the face particles the wall stands in front of (the segment to them meets the wall), not the end's own row
+    beside the end (in the second vessel's liquid space, which it sees round the end); without the option it
+    sees that row too (counted twice with the liquid there).  A particle beside the wall sees its face's
+    particles either way, and never the other face's."""
+    tank = load_tank(FLOWS[1])
+    cfg = settings.load(CFG, overrides=[f"walls.thin_line_of_sight={'true' if line_of_sight else 'false'}"])
+    l0 = COARSE
+    pos = np.array([[100.0 - 0.2 * l0, 20.0 - 0.3 * l0], [100.0 - 0.5 * l0, 40.0]])
+    s = solver.State(tank, cfg, l0, pos, np.zeros((2, 2)))
+    s.neighbours(s.pos)
+    d = s.distances(s.pos)
+    for i, below in ((0, True), (1, False)):
+        row = slice(s.start[i], s.start[i + 1])
+        face = s.tw[s.nbr[row]] >= 0
+        seen = np.isfinite(d[row]) & face & (d[row] < s.re_n)
+        assert seen.any() and np.all(s.tside[s.nbr[row][seen]] == 1)
+        through = [operators.segments_cross(*s.pos[i], *s.pos[j], s.thin[0]) for j in s.nbr[row][seen]]
+        assert all(through) == (line_of_sight or not below)
+        if below:  # the end's row of the first vessel's face, within r_e of the particle
+            j = s.nbr[row]
+            r = np.hypot(*(s.pos[j] - s.pos[i]).T)
+            end_row = face & (s.tside[j] == 1) & (np.abs(s.pos[j, 1] - s.pos[j[face], 1].min()) < 1e-9) & (r < s.re_n)
+            assert end_row.any() and seen[end_row].any() == (not line_of_sight)
+
+
 def drop(tank, wall, side, variant, l0, rows=4):
     """A rows x rows block of liquid particles thrown along the face's normal at the flow's impact speed
     sqrt(2 g 122.5) = 490 cm/s (the fall from the first vessel's surface to the second vessel's floor in
