@@ -10,7 +10,9 @@ liquid's cells [0, l0]^2 tile the vessel exactly and a first-row particle faces
 l0 of wall.  Rows are extended past an end joined to another wall (corners);
 candidates of a one-faced wall on the liquid side of another wall are dropped.
 A thin wall's two sets of rows lie in each other's liquid space: the particles
-of a face are seen only by particles on that face's side (operators.visible).
+of a face are seen only by particles on that face's side (operators.visible) and,
+with walls.thin_line_of_sight, only where the wall hides them (not round its free
+end, where the other vessel's liquid is seen in their place).
 """
 
 import numpy as np

@@ -1,5 +1,6 @@
 """The stages of one MPS time step (numba): explicit step, collision model, free surface, source term,
-pressure-equation assembly, pressure correction, particle shifting and the wall-crossing check.
+pressure-equation assembly, pressure correction, particle shifting, the penetration guard (reflect) and the
+wall-crossing check.
 
 Koshizuka & Oka (1996), as the public MPS-Basic code implements it (github.com/MPS-Basic/MPS-Basic,
 src/mps.cpp, src/pressure_calculator/implicit.cpp), with the named options of config/methods/mps.yaml.
@@ -308,6 +309,64 @@ def update(ps, vs, kind, g, rho0, dt):
         pos[i, 0] = ps[i, 0] - dt * dt / rho0 * g[i, 0]
         pos[i, 1] = ps[i, 1] - dt * dt / rho0 * g[i, 1]
     return pos, vel
+
+
+@njit(**PAR)
+def reflect(pos_old, pos, vel, kind, walls, restitution, gap):
+    """Wall-penetration guard: a fluid particle whose move pos_old -> pos crosses a wall segment
+    (crossed_wall: from either side of a thin wall) is put back on the side it came from, at its mirror
+    image in the wall's line (at least ``gap`` cm from it), and the normal component of its velocity into
+    the wall is reversed times ``restitution`` (the collision model's inelastic impulse against an
+    immovable wall: v_n -> -e v_n).  Repeated for a move that then crosses another wall (a corner); a move
+    still crossing after 4 reflections ends at pos_old.  Returns (pos, vel, reflected (N,) bool); the
+    inputs are not changed."""
+    po = pos.copy()
+    vo = vel.copy()
+    hit = np.zeros(pos.shape[0], np.bool_)
+    for i in prange(pos.shape[0]):
+        if kind[i] != FLUID:
+            continue
+        x0 = pos_old[i, 0]
+        y0 = pos_old[i, 1]
+        x1 = pos[i, 0]
+        y1 = pos[i, 1]
+        if not (np.isfinite(x1) and np.isfinite(y1)):
+            continue
+        vx = vel[i, 0]
+        vy = vel[i, 1]
+        done = False
+        for _ in range(4):
+            w = crossed_wall(x0, y0, x1, y1, walls)
+            if w < 0:
+                done = True
+                break
+            hit[i] = True
+            ax = walls[w, 0]
+            ay = walls[w, 1]
+            ex = walls[w, 2] - ax
+            ey = walls[w, 3] - ay
+            L = np.hypot(ex, ey)
+            nx = -ey / L
+            ny = ex / L
+            if (x0 - ax) * nx + (y0 - ay) * ny < 0.0:  # came from a thin wall's back
+                nx = -nx
+                ny = -ny
+            d1 = (x1 - ax) * nx + (y1 - ay) * ny  # <= 0: behind the line
+            push = max(-2.0 * d1, -d1 + gap)
+            x1 += push * nx
+            y1 += push * ny
+            vn = vx * nx + vy * ny
+            if vn < 0.0:
+                vx -= (1.0 + restitution) * vn * nx
+                vy -= (1.0 + restitution) * vn * ny
+        if not done:
+            x1 = x0
+            y1 = y0
+        po[i, 0] = x1
+        po[i, 1] = y1
+        vo[i, 0] = vx
+        vo[i, 1] = vy
+    return po, vo, hit
 
 
 @njit(**JIT)

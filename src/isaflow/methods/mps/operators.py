@@ -13,7 +13,8 @@ Neighbours are full per-particle lists (CSR: start (N+1,), nbr (M,)), built and 
 pass computes particle i's value from its own row in a fixed order, so the loops over particles run in
 parallel (numba prange) and give bit-identical results for any thread count.  Visibility across thin walls
 (a dividing wall with particles behind both faces, boundary.py): a thin wall's face particles are seen only
-from their own side of the wall, and no pair sees across a thin wall segment.
+from their own side of the wall (and, with walls.thin_line_of_sight, only where the wall stands between), and
+no pair sees across a thin wall segment.
 Units: cm, s, density N s^2 / cm^4 (2D), pressure N / cm^2.
 """
 
@@ -76,13 +77,14 @@ def segments_cross(x0, y0, x1, y1, seg):
 
 
 @njit(inline="always", **JIT)
-def visible(i, j, pos, tw, tside, near, thin):
+def visible(i, j, pos, tw, tside, near, thin, behind=False):
     """Whether particles i and j see each other across the thin walls thin (T, 4).
 
     tw (N,) the thin wall a face particle belongs to (-1: none), tside (N,) its face (+1 / -1);
     near (N,) int64 bit t set when the particle is within reach of thin wall t.  A face particle of
     thin wall t is seen only by particles on its face's side of t (face particles: their face);
-    any other pair is cut when the segment between them meets t.
+    any other pair is cut when the segment between them meets t.  behind: a face particle is seen only
+    from where the wall hides it, i.e. when the segment to it also meets t (walls.thin_line_of_sight).
     """
     if tw[i] < 0 and tw[j] < 0 and (near[i] & near[j]) == 0:
         return True
@@ -91,6 +93,8 @@ def visible(i, j, pos, tw, tside, near, thin):
             si = tside[i] if tw[i] == t else side_of(pos[i, 0], pos[i, 1], thin[t])
             sj = tside[j] if tw[j] == t else side_of(pos[j, 0], pos[j, 1], thin[t])
             if si != sj:
+                return False
+            if behind and tw[i] != tw[j] and not segments_cross(pos[i, 0], pos[i, 1], pos[j, 0], pos[j, 1], thin[t]):
                 return False
         elif (near[i] >> t) & 1 and (near[j] >> t) & 1:
             if segments_cross(pos[i, 0], pos[i, 1], pos[j, 0], pos[j, 1], thin[t]):
@@ -210,7 +214,7 @@ def distances(pos, start, nbr):
 
 
 @njit(**PAR)
-def visible_distances(pos, start, nbr, tw, tside, thin, reach):
+def visible_distances(pos, start, nbr, tw, tside, thin, reach, behind=False):
     """(M,) distance [cm] of every list entry at positions pos, inf for a pair that does not see each other
     across the thin walls thin (T, 4) at pos (visible; reach [cm]: the lists' radius).  Every operator skips
     a pair at r >= its radius, so visibility is that of the positions the operators are evaluated at, not
@@ -221,7 +225,7 @@ def visible_distances(pos, start, nbr, tw, tside, thin, reach):
     for i in prange(n):
         for k in range(start[i], start[i + 1]):
             j = nbr[k]
-            if visible(i, j, pos, tw, tside, near, thin):
+            if visible(i, j, pos, tw, tside, near, thin, behind):
                 d[k] = np.hypot(pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1])
             else:
                 d[k] = np.inf

@@ -80,6 +80,7 @@ def summary_row(path):
                max_speed_cm_s=float(ds["hist_max_speed"].values[-1]), message=a.get("status_message", ""),
                escape_depth_cm=escape_depth(ds), graze_steps=int(a.get("graze_steps", 0)),
                deepest_graze_cm=float(a.get("deepest_graze_cm", 0.0)),
+               reflected_particles=int(a.get("reflected_particles", 0)), reflect_steps=int(a.get("reflect_steps", 0)),
                ms_per_step=1e3 * float(ds["wall_time"]) / max(1, int(ds["force_evals"])))
     rel, absn, probe = noise(ds)
     u = ds["hist_rms_speed"].values

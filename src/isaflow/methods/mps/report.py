@@ -50,6 +50,12 @@ def findings(df):
         out.append(f"Wall-line grazes (a move across a wall line ending within l0/2 of the wall, i.e. short of the first "
                    f"wall-particle row; counted, not escapes) occur in {len(grazed)} of {len(df)} runs, the deepest "
                    f"{deep.deepest_graze_cm:.2g} cm ({deep.deepest_graze_cm / deep.spacing_cm:.0%} of l0, {deep.run}).")
+    if "reflected_particles" in df and (df.reflected_particles > 0).any():
+        hit = df[df.reflected_particles > 0]
+        most = hit.loc[hit.reflected_particles.idxmax()]
+        out.append(f"The penetration guard (walls.reflect: a move across a wall line is mirrored back to its side) acted "
+                   f"in {len(hit)} of {len(df)} runs, at most on {int(most.reflected_particles)} particles in "
+                   f"{int(most.reflect_steps)} steps ({most.run}).")
     return "  ".join(out)
 
 

@@ -49,6 +49,8 @@ VALUES = {
     'pressure.fail_factor': {"type": "number", "minimum": 1},
     'walls.panel_length': {"type": "number", "exclusiveMinimum": 0},
     'walls.graze_depth': {"type": "number", "minimum": 0},
+    'walls.reflect': {"type": "boolean"},
+    'walls.thin_line_of_sight': {"type": "boolean"},
     'resolution.spacing': {"type": ["number", "null"], "exclusiveMinimum": 0},
     'start.on_wall_point': {"type": ["array", "null"], "items": {"type": "number"}, "minItems": 2, "maxItems": 2},
     'probes.single': {"type": "array", "items": {"type": "array", "items": {"type": "number"}, "minItems": 2, "maxItems": 2}},

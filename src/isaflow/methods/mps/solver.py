@@ -1,8 +1,9 @@
 """MPS time stepping on a tank: solve(tank, settings, variant, spacing, ...) -> contract.Result.
 
 Per step (model.py, numba, every particle loop a gather run in parallel): neighbour list, explicit step,
-collision model, free surface and source term, pressure equation (pressure.py), pressure correction,
-particle shifting, wall-crossing check.  The step loop runs in Python around compiled stages.
+collision model, penetration guard (walls.reflect: a move across a wall line mirrored back), free surface and
+source term, pressure equation (pressure.py), pressure correction, particle shifting, penetration guard,
+wall-crossing check.  The step loop runs in Python around compiled stages.
 Rest: isaflow.rest (one criterion for every dynamic method).  Units: cm, N, s; pressure N/cm^2
 (2D, per cm of thickness).
 """
@@ -96,6 +97,7 @@ class State:
         self.escape_box = box
         self.graze_depth = cfg["walls.graze_depth"] * l0  # cm: deeper crossings are escapes
         self.grazes, self.deepest_graze = 0, 0.0  # steps with a graze, deepest graze [cm]
+        self.reflect_steps, self.reflections = 0, 0  # steps with a wall reflection, particles reflected (walls.reflect)
         self.panel_wall, self.panel_centre, self.panel_side, self.load_matrix = boundary.load_map(
             self.walls, self.bnd, cfg["walls.panel_length"])
         self.surface_mode = model.SURFACE[cfg["model.surface_pressure"]]
@@ -124,12 +126,19 @@ class State:
         """(M,) distance of every list entry at pos, inf where the pair does not see each other across a thin
         wall at pos (the lists hold every pair in range; visibility is that of the positions the operators
         use, so a particle that grazes a thin wall's line between list builds sees, and is seen, as it is now)."""
-        return model.visible_distances(pos, self.start, self.nbr, self.tw, self.tside, self.thin, self.rmax + self.skin)
+        return model.visible_distances(pos, self.start, self.nbr, self.tw, self.tside, self.thin, self.rmax + self.skin,
+                                       self.cfg["walls.thin_line_of_sight"])
 
     def list_valid(self, pos):
         """The lists still hold every pair closer than rmax at pos (nobody moved more than skin / 2)."""
         d = pos[: self.nf] - self.list_pos[: self.nf]
         return float(np.max(d[:, 0] ** 2 + d[:, 1] ** 2, initial=0.0)) <= (0.5 * self.skin) ** 2
+
+    def count_reflections(self, hit):
+        n_hit = int(np.count_nonzero(hit))
+        if n_hit:
+            self.reflect_steps += 1
+            self.reflections += n_hit
 
     def panel_forces(self):
         """(P, 2) force of each wall panel on the liquid [N] from the wall particles' pressures."""
@@ -161,6 +170,11 @@ def step(s, dt, source, cfg, timers=None):
     coll = cfg["model.collision_distance"] * s.l0
     if coll > 0.0:
         ps, vs = model.collide(ps, vs, s.kind, s.start, s.nbr, s.distances(ps), coll, cfg["model.restitution"])
+        if not s.list_valid(ps):
+            s.neighbours(ps)
+    if cfg["walls.reflect"]:  # the predicted positions stay on the side each particle started on
+        ps, vs, hit = model.reflect(pos_old, ps, vs, s.kind, s.walls, cfg["model.restitution"], 1e-6 * s.l0)
+        s.count_reflections(hit)
         if not s.list_valid(ps):
             s.neighbours(ps)
     dist = s.distances(ps)
@@ -213,6 +227,9 @@ def step(s, dt, source, cfg, timers=None):
             s.neighbours(pos)
         d2 = s.distances(pos)
         pos = pos + model.shift(pos, s.kind, surf, normal, s.start, s.nbr, d2, s.re_n, s.n0_n, c, s.l0)
+    if cfg["walls.reflect"]:
+        pos, vel, hit = model.reflect(pos_old, pos, vel, s.kind, s.walls, cfg["model.restitution"], 1e-6 * s.l0)
+        s.count_reflections(hit)
     bad, graze = model.check(pos_old, pos, vel, s.kind, s.walls, s.escape_box, s.graze_depth)
     s.pos, s.vel, s.p = pos, vel, p
     s.surf = surf
@@ -402,7 +419,8 @@ def _solve(tank, cfg, variant, l0, t_end, probes, start, snapshots, log, threads
         "time_predict_s": timers[0], "time_solve_s": timers[1], "time_correct_s": timers[2], "list_builds": s.builds,
         "collision_distance_cm": cfg["model.collision_distance"] * l0, "restitution": cfg["model.restitution"],
         "settings_file": cfg.path, "panel_length": cfg["walls.panel_length"], "graze_depth_cm": s.graze_depth,
-        "graze_steps": s.grazes, "deepest_graze_cm": s.deepest_graze, "escapes": int(status == "escaped"),
+        "graze_steps": s.grazes, "deepest_graze_cm": s.deepest_graze, "wall_reflect": int(cfg["walls.reflect"]),
+        "reflect_steps": s.reflect_steps, "reflected_particles": s.reflections, "escapes": int(status == "escaped"),
         "threads": threads, "start_state": origin,
         "layer_pitch": l0, "held_weight": float(s.weight * s.nf), "initial_depth": depth0, "tank_difference": rows_note,
         "rest_energy_ratio": monitor.limit, "rest_window": monitor.window, "rest_depth_cm": depth0,
