@@ -23,12 +23,14 @@ DEFAULT_MEMORY = 8.0 * 2**30  # bytes, when neither the environment nor /proc/me
 
 # What the scheduler is asked for per run job (job_resources), from the estimate and measured peaks: the
 # Snakemake benchmarks of 204 run jobs (isa, mps, sph) on the shared 2-core test machine peaked at
-# 195-347 MB resident (the interpreter with numpy, xarray, netCDF4 and the compiled kernels; a run's own
-# arrays are a few MB) and took at most 60 s + 3 x the estimate's time in wall-clock time.
-JOB_BASE_MB = 400  # resident size of a run job before its own arrays (measured peak 347 MB, rounded up)
+# 195-379 MB resident (the interpreter with numpy, xarray, netCDF4 and the compiled kernels; a run's own
+# arrays are a few MB) and took at most 60 s + 3 x the estimate's time in wall-clock time at load 2-4;
+# at load 7 (the machine running a full workflow besides) a two-thread SPH run took 207 s locally and
+# 391 s as a one-CPU SLURM job for an estimate of 63 s (6.2 x).
+JOB_BASE_MB = 400  # resident size of a run job before its own arrays (measured peak 379 MB, rounded up)
 JOB_MEMORY_FACTOR = 2  # safety factor on (JOB_BASE_MB + the estimate's bytes)
 JOB_START_S = 120  # imports, numba cache load or compile (15 s cold), reading and writing files
-JOB_TIME_FACTOR = 4  # the estimate uses the fastest measured step cost; measured wall <= 60 s + 3 x estimate
+JOB_TIME_FACTOR = 10  # the estimate uses the fastest measured step cost; worst measured 6.2 x the estimate
 JOB_MIN_RUNTIME = 5  # min
 
 
