@@ -25,12 +25,12 @@ DEFAULT_MEMORY = 8.0 * 2**30  # bytes, when neither the environment nor /proc/me
 # Snakemake benchmarks of 204 run jobs (isa, mps, sph) on the shared 2-core test machine peaked at
 # 195-379 MB resident (the interpreter with numpy, xarray, netCDF4 and the compiled kernels; a run's own
 # arrays are a few MB) and took at most 60 s + 3 x the estimate's time in wall-clock time at load 2-4;
-# at load 7 (the machine running a full workflow besides) a two-thread SPH run took 207 s locally and
-# 391 s as a one-CPU SLURM job for an estimate of 63 s (6.2 x).
+# with the machine running a full workflow besides (load 6-7 on 2 cores) a two-thread SPH run with an
+# estimate of 63 s took 207-557 s locally and 391-628 s as a SLURM job (up to 10 x).
 JOB_BASE_MB = 400  # resident size of a run job before its own arrays (measured peak 379 MB, rounded up)
 JOB_MEMORY_FACTOR = 2  # safety factor on (JOB_BASE_MB + the estimate's bytes)
 JOB_START_S = 120  # imports, numba cache load or compile (15 s cold), reading and writing files
-JOB_TIME_FACTOR = 10  # the estimate uses the fastest measured step cost; worst measured 6.2 x the estimate
+JOB_TIME_FACTOR = 15  # the estimate uses the fastest measured step cost; worst measured 10 x the estimate
 JOB_MIN_RUNTIME = 5  # min
 
 
