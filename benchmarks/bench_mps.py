@@ -24,7 +24,7 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from isaflow.methods.mps import boundary, settings, solver  # noqa: E402
-from isaflow.scene import load_tank  # noqa: E402
+from isaflow.tank import load as load_tank  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 SIZES = (180, 720, 2000, 5000, 20000)

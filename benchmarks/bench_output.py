@@ -14,7 +14,7 @@ write the netCDF run file.  Units: s.
 
 Output: benchmarks/results/output_cost.csv (one row per repetition) and the medians
 on stdout.  Runtime ~15 s.
-Run: python benchmarks/bench_output.py [--repeats 7] [--scene config/scenes/single_refined.yaml]
+Run: python benchmarks/bench_output.py [--repeats 7] [--resolution refined]
 """
 
 import argparse
@@ -24,48 +24,51 @@ from pathlib import Path
 
 import pandas as pd
 
-from isaflow import runfile, scene
-from isaflow.methods.isa import solver
+from isaflow import run
 
 # Parameters
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "benchmarks" / "results" / "output_cost.csv"
+WHY = "inferred: benchmark of the run file's cost"
 SETTINGS = {
-    "lean": ["solver.history={}"],
-    "full": ["solver.history={every: 1, walls: true, vessels: true, snapshots: 20}"],
+    "lean": {"solver.history": {"value": {}, "source": WHY}},
+    "full": {"solver.history": {"value": {"every": 1, "walls": True, "vessels": True, "snapshots": 20},
+                                "source": WHY}},
 }
-COMMON = ["solver.variant=capped", "solver.accept=[converged,cycle,step_limit]"]
+TANK = ROOT / "config" / "tanks" / "single.yaml"
+ISA_SETTINGS = ROOT / "config" / "methods" / "isa.yaml"
 
 
-def one_run(scene_path, overrides, tmp):
-    """(steps, status, solver s, file s, file bytes) of one relaxation and its run file."""
-    sc = scene.load(scene_path, COMMON + overrides)
-    pos0, weight, start, a = scene.initial_state(sc)
-    started = runfile.now()
-    run = solver.solve(sc, pos0, weight, start_step=start)
-    t0 = time.perf_counter()
-    ds = runfile.to_dataset(run, sc, runfile.provenance({"scene": scene_path}), started, runfile.now(), a)
+def one_run(resolution, overrides, tmp):
+    """(steps, status, solver s, file s, file bytes) of one capped relaxation of the single tank and its run file
+    (isaflow.run: the command line's path)."""
     path = Path(tmp) / "run.nc"
-    runfile.write(ds, path)
+    if path.exists():
+        path.unlink()
+    p = run.prepare("isa", str(TANK), "capped", resolution, str(path), str(ISA_SETTINGS), overrides, None,
+                    ("converged", "cycle", "step_limit"), 1)
+    result, started, finished = run.solve(p, log=lambda msg: None)
+    t0 = time.perf_counter()
+    run.write(p, result, started, finished)
     t_file = time.perf_counter() - t0
-    return run.steps, run.status, run.wall_time, t_file, path.stat().st_size
+    return result.steps, result.status, result.wall_time, t_file, path.stat().st_size
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeats", type=int, default=7)
-    ap.add_argument("--scene", default=str(ROOT / "config" / "scenes" / "single_refined.yaml"))
+    ap.add_argument("--resolution", default="refined", help="ISA resolution of the single tank")
     args = ap.parse_args(argv)
     rows = []
     with tempfile.TemporaryDirectory() as tmp:
-        one_run(args.scene, SETTINGS["lean"], tmp)  # warm-up: compilation and caches
+        one_run(args.resolution, SETTINGS["lean"], tmp)  # warm-up: compilation and caches
         for rep in range(args.repeats):
             order = list(SETTINGS) if rep % 2 == 0 else list(SETTINGS)[::-1]
             for name in order:
-                steps, status, t_solve, t_file, size = one_run(args.scene, SETTINGS[name], tmp)
+                steps, status, t_solve, t_file, size = one_run(args.resolution, SETTINGS[name], tmp)
                 rows.append(dict(setting=name, repeat=rep, steps=steps, status=status, solver_s=t_solve,
                                  file_s=t_file, total_s=t_solve + t_file, file_bytes=size,
-                                 overrides="; ".join(SETTINGS[name])))
+                                 overrides=str(SETTINGS[name]["solver.history"]["value"])))
     df = pd.DataFrame(rows)
     OUT.parent.mkdir(parents=True, exist_ok=True)
     df.to_csv(OUT, index=False, float_format="%.6g")

@@ -34,7 +34,7 @@ from isaflow.core.geometry import bounding_box  # noqa: E402
 from isaflow.methods.sph import kernels as K  # noqa: E402
 from isaflow.methods.sph import settings as S  # noqa: E402
 from isaflow.methods.sph import solver  # noqa: E402
-from isaflow.scene import load_tank  # noqa: E402
+from isaflow.tank import load as load_tank  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -20,7 +20,8 @@ import yaml
 from conftest import ROOT
 
 PROFILES = {name: ROOT / path / "config.yaml" for name, path in [
-    ("default", "workflow/profiles/default"), ("slurm", "workflow/profiles/slurm"), ("test", "tests/cluster/profile")]}
+    ("default", "workflow/profiles/default"), ("slurm", "workflow/profiles/slurm"), ("test", "tests/cluster/profile"),
+    ("integration", ".tests/integration")]}
 HAS_SLURM_PLUGIN = importlib.util.find_spec("snakemake_executor_plugin_slurm") is not None
 needs_plugin = pytest.mark.skipif(not HAS_SLURM_PLUGIN, reason="snakemake-executor-plugin-slurm not installed "
                                   "(pip install -r requirements/lock-py311.txt)")
@@ -44,7 +45,8 @@ def test_slurm_profile_takes_resources_from_the_rules():
     profile = yaml.safe_load(PROFILES["slurm"].read_text())
     assert profile["executor"] == "slurm"
     assert not {"set-resources", "set-threads", "resources"} & set(profile), "per-rule resources belong in the rules"
-    assert set(profile["default-resources"]) == {"runtime", "mem_mb", "cpus_per_task"}
+    # cpus_per_task must not be a default: the plugin would ask for it instead of the rule's threads
+    assert set(profile["default-resources"]) == {"runtime", "mem_mb", "disk_mb"}
     # the site profile of the test cluster must not shadow what the workflow profile sets
     assert not set(yaml.safe_load(PROFILES["test"].read_text())) & set(profile)
 

@@ -156,3 +156,38 @@ def test_equilibrium_balances_the_weight(single_runs):
 
 def test_run_spec_helper_runs_a_scene(tmp_path):
     assert run_spec(tmp_path, TINY, tmp_path / "x.nc") == 0
+
+
+def test_a_silent_run_still_logs_every_heartbeat_with_its_id_and_names_itself_when_it_ends(tmp_path, monkeypatch):
+    """Progress in every job's log at least every 30 s: a 'running' line when nothing else came (compiling, a
+    method's own pace); the finish line and the written line carry the run id."""
+    import time
+
+    from isaflow import run
+
+    monkeypatch.setattr(run, "HEARTBEAT", 0.3)
+    tp, sp = write_spec(tmp_path, TINY)
+    p = run.prepare("isa", tp, "capped", "r", tmp_path / "run.nc", settings_path=sp, run_id="tiny_run")
+    warm, solve = p.entry.warm_up, p.entry.solve
+
+    class Slow:  # the entry module, with a silent warm-up of 2.5 s (numba releases the GIL; sleep does too)
+        REFERENCES = p.entry.REFERENCES
+
+        def warm_up(self, threads):
+            time.sleep(2.5)
+            warm(threads)
+
+        def solve(self, *a, **kw):
+            return solve(*a, **kw)
+
+    p.entry = Slow()
+    lines = []
+    result, _, _ = run.solve(p, log=lines.append)
+    beats = [line for line in lines if line.startswith("tiny_run: running, ") and "warming up" in line]
+    assert len(beats) >= 2, lines  # the heartbeat looks once a second
+    assert all(line.startswith("tiny_run: ") for line in lines)
+    lines.clear()
+    assert run.run("isa", tp, "capped", "r", tmp_path / "r2.nc", settings_path=sp, run_id="tiny_run",
+                   log=lines.append) == 0
+    assert any(line.startswith("tiny_run: finished: converged") for line in lines), lines
+    assert lines[-1] == f"tiny_run: wrote {tmp_path / 'r2.nc'}"

@@ -21,6 +21,18 @@ LIMITS = Path("config") / "limits.yaml"
 LIMIT_VALUES = {"cpu_hours": {"type": "number", "exclusiveMinimum": 0}}
 DEFAULT_MEMORY = 8.0 * 2**30  # bytes, when neither the environment nor /proc/meminfo says
 
+# What the scheduler is asked for per run job (job_resources), from the estimate and measured peaks: the
+# Snakemake benchmarks of 204 run jobs (isa, mps, sph) on the shared 2-core test machine peaked at
+# 195-379 MB resident (the interpreter with numpy, xarray, netCDF4 and the compiled kernels; a run's own
+# arrays are a few MB) and took at most 60 s + 3 x the estimate's time in wall-clock time at load 2-4;
+# with the machine running a full workflow besides (load 6-7 on 2 cores) a two-thread SPH run with an
+# estimate of 63 s took 207-557 s locally and 391-628 s as a SLURM job (up to 10 x).
+JOB_BASE_MB = 400  # resident size of a run job before its own arrays (measured peak 379 MB, rounded up)
+JOB_MEMORY_FACTOR = 2  # safety factor on (JOB_BASE_MB + the estimate's bytes)
+JOB_START_S = 120  # imports, numba cache load or compile (15 s cold), reading and writing files
+JOB_TIME_FACTOR = 15  # the estimate uses the fastest measured step cost; worst measured 10 x the estimate
+JOB_MIN_RUNTIME = 5  # min
+
 
 @dataclass
 class Cost:
@@ -69,12 +81,22 @@ def cpu_hours(path=LIMITS):
     return float(settings.load(path, LIMIT_VALUES, what="resource limits")["cpu_hours"])
 
 
+def job_resources(cost):
+    """{'mem_mb', 'runtime' (minutes)} to request for a run job from its estimate (constants above):
+    mem_mb = JOB_MEMORY_FACTOR x (JOB_BASE_MB + estimated MB), rounded up to 100 MB;
+    runtime = (JOB_START_S + JOB_TIME_FACTOR x estimated s) in minutes, rounded up, at least JOB_MIN_RUNTIME."""
+    mem_mb = math.ceil(JOB_MEMORY_FACTOR * (JOB_BASE_MB + cost.bytes / 2**20) / 100) * 100
+    runtime = max(JOB_MIN_RUNTIME, math.ceil((JOB_START_S + JOB_TIME_FACTOR * cost.hours * 3600) / 60))
+    return {"mem_mb": int(mem_mb), "runtime": int(runtime)}
+
+
 def gb(b):
     return f"{b / 2**30:.3g} GB"
 
 
 def check(path, cost, max_hours=None):
-    """Refuse (InputError naming path and the setting) a run whose memory or time exceeds the limits.
+    """Refuse (InputError naming path and the setting) a run whose memory or time exceeds the limits;
+    returns the cost.
 
     max_hours: the run's own CPU-hour limit (a deliberate long run), else config/limits.yaml's."""
     numbers = (cost.particles, cost.steps, cost.bytes)
@@ -93,3 +115,4 @@ def check(path, cost, max_hours=None):
                          f"{cost.steps:.3g} steps, {cost.detail}), about {cost.hours:.3g} CPU-hours at "
                          f"{cost.ns_per_particle_step:g} ns per particle-step; the budget is {budget:g} h "
                          f"(config/limits.yaml cpu_hours, or the run's max_hours for a deliberate long run)")
+    return cost

@@ -20,14 +20,14 @@ WORKFLOW_KEYS = ("meta", "runtime")  # keys the workflow adds to a declaration (
 
 def check(method, tank, s, accept=("converged",), stability=False, max_hours=None, particles=None):
     """Refuse (InputError) a run whose outcomes, settings or cost are not allowed.  tank: tank.Tank; s: resolved
-    settings.Settings; particles: a start file's count (None: the resolution's)."""
+    settings.Settings; particles: a start file's count (None: the resolution's).  Returns the budget.Cost."""
     unstable = [a for a in accept if a in UNSTABLE]
     if unstable and not stability:
         raise InputError(f"accept: outcome '{unstable[0]}' may be accepted only by a declared stability case "
                          f"(stability: true / --stability-case); any other run that ends so fails")
     checks = methods.get(method).checks_module()
     checks.plausible(tank, s, stability)  # first: it refuses derived numbers that over- or underflow
-    budget.check(s.path, checks.cost(tank, s, particles), max_hours)
+    return budget.check(s.path, checks.cost(tank, s, particles), max_hours)
 
 
 class Declarations:
@@ -35,6 +35,7 @@ class Declarations:
 
     def __init__(self):
         self._tanks, self._specs = {}, {}
+        self.costs = {}  # {(method, run id): budget.Cost} of every checked run
 
     def tank(self, name):
         if name not in self._tanks:
@@ -53,7 +54,7 @@ class Declarations:
         path, spec = m.settings, self.spec(method)
         for run_id, decl in runs.items():
             try:
-                self._check_run(method, m, path, spec, runs, run_id, decl)
+                self.costs[method, run_id] = self._check_run(method, m, path, spec, runs, run_id, decl)
             except InputError as err:
                 raise InputError(err if f"runs.{run_id}" in str(err) else f"{err} (run '{run_id}')") from None
 
@@ -77,4 +78,4 @@ class Declarations:
         if unstable and not decl.get("stability"):
             raise InputError(f"{where}.accept': outcome '{unstable[0]}' may be accepted only by a stability "
                              f"case (stability: true); any other run that ends so fails its job")
-        check(method, tank, s, accept, decl.get("stability", False), decl.get("max_hours"))
+        return check(method, tank, s, accept, decl.get("stability", False), decl.get("max_hours"))

@@ -12,6 +12,7 @@ output could not be written after the solve.
 
 import os
 import sys
+import threading
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -20,6 +21,7 @@ from . import methods, preflight, runfile, settings, tank as tanks
 from .inputs import InputError, printable
 
 PROGRESS_EVERY = 20.0  # s of wall time between progress lines (a log line at least every 30 s)
+HEARTBEAT = 25.0  # s: without any line for this long (compiling, a method's own pace), a 'running' line
 
 
 @dataclass
@@ -92,13 +94,48 @@ def prepare(method, tank, variant, resolution, out, settings_path=None, override
                     run_id or Path(out).stem, label, stability)
 
 
-def _progress(run_id, log):
+class _Heartbeat:
+    """Every line of a run goes through log(); a daemon thread adds '<run id>: running, N s, <phase>' whenever
+    no line came for HEARTBEAT s, so a job's log never stays silent for 30 s: compiled code is warming up, or a
+    method prints at its own pace (numba kernels release the GIL, so the thread runs while they do)."""
+
+    def __init__(self, run_id, log):
+        self.run_id, self._log = run_id, log
+        self.phase = "starting"
+        self.t0 = self.last = time.perf_counter()
+        self._stop = threading.Event()
+        self._lock = threading.Lock()
+        self._thread = threading.Thread(target=self._beat, name=f"heartbeat {run_id}", daemon=True)
+
+    def log(self, msg):
+        with self._lock:
+            self.last = time.perf_counter()
+            self._log(msg)
+
+    def _beat(self):
+        while not self._stop.wait(1.0):
+            if time.perf_counter() - self.last >= HEARTBEAT:
+                self.log(f"{self.run_id}: running, {time.perf_counter() - self.t0:.0f} s, {self.phase}")
+
+    def __enter__(self):
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc):
+        self._stop.set()
+        self._thread.join()
+
+
+def _progress(run_id, log, beat=None):
     """A progress callback printing at most every PROGRESS_EVERY s: progress(step, measure name, value, units);
-    progress.log(text) prints a method's own progress line (it keeps its own pace), with the run id."""
+    progress.log(text) prints a method's own progress line (it keeps its own pace), with the run id.  beat: the
+    run's _Heartbeat, told the last step so its lines say where the solver is."""
     last = [time.perf_counter()]
 
     def progress(step, name, value, units, force=False):
         now = time.perf_counter()
+        if beat is not None:
+            beat.phase = f"solving, step {step}, {name} = {value:.4g} {units}"
         if force or now - last[0] >= PROGRESS_EVERY:
             last[0] = now
             log(f"{run_id}: step {step:>9d}  {name} = {value:.4g} {units}")
@@ -108,12 +145,16 @@ def _progress(run_id, log):
 
 
 def solve(p, log=None):
-    """(Result, started, finished) of a prepared run; compiled code is warmed first (not timed)."""
+    """(Result, started, finished) of a prepared run; compiled code is warmed first (not timed).  A line at
+    least every HEARTBEAT s while it works (_Heartbeat)."""
     log = log or (lambda msg: print(msg, file=sys.stderr, flush=True))
-    p.entry.warm_up(p.threads)
-    started = runfile.now()
-    result = p.entry.solve(p.tank, p.settings, p.variant, p.resolution, p.start,
-                           progress=_progress(p.run_id, log), threads=p.threads)
+    with _Heartbeat(p.run_id, log) as beat:
+        beat.phase = "warming up compiled code"
+        p.entry.warm_up(p.threads)
+        beat.phase = "solving"
+        started = runfile.now()
+        result = p.entry.solve(p.tank, p.settings, p.variant, p.resolution, p.start,
+                               progress=_progress(p.run_id, beat.log, beat), threads=p.threads)
     return result, started, runfile.now()
 
 
@@ -149,13 +190,14 @@ def run(method, tank, variant, resolution, out, settings_path=None, overrides=()
         log(f"error: {getattr(err, 'filename', None) or tank}: {err.strerror or err}")
         return 2
     result, started, finished = solve(p, log)
-    log(f"{p.run_id}: {result.status}: {result.message} ({result.wall_time:.3f} s solver, "
+    log(f"{p.run_id}: finished: {result.status}: {result.message} ({result.wall_time:.3f} s solver, "
         f"{result.params.get('threads', p.threads or 1)} thread(s))")
     if result.status not in p.accept:
         log(f"error: {p.run_id}: outcome '{result.status}' is not accepted ({', '.join(p.accept)}); no output written")
         return 1
     try:
         write(p, result, started, finished, command)
+        log(f"{p.run_id}: wrote {out}")
     except (OSError, runfile.RunFileError) as err:
         log(f"error: {out}: the run finished but its file could not be written: "
             f"{getattr(err, 'strerror', None) or err}")

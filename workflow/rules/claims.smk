@@ -13,6 +13,10 @@ rule claims:
     params:
         func="claims.write",
         kw=lambda wc: {"registry": "config/claims", "runs": claim_runs()},
+    message:
+        JOB
+    resources:
+        **CLAIMS,
     log:
         "logs/claims.log",
     conda:

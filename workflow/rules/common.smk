@@ -19,6 +19,30 @@ def refuse(message):
     raise SystemExit(2)
 
 
+# Resources of the rules, documented in docs/cluster.md.  `threads` where a job uses more than one core; `resources:`
+# mem_mb and runtime (minutes).  Runs (runs.smk): per run from its cost estimate (run_resources below,
+# isaflow.budget.job_resources).  Every other rule: one of these classes, from measured job times (the
+# start and end times Snakemake records, full runs on the shared 2-core machine) and peaks (the run jobs'
+# benchmarks: 195-347 MB resident for the same interpreter, numpy, xarray and matplotlib):
+#   SMALL  tables, figures, summaries, report fragments: at most 17 s measured
+#   SOLID  the solid and 1D SPH computations (one core, numba): at most 48 s measured
+#   CLAIMS the claims rule: opens every run file of every method (a few hundred small files)
+#   BENCH  the step benchmark (2 threads, up to 1e6 particles at 253 B each: benchmarks/results/memory.csv;
+#          80-109 s measured)
+SMALL = {"mem_mb": 1000, "runtime": 5}
+SOLID = {"mem_mb": 1000, "runtime": 10}
+CLAIMS = {"mem_mb": 2000, "runtime": 15}
+BENCH = {"mem_mb": 2000, "runtime": 15}
+# the line each job prints when it starts (its rule and first output, so the wildcards)
+JOB = "{rule}: {output[0]}"
+RUN_RESOURCES = {}  # {(method, run id): {'mem_mb', 'runtime'}}, filled by check_inputs() from the estimates
+
+
+def run_resources(wc):
+    """mem_mb and runtime of a tank run from its cost estimate (isaflow.budget.job_resources)."""
+    return RUN_RESOURCES[wc.method, wc.run]
+
+
 def read_config(path, schema):
     """A configuration file read by the hardened reader and checked against a schema (workflow/schemas/)."""
     try:
@@ -171,9 +195,10 @@ def check_inputs():
     """Every input checked before any job starts (the Snakefile calls this after every rules file declared
     its runs): the comparison's tanks; every declared run of every tank method (tank, variant, resolution,
     overrides, start run, outcomes, plausibility, cost: isaflow.preflight); the settings of the methods
-    without tanks (their checks' validate).  The first error stops the workflow with one line."""
+    without tanks (their checks' validate).  The first error stops the workflow with one line.  Each run's
+    estimate then gives its job's mem_mb and runtime (RUN_RESOURCES, isaflow.budget.job_resources)."""
+    from isaflow import budget as _budget
     from isaflow import preflight as _preflight
-    from isaflow import tank as _tank
 
     d = _preflight.Declarations()
     try:
@@ -189,3 +214,4 @@ def check_inputs():
                 m.checks_module().validate(m.settings)
     except _inputs.InputError as err:
         refuse(err)
+    RUN_RESOURCES.update({key: _budget.job_resources(cost) for key, cost in d.costs.items()})

@@ -12,6 +12,10 @@ rule compare_table:
     params:
         func="tables.compare_table",
         kw=lambda wc: {"compare": compare_runs()},
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/compare/table.log",
     conda:
@@ -29,6 +33,10 @@ rule compare_figure_tanks:
     params:
         func="figures.methods.tanks_figure",
         kw={"tanks": config["compare"]["tanks"]},
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/compare/figure_tanks.log",
     conda:
@@ -45,6 +53,10 @@ rule compare_figure_runtime:
         report_figure("methods_error_vs_runtime", "methods_figure", "Methods compared", "Error against run time"),
     params:
         func="figures.methods.error_vs_runtime_figure",
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/compare/figure_runtime.log",
     conda:
@@ -63,6 +75,10 @@ rule compare_report:
     params:
         func="report.methods.methods_section",
         kw={"tanks": config["compare"]["tanks"]},
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/compare/report.log",
     conda:

@@ -11,6 +11,10 @@ rule report_inferred:
         "results/report/90_inferred.md",
     params:
         func="report.inferred.inferred_section",
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/report/inferred.log",
     conda:
@@ -31,6 +35,10 @@ rule replication_report:
         report_file("results/report/replication.html", "replication", "Report"),
     params:
         func="report.assemble",
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/report/assemble.log",
     conda:
@@ -47,6 +55,10 @@ rule timing_report:
         "docs/timing.md",
     params:
         func="report.speed.timing_report",
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/report/timing.log",
     conda:

@@ -9,10 +9,14 @@ rule run:
         "results/runs/{method}/{run}.nc",
     params:
         decl=lambda wc: RUNS[wc.method][wc.run],
+    # threads: the declaration's (numba and OpenMP threads of the solver); mem_mb and runtime: from the
+    # run's cost estimate (common.smk run_resources, isaflow.budget.job_resources)
     threads: lambda wc: RUNS[wc.method][wc.run].get("threads", 1)
     resources:
-        mem_mb=lambda wc: RUNS[wc.method][wc.run].get("mem_mb", 1000),
-        runtime=lambda wc: RUNS[wc.method][wc.run].get("runtime", 20),
+        mem_mb=lambda wc: run_resources(wc)["mem_mb"],
+        runtime=lambda wc: run_resources(wc)["runtime"],
+    message:
+        "run {wildcards.method}/{wildcards.run}: {threads} thread(s), {resources.mem_mb} MB, {resources.runtime} min"
     log:
         "logs/runs/{method}/{run}.log",
     benchmark:

@@ -10,8 +10,9 @@ for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS", "NUMB
     os.environ[_var] = str(snakemake.threads)  # noqa: F821
 
 sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
-# this workflow's own package first (its checkout's src/), whatever else the environment has installed
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(snakemake.scriptdir)), "src"))  # noqa: F821
+# the project's source of this checkout (src/ next to workflow/), ahead of any installed copy: the rules run
+# the checked-out code without an (editable) install tied to one checkout
+sys.path.insert(0, os.path.realpath(os.path.join(os.path.dirname(__file__), "..", "..", "src")))
 
 from isaflow import run  # noqa: E402
 

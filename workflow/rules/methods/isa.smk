@@ -55,6 +55,10 @@ rule isa_metrics:
         "results/isa/metrics.csv",
     params:
         func="methods.isa.tables.metrics_table",
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/isa/metrics.log",
     conda:
@@ -71,6 +75,10 @@ rule isa_calibration_table:
         "results/isa/calibration.csv",
     params:
         func="methods.isa.tables.calibration_table",
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/isa/calibration_table.log",
     conda:
@@ -88,6 +96,10 @@ rule isa_fig_inputs:
     params:
         func="methods.isa.figures.single.inputs_figure",
         kw=lambda wc: {"inferred": ISA.get("inferred", {}).get(wc.name)},
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/isa/figures/{name}.log",
     wildcard_constraints:
@@ -108,6 +120,10 @@ rule isa_fig_single:
         func="methods.isa.figures.single.single_vessel_figure",
         kw=lambda wc: {"paper_level": ISA["paper"][FIGS[wc.name].removesuffix("_capped")]["level"],
                        "inferred": ISA.get("inferred", {}).get(wc.name)},
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/isa/figures/{name}.log",
     wildcard_constraints:
@@ -127,6 +143,10 @@ rule isa_fig_calibration:
     params:
         func="methods.isa.figures.single.calibration_figure",
         kw={"paper_levels": {k: v["level"] for k, v in ISA["paper"].items()}, "adopted": ISA["calibration"]["adopted"]},
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/isa/figures/calibration_free_surface.log",
     conda:
@@ -143,6 +163,10 @@ rule isa_fig_convergence:
         report_figure("convergence_single", "study_figure", "Studies", "ISA convergence"),
     params:
         func="methods.isa.figures.single.convergence_figure",
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/isa/figures/convergence_single.log",
     conda:
@@ -163,6 +187,10 @@ rule isa_fig_flow:
             "fig10_flow_complete": "methods.isa.figures.flow.flow_complete_figure",
         }[wc.name],
         kw=lambda wc: {"paper": FLOW["paper"], "inferred": ISA.get("inferred", {}).get(wc.name)},
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/isa/figures/{name}.log",
     wildcard_constraints:
@@ -186,6 +214,10 @@ rule isa_fig_overdamped:
     params:
         func="methods.isa.figures.damping.overdamped_figure",
         kw={**_OD, "inferred": ISA.get("inferred", {}).get("isa_overdamped")},
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/isa/figures/isa_overdamped.log",
     conda:
@@ -203,6 +235,10 @@ rule isa_fig_flow_history:
     params:
         func="methods.isa.figures.flow.flow_history_figure",
         kw={"chains": FLOW["chains"]},
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/isa/figures/flow_history.log",
     conda:
@@ -222,6 +258,10 @@ rule isa_table1:
     params:
         func="methods.isa.tables.write_table1",
         kw={"rows": ISA["table1"]},
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/isa/table1.log",
     conda:
@@ -239,6 +279,10 @@ rule isa_study_error_table:
     params:
         func="methods.isa.tables.error_table",
         kw={"meta": STUDY_META, "paper": ISA["paper"]},
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/isa/study/error_table.log",
     conda:
@@ -259,6 +303,10 @@ rule isa_study_fire_tables:
     params:
         func="methods.isa.tables.fire_tables",
         kw={"meta": STUDY_META, "paper": ISA["paper"], "required_ratio": STUDY["fire_tuning"]["required_ratio"]},
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/isa/study/fire_tables.log",
     conda:
@@ -276,6 +324,10 @@ rule isa_study_map_table:
     params:
         func="methods.isa.tables.map_table",
         kw={"meta": STUDY_META},
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/isa/study/map_table.log",
     conda:
@@ -293,6 +345,10 @@ rule isa_study_cases_table:
     params:
         func="methods.isa.tables.cases_table",
         kw={"meta": STUDY_META},
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/isa/study/cases_table.log",
     conda:
@@ -309,6 +365,10 @@ rule isa_fig_error_vs_runtime:
         report_figure("error_vs_runtime", "study_figure", "Studies", "ISA error against run time"),
     params:
         func="methods.isa.figures.study.error_vs_runtime_figure",
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/isa/figures/error_vs_runtime.log",
     conda:
@@ -325,6 +385,10 @@ rule isa_fig_stability_map:
         report_figure("stability_map", "study_figure", "Studies", "ISA stability"),
     params:
         func="methods.isa.figures.study.stability_map_figure",
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/isa/figures/stability_map.log",
     conda:
@@ -342,6 +406,10 @@ rule isa_report_findings:
         "results/report/findings.md",
     params:
         func="methods.isa.report.findings.findings_file",
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/isa/report/findings.log",
     conda:
@@ -362,6 +430,10 @@ rule isa_report_single:
         "docs/tables/calibration.csv",
     params:
         func="methods.isa.report.single.single_section",
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/isa/report/single.log",
     conda:
@@ -379,6 +451,10 @@ rule isa_report_flow:
         "results/report/20_flow.md",
     params:
         func="methods.isa.report.flow.flow_section",
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/isa/report/flow.log",
     conda:
@@ -402,6 +478,10 @@ rule isa_report_study:
         "docs/tables/study_cases.csv",
     params:
         func="methods.isa.report.study.report_section",
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/isa/report/study.log",
     conda:
@@ -423,12 +503,18 @@ rule isa_bench_step:
         "benchmarks/results/machine.txt",
         "benchmarks/results/step_cost.png",
     threads: 2  # the benchmark takes the whole 2-core machine so other jobs do not perturb it
+    message:
+        JOB
+    resources:
+        **BENCH,
     log:
         "logs/isa/bench_step.log",
     conda:
         "../../envs/isaflow.yaml"
+    params:
+        src=os.path.join(workflow.basedir, "src"),  # this checkout's source (no install needed)
     shell:
-        "python {input.script} > {log} 2>&1"
+        "PYTHONPATH={params.src} python {input.script} > {log} 2>&1"
 
 
 rule isa_bench_output:
@@ -438,12 +524,18 @@ rule isa_bench_output:
     output:
         "benchmarks/results/output_cost.csv",
     threads: 2  # the benchmark takes the whole 2-core machine so other jobs do not perturb it
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/isa/bench_output.log",
     conda:
         "../../envs/isaflow.yaml"
+    params:
+        src=os.path.join(workflow.basedir, "src"),  # this checkout's source (no install needed)
     shell:
-        "python {input.script} > {log} 2>&1"
+        "PYTHONPATH={params.src} python {input.script} > {log} 2>&1"
 
 
 rule isa_timing:
@@ -460,6 +552,10 @@ rule isa_timing:
         "results/timing/10_isa.md",
     params:
         func="methods.isa.report.speed.timing_fragment",
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/isa/report/timing.log",
     conda:
@@ -480,6 +576,14 @@ PAPER_TARGETS = [f for name in ("fig05_inputs_coarse", "fig06_single_coarse", "f
 rule paper:
     input:
         PAPER_TARGETS,
+
+
+# the smallest target set CI runs (.tests/integration/config.yaml): the paper's coarse Figures 5, 6, 9 and 10
+# from their three coarse runs (7 jobs)
+rule integration:
+    input:
+        [f for name in ("fig05_inputs_coarse", "fig06_single_coarse", "fig09_flow_incomplete", "fig10_flow_complete")
+         for f in figure(name)],
 
 
 register(targets=PAPER_TARGETS + figure("calibration_free_surface") + figure("convergence_single")

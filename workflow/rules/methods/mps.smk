@@ -18,6 +18,10 @@ rule mps_summary:
         "results/mps/summary.csv",
     params:
         func="methods.mps.outputs.summary",
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/mps/summary.log",
     conda:
@@ -34,6 +38,10 @@ rule mps_figure_loads:
         report_figure("mps_wall_loads", "mps_figure", "Methods compared", "MPS"),
     params:
         func="methods.mps.figures.wall_loads",
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/mps/figure_loads.log",
     conda:
@@ -50,6 +58,10 @@ rule mps_figure_rest:
         report_figure("mps_rest", "mps_figure", "Methods compared", "MPS"),
     params:
         func="methods.mps.figures.rest",
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/mps/figure_rest.log",
     conda:
@@ -66,6 +78,10 @@ rule mps_figure_flow:
         report_figure("mps_flow", "mps_figure", "Methods compared", "MPS"),
     params:
         func="methods.mps.figures.flow",
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/mps/figure_flow.log",
     conda:
@@ -86,6 +102,10 @@ rule mps_report:
         table="docs/tables/mps_single.csv",
     params:
         func="methods.mps.report.write",
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/mps/report.log",
     conda:

@@ -3,7 +3,7 @@
 # scripts/call.py.
 import re
 
-from isaflow.methods.solid import cases as _solid_cases
+from isaflow.methods.solid import settings as _solid_settings
 
 SOLID_CFG = "config/methods/solid.yaml"
 SOLID_CASES = ["bar_tension", "bar_compression", "shear", "hertz", "hertz_dt15ns", "hertz_dt56ns"]
@@ -40,7 +40,7 @@ SOLID_CLAIM_RUN_IDS = ["hertz_R50.8mm_paper", "hertz_R127mm_paper", "hertz_R20m_
 
 # the list above is what the settings give (hertz.scale_radii_mm, the bar_long sweep): refuse the rule file otherwise
 try:
-    _claim_ids = _solid_cases.claim_run_ids(SOLID_CFG)
+    _claim_ids = _solid_settings.claim_run_ids(SOLID_CFG)
 except _inputs.InputError as _err:
     refuse(_err)
 if sorted(_claim_ids) != sorted(SOLID_CLAIM_RUN_IDS):
@@ -68,6 +68,10 @@ rule solid_run:
         kw=lambda wc: dict(case=wc.case, variant=wc.variant),
     conda:
         "../../envs/isaflow.yaml"
+    message:
+        JOB
+    resources:
+        **SOLID,
     log:
         "logs/solid/{case}_{variant}.log",
     script:
@@ -87,6 +91,10 @@ rule solid_vessel:
         kw=lambda wc: dict(case="vessel", variant=wc.variant),
     conda:
         "../../envs/isaflow.yaml"
+    message:
+        JOB
+    resources:
+        **SOLID,
     log:
         "logs/solid/vessel_{variant}.log",
     script:
@@ -104,6 +112,10 @@ rule solid_floor_uniform:
         kw=dict(case="floor_uniform", variant="uniform_load"),
     conda:
         "../../envs/isaflow.yaml"
+    message:
+        JOB
+    resources:
+        **SOLID,
     log:
         "logs/solid/floor_uniform_uniform_load.log",
     script:
@@ -124,6 +136,10 @@ rule solid_floor_oneway:
         kw=lambda wc: dict(case=f"floor_{wc.src}", variant="oneway"),
     conda:
         "../../envs/isaflow.yaml"
+    message:
+        JOB
+    resources:
+        **SOLID,
     log:
         "logs/solid/floor_{src}_oneway.log",
     script:
@@ -142,6 +158,10 @@ rule solid_figures_44:
         func="methods.solid.figures.vessel_and_floor",
     conda:
         "../../envs/isaflow.yaml"
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/solid/figures_44.log",
     script:
@@ -159,6 +179,10 @@ rule solid_figures:
         func="methods.solid.figures.bar_and_hertz",
     conda:
         "../../envs/isaflow.yaml"
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/solid/figures.log",
     script:
@@ -177,6 +201,10 @@ rule solid_report:
         func="methods.solid.report.report",
     conda:
         "../../envs/isaflow.yaml"
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/solid/report.log",
     script:

@@ -21,6 +21,10 @@ rule sph_summary:
         "results/sph/summary.csv",
     params:
         func="methods.sph.outputs.summary",
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/sph/summary.log",
     conda:
@@ -38,6 +42,10 @@ rule sph_figures:
         SPH_REPORT_FIGURES,
     params:
         func="methods.sph.figures.all_figures",
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/sph/figures.log",
     conda:
@@ -55,6 +63,10 @@ rule sph_report:
         "results/timing/50_sph.md",
     params:
         func="methods.sph.report.write",
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/sph/report.log",
     conda:

@@ -22,10 +22,12 @@ rule sph1d_sweep:
         "results/sph1d/sweep.nc",
     params:
         func="methods.sph1d.pipeline.run_sweep",
-    resources:
-        runtime=10,
     conda:
         "../../envs/isaflow.yaml"
+    message:
+        JOB
+    resources:
+        **SOLID,
     log:
         "logs/sph1d/sweep.log",
     script:
@@ -41,10 +43,13 @@ rule sph1d_sweep_n8192:
     params:
         func="methods.sph1d.pipeline.run_sweep",
         kw={"resolution": "n8192"},
-    resources:
-        runtime=20,
     conda:
         "../../envs/isaflow.yaml"
+    message:
+        JOB
+    resources:
+        mem_mb=1000,
+        runtime=20,
     log:
         "logs/sph1d/sweep_n8192.log",
     script:
@@ -63,6 +68,10 @@ rule sph1d_cases:
         func="methods.sph1d.pipeline.make_cases",
     conda:
         "../../envs/isaflow.yaml"
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/sph1d/cases.log",
     script:
@@ -81,6 +90,10 @@ rule sph1d_figures:
         func="methods.sph1d.pipeline.make_figures",
     conda:
         "../../envs/isaflow.yaml"
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/sph1d/figures.log",
     script:
@@ -103,6 +116,10 @@ rule sph1d_report:
         func="methods.sph1d.pipeline.make_report",
     conda:
         "../../envs/isaflow.yaml"
+    message:
+        JOB
+    resources:
+        **SMALL,
     log:
         "logs/sph1d/report.log",
     script:

@@ -11,7 +11,7 @@ from isaflow.core.units import PA
 
 from . import lattice as L
 from . import solve as S
-from .settings import material_units
+from .settings import claim_run_ids, material_units  # noqa: F401 (claim_run_ids: pure Python, read while the workflow parses)
 
 UM, MM = 1e-4, 0.1  # cm
 
@@ -283,22 +283,6 @@ def run_bar_long(cfg, variant, strain, dt_frac, case="bar_tension_long"):
     return S.result(st, case, status, msg, resid, hist,
                     {"strain": strain, "dt_over_dx_c": dt_frac, "dt_s": dt, "perturbation_dx": lg["perturbation_dx"],
                      "seed": lg["seed"], "grips": c["grips"], "damped": 0})
-
-
-def claim_run_ids(config_path):
-    """The run ids '<case>_<variant>' the claims registry asks for, from the settings file: the Hertz plate under
-    every hertz.scale_radii_mm disk, eqs. 26-27 stepping (paper, hooke) and eq. 27 alone, the bar in sustained
-    tension at every bar_long strain x step (the kept pair named bar_tension_long), the vessel with water under
-    the printed solid model."""
-    from .settings import load
-
-    c = load(config_path)
-    radii = [f"{r:g}mm" if r < 1000 else f"{r / 1000:g}m" for r in c["hertz"]["scale_radii_mm"]]
-    lg = c["bar_long"]
-    sweep = [f"bar_tension_long_e{100 * e:g}_dt{d:g}_paper" for e in lg["strain_sweep"] for d in lg["dt_sweep"]
-             if (e, d) != (lg["strain"], lg["dt_over_dx_c"])]
-    return ([f"hertz_R{r}_paper" for r in radii] + ["hertz_eq27_paper", "hertz_eq27_hooke", "hertz_eq27_uncapped_paper",
-            "bar_tension_long_paper"] + sweep + ["vessel_water_particles_paper"])
 
 
 def long_bar_case(cfg, case):

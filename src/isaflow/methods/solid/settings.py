@@ -63,3 +63,17 @@ def load_with_sources(path):
 def material_units(mat):
     """(E N/cm^2, nu, rho N s^2/cm^4) from the file's GPa and kg/m^3."""
     return mat["E_GPa"] * 1e9 * PA, mat["nu"], mat["rho_kg_m3"] * KG / 1e6
+
+
+def claim_run_ids(config_path):
+    """The run ids '<case>_<variant>' the claims registry asks for, from the settings file: the Hertz plate under
+    every hertz.scale_radii_mm disk, eqs. 26-27 stepping (paper, hooke) and eq. 27 alone, the bar in sustained
+    tension at every bar_long strain x step (the kept pair named bar_tension_long), the vessel with water under
+    the printed solid model."""
+    c = load(config_path)
+    radii = [f"{r:g}mm" if r < 1000 else f"{r / 1000:g}m" for r in c["hertz"]["scale_radii_mm"]]
+    lg = c["bar_long"]
+    sweep = [f"bar_tension_long_e{100 * e:g}_dt{d:g}_paper" for e in lg["strain_sweep"] for d in lg["dt_sweep"]
+             if (e, d) != (lg["strain"], lg["dt_over_dx_c"])]
+    return ([f"hertz_R{r}_paper" for r in radii] + ["hertz_eq27_paper", "hertz_eq27_hooke", "hertz_eq27_uncapped_paper",
+            "bar_tension_long_paper"] + sweep + ["vessel_water_particles_paper"])
