@@ -502,6 +502,8 @@ rule isa_bench_step:
         "benchmarks/results/summary.txt",
         "benchmarks/results/machine.txt",
         "benchmarks/results/step_cost.png",
+        "benchmarks/results/step_threads.csv",
+        "benchmarks/results/newton_evals.csv",
     threads: 2  # the benchmark takes the whole 2-core machine so other jobs do not perturb it
     message:
         JOB

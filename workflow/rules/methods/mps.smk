@@ -90,6 +90,27 @@ rule mps_figure_flow:
         "../../scripts/call.py"
 
 
+rule mps_bench:
+    input:
+        script="benchmarks/bench_mps.py",
+        code=code("methods/mps/*"),
+    output:
+        "benchmarks/results/mps_step_cost.csv",
+    threads: 2  # the benchmark times 1 and 2 threads; it takes the whole 2-core machine
+    message:
+        JOB
+    resources:
+        **BENCH,
+    log:
+        "logs/mps/bench.log",
+    conda:
+        "../../envs/isaflow.yaml"
+    params:
+        src=os.path.join(workflow.basedir, "src"),  # this checkout's source (no install needed)
+    shell:
+        "PYTHONPATH={params.src} python {input.script} > {log} 2>&1"
+
+
 rule mps_report:
     input:
         summary="results/mps/summary.csv",

@@ -75,6 +75,27 @@ rule sph_report:
         "../../scripts/call.py"
 
 
-register(SPH_FILES + ["results/sph/summary.csv"] + [f for n in ("sph_single", "sph_flow", "sph_flow_snapshots")
+rule sph_bench:
+    input:
+        script="benchmarks/bench_sph.py",
+        code=code("methods/sph/*"),
+    output:
+        "benchmarks/results/sph_step_cost.csv",
+    threads: 2  # 1 and 2 threads side by side; it takes the whole 2-core machine
+    message:
+        JOB
+    resources:
+        **BENCH,
+    log:
+        "logs/sph/bench.log",
+    conda:
+        "../../envs/isaflow.yaml"
+    params:
+        src=os.path.join(workflow.basedir, "src"),  # this checkout's source (no install needed)
+    shell:
+        "PYTHONPATH={params.src} python {input.script} > {log} 2>&1"
+
+
+register(SPH_FILES + ["results/sph/summary.csv", "benchmarks/results/sph_step_cost.csv"] + [f for n in ("sph_single", "sph_flow", "sph_flow_snapshots")
                                                     for f in figure(n)],
          ["results/report/50_sph.md"], timing=["results/timing/50_sph.md"])
