@@ -314,7 +314,8 @@ def test_the_workflow_refuses_bad_inputs_while_it_is_parsed(tmp_path, case):
 
 def test_no_shell_line_is_built_from_configuration():
     """Every `shell:` command of the workflow names only files and threads ({input.*}, {output}, {log},
-    {threads}): settings, overrides and wildcards reach the code as data (params, script:)."""
+    {threads}, the checkout's {params.src}): settings, overrides and wildcards reach the code as data (params,
+    script:)."""
     commands = []
     for path in [ROOT / "Snakefile", *sorted((ROOT / "workflow").rglob("*.smk"))]:
         text = path.read_text()
@@ -322,7 +323,8 @@ def test_no_shell_line_is_built_from_configuration():
         assert "shell(" not in text, path
     for cmd in commands:
         for field in re.findall(r"{([^}]*)}", cmd):
-            assert re.fullmatch(r"input(\.\w+)?|output(\[\d+\])?|log|threads", field), (cmd, field)
+            # params.src: the checkout's src/ (workflow.basedir), the one param a benchmark's shell line names
+            assert re.fullmatch(r"input(\.\w+)?|output(\[\d+\])?|log|threads|params\.src", field), (cmd, field)
 
 
 def test_the_1d_settings_name_the_numerical_modules_choices():
