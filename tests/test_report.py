@@ -32,3 +32,10 @@ def test_assemble_puts_the_claims_first_and_every_part_after(tmp_path):
                                      "| `hat-x` eq. 6 | method result | \"c2\"", "## Why not reproduced", "because",
                                      "- a finding", "## section 10_a", "## section 20_b")]
     assert order == sorted(order)
+
+
+def test_a_calibrated_verdict_is_counted_as_calibrated_not_as_reproduced():
+    df = pd.DataFrame([dict(paper="p", kind="method result", verdict="reproduced only after calibrating k_pair"),
+                       dict(paper="p", kind="method result", verdict="reproduced")])
+    c = claims.counts(df).iloc[0]
+    assert c["reproduced"] == 1 and c["reproduced only after calibrating"] == 1

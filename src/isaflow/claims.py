@@ -170,7 +170,7 @@ def judge(ctx, claims=None, inputs=None, found=None):
 
 def verdict_class(v):
     """The verdict's class (one of VERDICTS) of a verdict string."""
-    return next((k for k in VERDICTS if str(v).startswith(k)), "other")
+    return next((k for k in sorted(VERDICTS, key=len, reverse=True) if str(v).startswith(k)), "other")
 
 
 def counts(df):

@@ -11,6 +11,8 @@ from pathlib import Path
 import numpy as np
 
 from .. import claims_registry
+from ..claims import VERDICTS, verdict_class as _verdict_class
+from ..html import page
 from ..methods import papers
 
 
@@ -48,7 +50,7 @@ def comparison(quantity, paper, ours, diff, tol=None, note=""):
             "verdict": verdict(diff, tol, note)}
 
 
-VERDICT_ORDER = ("not reproduced", "reproduced only after calibrating", "reproduced", "not testable here")
+VERDICT_ORDER = (VERDICTS[2], VERDICTS[1], VERDICTS[0], VERDICTS[3])  # the summary sentence: failures first
 PAPERS = papers()  # {paper id: label}, from the method registry
 
 
@@ -70,17 +72,12 @@ def _cell(x, limit=None):
     return text if limit is None or len(text) <= limit else text[:limit - 3].rstrip() + "..."
 
 
-def _verdict_class(v):
-    return next((k for k in VERDICT_ORDER if str(v).startswith(k)), "other")
-
-
 def counts_table(counts):
     """Markdown: claims per paper and kind by verdict class (the claims rule's counts.csv)."""
     import pandas as pd
 
     c = pd.read_csv(counts)
-    cols = [v for v in ("reproduced", "reproduced only after calibrating", "not reproduced", "not testable here")
-            if v in c.columns]
+    cols = [v for v in VERDICTS if v in c.columns]
     lines = ["| paper | kind | " + " | ".join(cols) + " | total |", "|---|---|" + "---|" * (len(cols) + 1)]
     for _, r in c.iterrows():
         n = [int(r[k]) for k in cols]
@@ -140,7 +137,7 @@ def assemble(parts, claims, counts, findings, outputs):
     head += summary(df) + [""]
     for paper, g in df.groupby("paper", sort=False):
         head += [f"### {PAPERS.get(paper, paper)}", "", claims_table(g), ""]
-    why = df[df["verdict"].map(_verdict_class).eq("not reproduced") & df["why"].astype(bool)]
+    why = df[df["verdict"].map(_verdict_class).eq(VERDICTS[2]) & df["why"].astype(bool)]
     if len(why):
         head += ["## Why not reproduced", ""]
         head += [f"- **`{r['id']}`** ({_cell(r['claim'], 80) or 'project check'}): {_cell(r['why'])}"
@@ -170,13 +167,3 @@ def write_html(markdown_text, out, title):
     Path(out).parent.mkdir(parents=True, exist_ok=True)
     Path(out).write_text(page(title, markdown.markdown(markdown_text, extensions=["tables"])))
 
-
-STYLE = ("<style>body{font-family:sans-serif;font-size:13px} table{border-collapse:collapse} "
-         "td,th{border:1px solid #bbb;padding:3px 6px;vertical-align:top;text-align:left} "
-         "th{background:#eee;position:sticky;top:0}</style>")
-
-
-def page(title, body):
-    """A self-contained HTML page (readable in a browser and inside the Snakemake report)."""
-    return (f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>{title}</title>{STYLE}</head>"
-            f"<body>{body}</body></html>\n")
