@@ -26,7 +26,7 @@ from pathlib import Path
 import pandas as pd
 
 from . import claims_registry, methods, runfile
-from .report import page
+from .html import page
 
 VERDICTS = ("reproduced", "reproduced only after calibrating", "not reproduced", "not testable here")
 COLUMNS = ["id", "paper", "section", "kind", "half", "claim", "measured", "tolerance", "verdict", "evidence", "why",
