@@ -9,6 +9,9 @@ from snakemake.utils import min_version
 
 min_version("8.20")
 
+# the About page of `snakemake --report report.html <target>`
+report: "workflow/report/workflow.rst"
+
 
 include: "workflow/rules/common.smk"
 include: "workflow/rules/runs.smk"
@@ -26,7 +29,7 @@ for _rules in sorted(glob.glob("workflow/rules/methods/*.smk")):
 
 rule all:
     input:
-        lambda wc: TARGETS["targets"],
+        lambda wc: TARGETS["targets"] + report_copies(TARGETS["targets"]),
     default_target: True
 
 

@@ -127,22 +127,59 @@ def test_lint_passes():
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
 
 
-def test_report_holds_every_committed_figure_with_its_caption(tmp_path):
-    """snakemake --report over the committed figures (a clean clone has them): every caption file resolves,
-    whichever rule file (rules/ or rules/methods/) marks the figure."""
+def test_report_holds_each_figure_the_run_made_with_its_own_caption(tmp_path):
+    """The report's figures are the copies a run of this checkout makes (rule report_figure_copy), each with
+    its own caption, category and subcategory (workflow/report/figures.yaml), whichever rule file makes the
+    figure; a committed figure the run did not make is not in the report."""
     import shutil
+
+    import yaml
 
     for item in ("Snakefile", "workflow", "config", "figures"):
         src = ROOT / item
         (shutil.copytree if src.is_dir() else shutil.copy)(src, tmp_path / item)
     (tmp_path / "src").symlink_to(ROOT / "src")
-    pngs = sorted(p.relative_to(tmp_path).as_posix() for p in (tmp_path / "figures").glob("*.png"))
-    assert len(pngs) >= 25
-    proc = subprocess.run([*SNAKEMAKE, "--workflow-profile", "none", "--report", "report.html", *pngs], cwd=tmp_path,
-                          capture_output=True, text=True, timeout=300)
+    spec = yaml.safe_load((ROOT / "workflow" / "report" / "figures.yaml").read_text())
+    names = sorted(p.stem for p in (tmp_path / "figures").glob("*.png") if p.stem in spec)
+    assert len(names) >= 25
+    made, left = names[:-1], names[-1]  # the last committed figure is not made by this "run"
+    copies = [f"results/report/figures/{n}.png" for n in made]
+    (tmp_path / "results" / "report" / "figures").mkdir(parents=True)
+    for n in made:  # what the rule's job does (the committed figures stand in for the run's)
+        shutil.copy(tmp_path / "figures" / f"{n}.png", tmp_path / "results" / "report" / "figures" / f"{n}.png")
+    base = [*SNAKEMAKE, "--workflow-profile", "none"]
+    proc = subprocess.run([*base, "--report", "report.html", *copies], cwd=tmp_path, capture_output=True, text=True,
+                          timeout=300)
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
     added = {line.split()[1] for line in proc.stderr.splitlines() if line.startswith("Adding ")}
-    assert added == {Path(p).name for p in pngs}
+    assert added == {f"{n}.png" for n in made}
+    # a report asking for every figure refuses (the figure the run did not make has no copy) instead of showing
+    # the committed figures/<name>.png
+    proc = subprocess.run([*base, "--report", "all.html", *copies, f"results/report/figures/{left}.png"], cwd=tmp_path,
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode != 0 and "marked for report but does not exist" in proc.stdout + proc.stderr
+    assert not (tmp_path / "all.html").exists()
     html = (tmp_path / "report.html").read_text()
-    for category in ("Paper figures", "Studies", "Methods compared"):
-        assert category in html
+    for n in made:
+        first = " ".join(spec[n]["caption"].split())[:40]
+        assert first.replace("&", "&amp;") in html or first in html, n
+        assert spec[n]["subcategory"] in html
+    assert "Replication of Papadopoulos, Koutitas" in html  # the About page (workflow/report/workflow.rst)
+    assert "not made by this run" in html  # no claims registry in this tree: no verdict is invented
+
+
+def test_every_figure_has_one_caption_naming_real_claims():
+    """Every figure a rule makes has its caption entry, and every claim a caption names is in its paper's
+    claims registry file (config/claims/<paper>.yaml)."""
+    import yaml
+
+    spec = yaml.safe_load((ROOT / "workflow" / "report" / "figures.yaml").read_text())
+    out = dry_run()
+    made = {Path(w.rstrip(",")).stem for w in out.split() if w.startswith("figures/") and w.rstrip(",").endswith(".png")}
+    assert made and made <= set(spec), sorted(made - set(spec))
+    assert set(spec) <= made, sorted(set(spec) - made)
+    for name, entry in spec.items():
+        for paper, ids in entry["claims"].items():
+            registry = yaml.safe_load((ROOT / "config" / "claims" / f"{paper}.yaml").read_text())
+            known = {c["id"] for c in registry["claims"]}
+            assert set(ids) <= known, (name, paper, sorted(set(ids) - known))

@@ -161,10 +161,56 @@ def report_file(path, caption, category, subcategory=None):
     return report(path, caption=os.path.relpath(rst, str(workflow.current_basedir)), category=category, **kw)
 
 
-def report_figure(name, caption, category, subcategory=None):
-    """figure(name) with the PNG marked for the Snakemake report."""
-    png, pdf = figure(name)
-    return [report_file(png, caption, category, subcategory), pdf]
+# The Snakemake report's figures: one caption per figure (workflow/report/figures.yaml) with the verdicts of the
+# claims it bears on.  The report holds copies results/report/figures/<name>.png (rule report_figure_copy),
+# made only by a run of this checkout, never the committed figures/<name>.png.
+REPORT_FIGURES = read_config("workflow/report/figures.yaml", "report_figures.schema.yaml")
+
+
+def report_copies(paths):
+    """results/report/figures/<name>.png of every figures/<name>.png in paths that has a caption."""
+    names = [os.path.basename(p)[:-4] for p in paths if p.startswith("figures/") and p.endswith(".png")]
+    return [f"results/report/figures/{n}.png" for n in names if n in REPORT_FIGURES]
+
+
+def _rst(text, limit=None):
+    """text as plain reStructuredText (markup characters escaped), cut to limit characters."""
+    text = " ".join(str(text).split())
+    if limit and len(text) > limit:
+        text = f"{text[: limit - 3].rstrip()}..."
+    return "".join(f"\\{c}" if c in "\\`*_|[]<>:" else c for c in text)
+
+
+def report_captions():
+    """{figure: caption (reStructuredText)}: its text in figures.yaml, then the verdict of every claim it names,
+    read from the claims registry this checkout's run made (results/claims/registry/<paper>.csv; read while
+    the workflow is parsed, so `snakemake --report` after the run shows the run's verdicts)."""
+    import csv
+
+    registry = {}
+    out = {}
+    for name, spec in REPORT_FIGURES.items():
+        lines = [" ".join(spec["caption"].split()), ""]
+        for paper, ids in spec["claims"].items():
+            path = f"results/claims/registry/{paper}.csv"
+            if paper not in registry:
+                with_rows = os.path.exists(path)
+                registry[paper] = {r["id"]: r for r in csv.DictReader(open(path, newline=""))} if with_rows else None
+            rows = registry[paper]
+            if rows is None:
+                lines += [f"Verdicts ({paper}): not made by this run ({path} comes from the claims rule).", ""]
+                continue
+            lines += [f"Verdicts ({paper}, {path}):", ""]
+            for cid in ids:
+                r = rows.get(cid)
+                what = f"{_rst(r['verdict'])}: {_rst(r['claim'], 160) or 'project check'}" if r else "not in the registry"
+                lines.append(f"- ``{cid}``: {what}")
+            lines.append("")
+        out[name] = "\n".join(lines)
+    return out
+
+
+config["report_captions"] = report_captions()
 
 
 # the claims (claims.smk)

@@ -29,7 +29,7 @@ rule compare_figure_tanks:
         table="results/compare/runs.csv",
         code=code("figures.methods"),
     output:
-        report_figure("methods_tanks", "methods_figure", "Methods compared", "Every method on every tank"),
+        figure("methods_tanks"),
     params:
         func="figures.methods.tanks_figure",
         kw={"tanks": config["compare"]["tanks"]},
@@ -50,7 +50,7 @@ rule compare_figure_runtime:
         table="results/compare/runs.csv",
         code=code("figures.methods"),
     output:
-        report_figure("methods_error_vs_runtime", "methods_figure", "Methods compared", "Error against run time"),
+        figure("methods_error_vs_runtime"),
     params:
         func="figures.methods.error_vs_runtime_figure",
     message:

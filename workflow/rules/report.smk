@@ -68,3 +68,28 @@ rule timing_report:
 
 
 register(targets=["docs/replication.md", "docs/timing.md"], report=["results/report/90_inferred.md"])
+
+
+# The report's copy of a figure, with its own caption (workflow/report/figures.yaml, the verdicts of the claims
+# it bears on from this run's claims registry), category and subcategory.  Only a run of this checkout makes
+# it, so a report never shows a committed figure the run did not make.
+rule report_figure_copy:
+    input:
+        "figures/{name}.png",
+    output:
+        report("results/report/figures/{name}.png", caption="../report/figure.rst",
+               category=lambda wc: REPORT_FIGURES[wc.name]["category"],
+               subcategory=lambda wc: REPORT_FIGURES[wc.name]["subcategory"]),
+    message:
+        JOB
+    localrule: True
+    resources:
+        **SMALL,
+    log:
+        "logs/report/figures/{name}.log",
+    wildcard_constraints:
+        name="|".join(REPORT_FIGURES),
+    conda:
+        "../envs/isaflow.yaml"
+    shell:
+        "cp {input} {output} 2> {log}"

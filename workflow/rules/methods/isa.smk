@@ -92,7 +92,7 @@ rule isa_fig_inputs:
         inputs=lambda wc: [isa_file(FIGS[wc.name])],
         code=code("methods.isa.figures.single"),
     output:
-        report_figure("{name}", "paper_figure", "Paper figures", "Single vessel"),
+        figure("{name}"),
     params:
         func="methods.isa.figures.single.inputs_figure",
         kw=lambda wc: {"inferred": ISA.get("inferred", {}).get(wc.name)},
@@ -115,7 +115,7 @@ rule isa_fig_single:
         inputs=lambda wc: [isa_file(FIGS[wc.name])],
         code=code("methods.isa.figures.single"),
     output:
-        report_figure("{name}", "paper_figure", "Paper figures", "Single vessel"),
+        figure("{name}"),
     params:
         func="methods.isa.figures.single.single_vessel_figure",
         kw=lambda wc: {"paper_level": ISA["paper"][FIGS[wc.name].removesuffix("_capped")]["level"],
@@ -139,7 +139,7 @@ rule isa_fig_calibration:
         inputs=CAL_FILES,
         code=code("methods.isa.figures.single"),
     output:
-        report_figure("calibration_free_surface", "study_figure", "Studies", "ISA calibration"),
+        figure("calibration_free_surface"),
     params:
         func="methods.isa.figures.single.calibration_figure",
         kw={"paper_levels": {k: v["level"] for k, v in ISA["paper"].items()}, "adopted": ISA["calibration"]["adopted"]},
@@ -160,7 +160,7 @@ rule isa_fig_convergence:
         inputs=[isa_file(r) for r in ["single_coarse", "single_coarse_capped", "single_refined", "single_refined_capped"]],
         code=code("methods.isa.figures.single"),
     output:
-        report_figure("convergence_single", "study_figure", "Studies", "ISA convergence"),
+        figure("convergence_single"),
     params:
         func="methods.isa.figures.single.convergence_figure",
     message:
@@ -180,7 +180,7 @@ rule isa_fig_flow:
         inputs=lambda wc: [isa_file(FIGS[wc.name])],
         code=code("methods.isa.figures.flow"),
     output:
-        report_figure("{name}", "paper_figure", "Paper figures", "Flow"),
+        figure("{name}"),
     params:
         func=lambda wc: {
             "fig09_flow_incomplete": "methods.isa.figures.flow.flow_incomplete_figure",
@@ -210,7 +210,7 @@ rule isa_fig_overdamped:
         inputs=[isa_file(r) for r in OD_RUNS],
         code=code("methods.isa.figures.damping"),
     output:
-        report_figure("isa_overdamped", "study_figure", "Studies", "ISA against overdamped dynamics"),
+        figure("isa_overdamped"),
     params:
         func="methods.isa.figures.damping.overdamped_figure",
         kw={**_OD, "inferred": ISA.get("inferred", {}).get("isa_overdamped")},
@@ -231,7 +231,7 @@ rule isa_fig_flow_history:
         inputs=sorted({isa_file(r) for chain in FLOW["chains"].values() for r in chain}),
         code=code("methods.isa.figures.flow"),
     output:
-        report_figure("flow_history", "study_figure", "Studies", "ISA flow"),
+        figure("flow_history"),
     params:
         func="methods.isa.figures.flow.flow_history_figure",
         kw={"chains": FLOW["chains"]},
@@ -362,7 +362,7 @@ rule isa_fig_error_vs_runtime:
         inputs=["results/isa/study/error_vs_runtime.csv"],
         code=code("methods.isa.figures.study"),
     output:
-        report_figure("error_vs_runtime", "study_figure", "Studies", "ISA error against run time"),
+        figure("error_vs_runtime"),
     params:
         func="methods.isa.figures.study.error_vs_runtime_figure",
     message:
@@ -382,7 +382,7 @@ rule isa_fig_stability_map:
         inputs=["results/isa/study/stability_map.csv", "results/isa/study/stability_cases.csv"],
         code=code("methods.isa.figures.study"),
     output:
-        report_figure("stability_map", "study_figure", "Studies", "ISA stability"),
+        figure("stability_map"),
     params:
         func="methods.isa.figures.study.stability_map_figure",
     message:
@@ -577,15 +577,18 @@ PAPER_TARGETS = [f for name in ("fig05_inputs_coarse", "fig06_single_coarse", "f
 
 rule paper:
     input:
-        PAPER_TARGETS,
+        PAPER_TARGETS + report_copies(PAPER_TARGETS),
+
+
+INTEGRATION_TARGETS = [f for name in ("fig05_inputs_coarse", "fig06_single_coarse", "fig09_flow_incomplete",
+                                      "fig10_flow_complete") for f in figure(name)]
 
 
 # the smallest target set CI runs (.tests/integration/config.yaml): the paper's coarse Figures 5, 6, 9 and 10
 # from their three coarse runs (7 jobs)
 rule integration:
     input:
-        [f for name in ("fig05_inputs_coarse", "fig06_single_coarse", "fig09_flow_incomplete", "fig10_flow_complete")
-         for f in figure(name)],
+        INTEGRATION_TARGETS + report_copies(INTEGRATION_TARGETS),
 
 
 register(targets=PAPER_TARGETS + figure("calibration_free_surface") + figure("convergence_single")

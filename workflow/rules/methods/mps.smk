@@ -35,7 +35,7 @@ rule mps_figure_loads:
         runs=MPS_SINGLE,
         code=code("methods.mps.figures"),
     output:
-        report_figure("mps_wall_loads", "mps_figure", "Methods compared", "MPS"),
+        figure("mps_wall_loads"),
     params:
         func="methods.mps.figures.wall_loads",
     message:
@@ -55,7 +55,7 @@ rule mps_figure_rest:
         runs=MPS_SINGLE,
         code=code("methods.mps.figures"),
     output:
-        report_figure("mps_rest", "mps_figure", "Methods compared", "MPS"),
+        figure("mps_rest"),
     params:
         func="methods.mps.figures.rest",
     message:
@@ -75,7 +75,7 @@ rule mps_figure_flow:
         runs=MPS_FLOW_FINEST,
         code=code("methods.mps.figures"),
     output:
-        report_figure("mps_flow", "mps_figure", "Methods compared", "MPS"),
+        figure("mps_flow"),
     params:
         func="methods.mps.figures.flow",
     message:

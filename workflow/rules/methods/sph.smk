@@ -9,8 +9,7 @@ _SPH_BLOCKS = [r for r, d in _SPH_RUNS.items()
 SPH_FILES = [run_file("sph", r) for r in _SPH_RUNS if r not in _SPH_BLOCKS]
 SPH_SINGLE = [run_file("sph", r) for r, d in _SPH_RUNS.items() if r.startswith("single_wcsph_") and d["variant"] == "wcsph"]
 SPH_FLOW = [run_file("sph", r) for r, d in _SPH_RUNS.items() if d["tank"] != "single" and d.get("start")]
-SPH_REPORT_FIGURES = [f for name in ("sph_single", "sph_flow", "sph_flow_snapshots")
-                      for f in report_figure(name, "sph_figure", "Methods compared", "WCSPH")]
+SPH_FIGURES = [f for name in ("sph_single", "sph_flow", "sph_flow_snapshots") for f in figure(name)]
 
 
 rule sph_summary:
@@ -39,7 +38,7 @@ rule sph_figures:
         flow_runs=SPH_FLOW,
         code=code("methods.sph.figures"),
     output:
-        SPH_REPORT_FIGURES,
+        SPH_FIGURES,
     params:
         func="methods.sph.figures.all_figures",
     message:
@@ -96,6 +95,5 @@ rule sph_bench:
         "PYTHONPATH={params.src} python {input.script} > {log} 2>&1"
 
 
-register(SPH_FILES + ["results/sph/summary.csv", "benchmarks/results/sph_step_cost.csv"] + [f for n in ("sph_single", "sph_flow", "sph_flow_snapshots")
-                                                    for f in figure(n)],
+register(SPH_FILES + ["results/sph/summary.csv", "benchmarks/results/sph_step_cost.csv"] + SPH_FIGURES,
          ["results/report/50_sph.md"], timing=["results/timing/50_sph.md"])

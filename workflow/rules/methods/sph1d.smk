@@ -7,8 +7,6 @@ SPH1D_SETTINGS = "config/methods/sph1d.yaml"
 SPH1D_CODE = code("methods/sph1d/*", "core/smoothing", "runfile")
 SPH1D_REGISTRY = "config/claims/merino_alonso2020.yaml"  # the classification rule's numbers
 SPH1D_FIGURES = [f for name in ("error_vs_n", "maps", "variants") for f in figure(f"sph1d_{name}")]
-SPH1D_REPORT_FIGURES = [f for name in ("error_vs_n", "maps", "variants")
-                        for f in report_figure(f"sph1d_{name}", "sph1d_figure", "Methods compared")]
 
 register(SPH1D_FIGURES + ["results/sph1d/summary.csv"], ["results/report/60_sph1d.md"],
          timing=["results/timing/60_sph1d.md"])
@@ -85,7 +83,7 @@ rule sph1d_figures:
         cases_csv="results/sph1d/cases.csv",
         code=SPH1D_CODE + code("figures/style"),
     output:
-        SPH1D_REPORT_FIGURES,
+        SPH1D_FIGURES,
     params:
         func="methods.sph1d.pipeline.make_figures",
     conda:
