@@ -31,7 +31,7 @@ def tanks_figure(table, outputs, tanks=()):
     df = df[df["compare"].astype(bool)]
     tanks = [t for t in tanks if t in set(df["tank"])] + [t for t in dict.fromkeys(df["tank"]) if t not in tanks]
     fig, axes = plt.subplots(3, len(tanks), figsize=(6.2 * len(tanks), 12.5), squeeze=False,
-                             gridspec_kw={"hspace": 0.08})
+                             gridspec_kw={"hspace": 0.08, "wspace": 0.32})
     handles = {}
     for col, tank in enumerate(tanks):
         g = df[df["tank"] == tank].reset_index(drop=True)

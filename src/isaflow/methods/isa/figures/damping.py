@@ -75,6 +75,7 @@ def overdamped_figure(inputs, outputs, isa_chain=("flow_incomplete", "flow_compl
                  label=f"rest: e < {float(so.attrs['rest_energy_ratio']):g} (config/rest.yaml)")
     ax_e.axhline(float(so.attrs["f_tol"]), color="k", ls=":", lw=1, label=f"f_tol = {float(so.attrs['f_tol']):g} N")
     ax_e.set_xlabel("t (s)")
+    ax_e.set_ylabel("e = KE / (W h) (1); max|F| (N)")
     ax_e.set_title(f"(c) single vessel, overdamped (zeta {float(so.attrs['zeta']):g}, dt = "
                    f"{float(so.attrs['dt']):.3g} s): {so.attrs['status']} at t = {float(so['sim_time']):.3g} s")
     ax_e.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2, fontsize=8, frameon=False)

@@ -155,8 +155,9 @@ def stability_map_figure(inputs, outputs):
     table.auto_set_font_size(False)
     table.set_fontsize(6.5)
     table.scale(1, 1.5)
-    for c in range(len(heads)):  # room for the two-line headers
-        table[0, c].set_height(2 * table[1, 0].get_height())
+    lines = max(h.count("\n") + 1 for h in heads)
+    for c in range(len(heads)):  # room for the longest wrapped header
+        table[0, c].set_height(lines * table[1, 0].get_height())
     ax.set_title("Extreme cases (figures/stability_cases.csv): outcome and steps per update rule", fontsize=9)
     fig.suptitle("Numerical stability of the single vessel: outcome classes of every run (status in its run file)")
     save(fig, outputs)
