@@ -188,7 +188,8 @@ def test_reduced_study_builds_both_figures_and_the_report_fragment(tmp_path):
     (tmp_path / "src").symlink_to(ROOT / "src")  # rules depend on the package sources
     shutil.copy(CI_CONFIG, tmp_path / "config" / "methods" / "isa_study.yaml")
     env = {**os.environ, "PATH": f"{Path(sys.executable).parent}{os.pathsep}{os.environ['PATH']}"}
-    targets = ["figures/error_vs_runtime.png", "figures/stability_map.png", "results/report/30_study.md"]
+    targets = ["figures/error_vs_runtime.png", "figures/stability_map.png", "results/report/30_study.md",
+               "results/report/figures/error_vs_runtime.png", "results/report/figures/stability_map.png"]
     proc = subprocess.run([sys.executable, "-m", "snakemake", "-c2", *targets], cwd=tmp_path, env=env,
                           capture_output=True, text=True, timeout=400)
     assert proc.returncode == 0, proc.stdout[-3000:] + proc.stderr[-3000:]
@@ -211,11 +212,12 @@ def test_reduced_study_builds_both_figures_and_the_report_fragment(tmp_path):
     ratio = pd.read_csv(tmp_path / "results" / "isa" / "study" / "fire_ratio.csv").iloc[0]
     assert ratio["ratio_vs_capped"] > 1 and ratio["ratio_vs_paper_reported"] > 1
     # the Snakemake report of those targets holds both figures with their captions
-    rep = subprocess.run([sys.executable, "-m", "snakemake", "--report", "report.html", *targets[:2]], cwd=tmp_path,
+    rep = subprocess.run([sys.executable, "-m", "snakemake", "--report", "report.html", *targets[3:]], cwd=tmp_path,
                          env=env, capture_output=True, text=True, timeout=300)
     assert rep.returncode == 0, rep.stdout[-2000:] + rep.stderr[-2000:]
     html = (tmp_path / "report.html").read_text()
     assert "error_vs_runtime.png" in html and "stability_map.png" in html and "Studies" in html
+    assert "ISA stability" in html and "Outcome of each ISA update rule" in html  # its own subcategory and caption
     text = (tmp_path / "results" / "report" / "30_study.md").read_text()
     assert "## Error against work, and numerical stability" in text and "Which configuration to pick" in text
     assert " s)" not in text and "wall_time" not in text  # no timing in the report text
