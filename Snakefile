@@ -1,6 +1,6 @@
 # Replication of Papadopoulos, Koutitas & Lazaridis (2016) and its neighbours.
 #   snakemake -c2                                   everything
-#   snakemake -c2 paper                             the paper's own outputs (Figures 5-10, Table 1, claims)
+#   snakemake -c2 paper                             the paper's own outputs (Figures 5-10, Table 1; the claims need the full run)
 #   snakemake -c1 figures/fig06_single_coarse.png   one figure and only what it needs
 # Parses with only Snakemake installed: the project's source is read from src/ (workflow/rules/common.smk).
 import glob
