@@ -33,7 +33,10 @@ def command(tmp_path, out):
 
 def start_run(tmp_path, out, pause="60"):
     env = {**os.environ, runfile.PAUSE_HOOK: pause}
-    proc = subprocess.Popen(command(tmp_path, out), stderr=subprocess.PIPE, text=True, cwd=ROOT, env=env)
+    # SIGINT at its default disposition in the child: a shell's background job (e.g. CI started with '&')
+    # inherits it ignored, and Python then installs no KeyboardInterrupt handler
+    proc = subprocess.Popen(command(tmp_path, out), stderr=subprocess.PIPE, text=True, cwd=ROOT, env=env,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     lines = queue.Queue()
     threading.Thread(target=lambda: [lines.put(x) for x in proc.stderr], daemon=True).start()
     while True:
