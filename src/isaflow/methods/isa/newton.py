@@ -215,6 +215,21 @@ def hess_vec(diag, blk, pi, pj, m, mu, x, y):
         y[j, 1] -= b01 * x[i, 0] + b11 * x[i, 1]
 
 
+@njit(inline="always", **JIT)
+def _precondition(diag, mu, r, z):
+    """z = the 2x2 block-Jacobi preconditioner of H + mu I applied to r (N, 2); returns r . z."""
+    rz = 0.0
+    for i in range(r.shape[0]):
+        a = diag[i, 0] + mu
+        c = diag[i, 1]
+        d = diag[i, 2] + mu
+        det = a * d - c * c
+        z[i, 0] = (d * r[i, 0] - c * r[i, 1]) / det
+        z[i, 1] = (a * r[i, 1] - c * r[i, 0]) / det
+        rz += r[i, 0] * z[i, 0] + r[i, 1] * z[i, 1]
+    return rz
+
+
 @njit(**JIT)
 def pcg(diag, blk, pi, pj, m, mu, b, x, tol, max_iter, r, z, p, q):
     """Solve (H + mu I) x = b (N, 2) by conjugate gradients with the 2x2 block-Jacobi preconditioner.
@@ -232,15 +247,7 @@ def pcg(diag, blk, pi, pj, m, mu, b, x, tol, max_iter, r, z, p, q):
             return 0, False
     x[:, :] = 0.0
     r[:, :] = b
-    rz = 0.0
-    for i in range(n):
-        a = diag[i, 0] + mu
-        c = diag[i, 1]
-        d = diag[i, 2] + mu
-        det = a * d - c * c
-        z[i, 0] = (d * r[i, 0] - c * r[i, 1]) / det
-        z[i, 1] = (a * r[i, 1] - c * r[i, 0]) / det
-        rz += r[i, 0] * z[i, 0] + r[i, 1] * z[i, 1]
+    rz = _precondition(diag, mu, r, z)
     p[:, :] = z
     rmax = np.abs(r).max() if n else 0.0
     it = 0
@@ -259,15 +266,7 @@ def pcg(diag, blk, pi, pj, m, mu, b, x, tol, max_iter, r, z, p, q):
             r[i, 0] -= alpha * q[i, 0]
             r[i, 1] -= alpha * q[i, 1]
             rmax = max(rmax, abs(r[i, 0]), abs(r[i, 1]))
-        rz_new = 0.0
-        for i in range(n):
-            a = diag[i, 0] + mu
-            c = diag[i, 1]
-            d = diag[i, 2] + mu
-            det = a * d - c * c
-            z[i, 0] = (d * r[i, 0] - c * r[i, 1]) / det
-            z[i, 1] = (a * r[i, 1] - c * r[i, 0]) / det
-            rz_new += r[i, 0] * z[i, 0] + r[i, 1] * z[i, 1]
+        rz_new = _precondition(diag, mu, r, z)
         beta = rz_new / rz
         rz = rz_new
         for i in range(n):
