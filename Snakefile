@@ -29,7 +29,7 @@ for _rules in sorted(glob.glob("workflow/rules/methods/*.smk")):
 
 rule all:
     input:
-        lambda wc: TARGETS["targets"] + report_copies(TARGETS["targets"]),
+        lambda wc: with_report_copies(TARGETS["targets"]),
     default_target: True
 
 

@@ -2,6 +2,8 @@
 # Snakemake installed), every configuration file read through the project's hardened reader and
 # checked against its schema before any job starts, the method registry, register(), the run
 # declarations of every tank method, and the source files each rule depends on.
+import csv
+import functools
 import glob
 import os
 import sys
@@ -167,10 +169,10 @@ def report_file(path, caption, category, subcategory=None):
 REPORT_FIGURES = read_config("workflow/report/figures.yaml", "report_figures.schema.yaml")
 
 
-def report_copies(paths):
-    """results/report/figures/<name>.png of every figures/<name>.png in paths that has a caption."""
+def with_report_copies(paths):
+    """paths, then results/report/figures/<name>.png of every figures/<name>.png among them that has a caption."""
     names = [os.path.basename(p)[:-4] for p in paths if p.startswith("figures/") and p.endswith(".png")]
-    return [f"results/report/figures/{n}.png" for n in names if n in REPORT_FIGURES]
+    return list(paths) + [f"results/report/figures/{n}.png" for n in names if n in REPORT_FIGURES]
 
 
 def _rst(text, limit=None):
@@ -181,22 +183,25 @@ def _rst(text, limit=None):
     return "".join(f"\\{c}" if c in "\\`*_|[]<>:" else c for c in text)
 
 
+@functools.cache
+def _judged_claims(path):
+    """{claim id: row} of a claims registry CSV, None if this checkout's run has not made it."""
+    if not os.path.exists(path):
+        return None
+    with open(path, newline="") as f:
+        return {r["id"]: r for r in csv.DictReader(f)}
+
+
 def report_captions():
     """{figure: caption (reStructuredText)}: its text in figures.yaml, then the verdict of every claim it names,
     read from the claims registry this checkout's run made (results/claims/registry/<paper>.csv; read while
     the workflow is parsed, so `snakemake --report` after the run shows the run's verdicts)."""
-    import csv
-
-    registry = {}
     out = {}
     for name, spec in REPORT_FIGURES.items():
         lines = [" ".join(spec["caption"].split()), ""]
         for paper, ids in spec["claims"].items():
             path = f"results/claims/registry/{paper}.csv"
-            if paper not in registry:
-                with_rows = os.path.exists(path)
-                registry[paper] = {r["id"]: r for r in csv.DictReader(open(path, newline=""))} if with_rows else None
-            rows = registry[paper]
+            rows = _judged_claims(path)
             if rows is None:
                 lines += [f"Verdicts ({paper}): not made by this run ({path} comes from the claims rule).", ""]
                 continue

@@ -577,7 +577,7 @@ PAPER_TARGETS = [f for name in ("fig05_inputs_coarse", "fig06_single_coarse", "f
 
 rule paper:
     input:
-        PAPER_TARGETS + report_copies(PAPER_TARGETS),
+        with_report_copies(PAPER_TARGETS),
 
 
 INTEGRATION_TARGETS = [f for name in ("fig05_inputs_coarse", "fig06_single_coarse", "fig09_flow_incomplete",
@@ -588,7 +588,7 @@ INTEGRATION_TARGETS = [f for name in ("fig05_inputs_coarse", "fig06_single_coars
 # from their three coarse runs (7 jobs)
 rule integration:
     input:
-        INTEGRATION_TARGETS + report_copies(INTEGRATION_TARGETS),
+        with_report_copies(INTEGRATION_TARGETS),
 
 
 register(targets=PAPER_TARGETS + figure("calibration_free_surface") + figure("convergence_single")
