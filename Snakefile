@@ -14,7 +14,6 @@ report: "workflow/report/workflow.rst"
 
 
 include: "workflow/rules/common.smk"
-include: "workflow/rules/runs.smk"
 include: "workflow/rules/compare.smk"
 include: "workflow/rules/report.smk"
 include: "workflow/rules/claims.smk"
@@ -27,6 +26,10 @@ for _rules in sorted(glob.glob("workflow/rules/methods/*.smk")):
     include: _rules
 
 
+# the rules of every declared run (after the methods declared them)
+include: "workflow/rules/runs.smk"
+
+
 rule all:
     input:
         lambda wc: with_report_copies(TARGETS["targets"]),
@@ -35,3 +38,9 @@ rule all:
 
 # every tank, settings file and declared run checked before any job starts (common.smk)
 check_inputs()
+
+
+# where the run's time went, from this process's start (isaflow.timing): printed, written to
+# results/timing/workflow_run.md and appended to docs/timing.md when this run made it
+onsuccess:
+    workflow_timing(workflow.cores)

@@ -19,7 +19,7 @@ NAMES = ({m for m in methods.PACKAGES} | {v for m in methods.registry().values()
 LAYERS = [  # a module may import its own layer and the ones above it in this list, never one below
     ("core",),
     ("inputs", "settings", "tank", "contract", "rest", "deps", "theory", "methods"),  # 'methods': the registry
-    ("metrics", "runfile", "tables", "run", "cli", "figures", "report"),
+    ("metrics", "runfile", "tables", "run", "cli", "figures", "report", "timing"),
     ("methods.",),  # a method package
 ]
 
@@ -80,7 +80,8 @@ with SnakemakeApi() as api:
     rules = {}
     for r in wf._workflow.rules:
         func = getattr(r.params, 'func', None) if hasattr(r, 'params') else None
-        code = [str(f) for f in r.input.get('code', [])] if 'code' in r.input.keys() else None
+        code = r.input.get('code') if 'code' in r.input.keys() else None
+        code = [str(f) for f in code] if isinstance(code, list) else None  # a function: a run rule's closure
         if isinstance(func, str) and code is not None:
             rules[r.name] = dict(func=func, code=code)
     print(json.dumps(rules))

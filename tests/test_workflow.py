@@ -35,7 +35,45 @@ def test_full_dry_run_has_every_paper_figure_and_the_report():
 
 def test_one_figure_builds_only_what_it_needs():
     counts = jobs(dry_run("figures/fig06_single_coarse.png"))
-    assert counts == {"isa_fig_single": 1, "run": 1}
+    assert counts == {"isa_fig_single": 1, "run": 1, "compile": 1}
+
+
+def test_the_paper_target_builds_figures_5_to_10_and_table_1_from_their_own_runs_only():
+    """No sweep, calibration or report section: the runs of Figures 5-10 and Table 1's chain."""
+    counts = jobs(dry_run("paper"))
+    assert not [r for r in counts if r.startswith("block_")]
+    runs = {Path(f).stem for f, rule in summary("paper").items() if rule == "run"}
+    assert runs == {"single_coarse", "single_refined", "flow_incomplete", "flow_complete"} | table1_runs()
+    assert counts["run"] == len(runs)
+
+
+def summary(*targets):
+    """{output file: rule} of every job the targets need (snakemake --summary)."""
+    proc = subprocess.run([*SNAKEMAKE, "--summary", "-c1", "--forceall", "--workflow-profile", "none", *targets],
+                          cwd=ROOT, capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    rows = [line.split("\t") for line in proc.stdout.splitlines()]
+    return {r[0]: r[2] for r in rows if len(r) > 2 and r[0] != "output_file"}
+
+
+def table1_runs():
+    from isaflow import inputs
+
+    _, schema = inputs.read_yaml(ROOT / "workflow" / "schemas" / "isa_workflow.schema.yaml", "schema")
+    table = inputs.load(ROOT / "config" / "methods" / "isa_workflow.yaml", schema, "isa workflow")[1]["table1"]
+    return {run for row in table for run in row["chain"]}
+
+
+def test_sweeps_run_as_blocks_and_every_run_is_made_by_one_rule():
+    """Every run file comes from one job: a block's (its sweep in one process) or its own; the full workflow
+    plans far fewer jobs than runs."""
+    made = summary()
+    runs = {f: rule for f, rule in made.items() if f.startswith("results/runs/")}
+    blocks = {rule for rule in runs.values() if rule.startswith("block_")}
+    assert len(runs) >= 300 and len(blocks) >= 10
+    counts = jobs(dry_run())
+    assert all(counts[b] == 1 for b in blocks)
+    assert counts["run"] + len(blocks) < len(runs) / 2
 
 
 def test_every_rule_has_a_log_and_solver_rules_a_benchmark():

@@ -144,13 +144,23 @@ def _progress(run_id, log, beat=None):
     return progress
 
 
+def compile_method(method, threads=None):
+    """Bind this process to method's kernel generation (core.jit.use), compiling and sealing it first if no
+    process has, then load (or compile) every kernel its runs time: the warm-up excluded from solver times."""
+    from .core import jit
+
+    entry = methods.get(method).entry_module()
+    jit.use(method, fill=lambda: entry.warm_up(threads))
+    entry.warm_up(threads)
+
+
 def solve(p, log=None):
     """(Result, started, finished) of a prepared run; compiled code is warmed first (not timed).  A line at
     least every HEARTBEAT s while it works (_Heartbeat)."""
     log = log or (lambda msg: print(msg, file=sys.stderr, flush=True))
     with _Heartbeat(p.run_id, log) as beat:
         beat.phase = "warming up compiled code"
-        p.entry.warm_up(p.threads)
+        compile_method(p.method, p.threads)
         beat.phase = "solving"
         started = runfile.now()
         result = p.entry.solve(p.tank, p.settings, p.variant, p.resolution, p.start,
@@ -179,27 +189,35 @@ def run(method, tank, variant, resolution, out, settings_path=None, overrides=()
         accept=("converged",), threads=None, run_id=None, log=None, command=None, label="", stability=False,
         max_hours=None):
     """Check, solve and write one run; returns the exit code (module docstring); errors as one line on stderr."""
+    return run_with_result(method, tank, variant, resolution, out, settings_path, overrides, start, accept, threads,
+                           run_id, log, command, label, stability, max_hours)[0]
+
+
+def run_with_result(method, tank, variant, resolution, out, settings_path=None, overrides=(), start=None,
+                    accept=("converged",), threads=None, run_id=None, log=None, command=None, label="",
+                    stability=False, max_hours=None):
+    """run(), returning (exit code, the solve's Result or None if refused before solving)."""
     log = log or (lambda msg: print(msg, file=sys.stderr, flush=True))
     try:
         p = prepare(method, tank, variant, resolution, out, settings_path, overrides, start, accept, threads, run_id,
                     label, stability, max_hours)
     except (InputError, runfile.RunFileError) as err:
         log(f"error: {err}")
-        return 2
+        return 2, None
     except OSError as err:
         log(f"error: {getattr(err, 'filename', None) or tank}: {err.strerror or err}")
-        return 2
+        return 2, None
     result, started, finished = solve(p, log)
     log(f"{p.run_id}: finished: {result.status}: {result.message} ({result.wall_time:.3f} s solver, "
         f"{result.params.get('threads', p.threads or 1)} thread(s))")
     if result.status not in p.accept:
         log(f"error: {p.run_id}: outcome '{result.status}' is not accepted ({', '.join(p.accept)}); no output written")
-        return 1
+        return 1, result
     try:
         write(p, result, started, finished, command)
         log(f"{p.run_id}: wrote {out}")
     except (OSError, runfile.RunFileError) as err:
         log(f"error: {out}: the run finished but its file could not be written: "
             f"{getattr(err, 'strerror', None) or err}")
-        return 3
-    return 0
+        return 3, result
+    return 0, result

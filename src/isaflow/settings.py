@@ -81,6 +81,7 @@ RUN_SCHEMA = {
         "note": {"type": "string", "maxLength": 2000},
         "stability": {"type": "boolean"},  # a stability case: literature ranges not enforced, may fail
         "max_hours": {"type": "number", "exclusiveMinimum": 0},  # its own CPU-hour budget (a long run)
+        "block": NAME,  # runs of one method sharing a block run in one job, one process (short sweep points)
     },
 }
 

@@ -6,13 +6,16 @@ import csv
 import functools
 import glob
 import os
+import re
 import sys
+import time
 
 sys.path.insert(0, os.path.join(workflow.basedir, "src"))
 
 from isaflow import deps as _deps  # noqa: E402
 from isaflow import inputs as _inputs  # noqa: E402
 from isaflow import methods as _methods  # noqa: E402
+from isaflow import timing as _timing  # noqa: E402
 
 
 def refuse(message):
@@ -40,9 +43,11 @@ JOB = "{rule}: {output[0]}"
 RUN_RESOURCES = {}  # {(method, run id): {'mem_mb', 'runtime'}}, filled by check_inputs() from the estimates
 
 
-def run_resources(wc):
-    """mem_mb and runtime of a tank run from its cost estimate (isaflow.budget.job_resources)."""
-    return RUN_RESOURCES[wc.method, wc.run]
+def run_resources(members):
+    """mem_mb and runtime of a job running members [(method, run id)] one after another, from their cost
+    estimates (isaflow.budget.job_resources): the largest memory, the sum of the times."""
+    res = [RUN_RESOURCES[m] for m in members]
+    return {"mem_mb": max(r["mem_mb"] for r in res), "runtime": sum(r["runtime"] for r in res)}
 
 
 def read_config(path, schema):
@@ -119,15 +124,60 @@ def run_file(method, run):
     return f"results/runs/{method}/{run}.nc"
 
 
-def run_inputs(wc):
-    """Inputs of every tank run (runs.smk) - tank, settings, start file (a run of the same method), code."""
-    decl = RUNS[wc.method][wc.run]
-    m = REGISTRY[wc.method]
-    out = {"tank": f"config/tanks/{decl['tank']}.yaml", "settings": m.settings,
-           "code": code("isaflow.run", m.entry) + ["workflow/scripts/run.py"]}
+def run_job(method, run):
+    """(method, run id, declaration + the paths isaflow.run reads: tank_file, settings_file, start_file)."""
+    decl = dict(RUNS[method][run], tank_file=f"config/tanks/{RUNS[method][run]['tank']}.yaml",
+                settings_file=REGISTRY[method].settings)
     if decl.get("start"):
-        out["start"] = run_file(wc.method, decl["start"])
-    return out
+        decl["start_file"] = run_file(method, decl["start"])
+    return method, run, decl
+
+
+def runs_inputs(members):
+    """Inputs of a job running members [(method, run id)]: tanks, settings, start files made by other jobs,
+    the code, and each method's compiled kernels (the compile rule's stamp; ancient: a later compile reruns
+    nothing)."""
+    inside = set(members)
+    out = {"tank": [], "settings": [], "start": [], "compiled": [],
+           "code": code("isaflow.run", "isaflow.timing") + ["workflow/scripts/run.py"]}
+    for method, run in members:
+        decl = RUNS[method][run]
+        out["tank"].append(f"config/tanks/{decl['tank']}.yaml")
+        out["settings"].append(REGISTRY[method].settings)
+        out["code"] += code(REGISTRY[method].entry)
+        out["compiled"].append(ancient(f"results/compiled/{method}.txt"))
+        if decl.get("start") and (method, decl["start"]) not in inside:
+            out["start"].append(run_file(method, decl["start"]))
+    return {k: sorted(set(v), key=str) for k, v in out.items()}
+
+
+def run_blocks():
+    """{block id '<method>_<block>': [(method, run id)]} of every declared run with a `block`, each run after the
+    run it continues; a block may not be both a run id's block and another method's unblocked run id."""
+    blocks = {}
+    for method in TANK_METHODS:
+        for run, decl in RUNS[method].items():
+            if decl.get("block"):
+                blocks.setdefault(f"{method}_{decl['block']}", []).append((method, run))
+    for bid, members in blocks.items():
+        done, order = set(), []
+        pending = list(members)
+        while pending:
+            ready = [mr for mr in pending
+                     if not RUNS[mr[0]][mr[1]].get("start") or (mr[0], RUNS[mr[0]][mr[1]]["start"]) not in pending]
+            if not ready:
+                refuse(f"{REGISTRY[pending[0][0]].settings}: field 'runs.{pending[0][1]}.start': the runs of block "
+                       f"'{bid}' continue each other in a circle")
+            order += ready
+            pending = [mr for mr in pending if mr not in ready]
+        blocks[bid] = order
+    unblocked = {run for m in TANK_METHODS for run, d in RUNS[m].items() if not d.get("block")}
+    for bid, members in blocks.items():
+        for method, run in members:
+            if run in unblocked:
+                refuse(f"{REGISTRY[method].settings}: field 'runs.{run}': in block '{bid}', and another method "
+                       f"declares a run '{run}' outside any block (run ids must tell the rules apart)")
+    return blocks
 
 
 def runtime_runs():
@@ -266,3 +316,19 @@ def check_inputs():
     except _inputs.InputError as err:
         refuse(err)
     RUN_RESOURCES.update({key: _budget.job_resources(cost) for key, cost in d.costs.items()})
+
+
+def workflow_timing(cores):
+    """Where this Snakemake run's time went (isaflow.timing), from this process's start to now."""
+    start, end = _timing.process_start(), time.time()
+    jobs = _timing.read(start)
+    if not jobs:
+        return
+    text = _timing.markdown(_timing.summary(jobs, start, end, cores))
+    print(text, file=sys.stderr)
+    os.makedirs("results/timing", exist_ok=True)
+    with open("results/timing/workflow_run.md", "w") as f:
+        f.write(text)
+    if os.path.exists("docs/timing.md") and os.path.getmtime("docs/timing.md") >= start:
+        with open("docs/timing.md", "a") as f:
+            f.write(f"\n{text}")

@@ -9,6 +9,9 @@ file that is no run file) ends the job with one line in the log and exit status 
 import importlib
 import os
 import sys
+import time
+
+_script_start = time.time()
 
 # BLAS/OpenMP threads = the rule's threads (1 unless it asks for more), set before numpy loads: a threaded
 # OpenBLAS sums in an order that varies from run to run, and two runs of the same commit must give
@@ -23,11 +26,13 @@ sys.path.insert(0, os.path.realpath(os.path.join(os.path.dirname(__file__), ".."
 # the command run files record: the rule and function, not Snakemake's temporary copy of this script
 sys.argv = ["snakemake", f"rule {snakemake.rule}:", f"isaflow.{snakemake.params.func}", "->", *snakemake.output]  # noqa: F821
 
+from isaflow import timing  # noqa: E402
 from isaflow.inputs import InputError  # noqa: E402
 from isaflow.runfile import RunFileError  # noqa: E402
 
 mod, name = snakemake.params.func.rsplit(".", 1)  # noqa: F821
 func = getattr(importlib.import_module(f"isaflow.{mod}"), name)
+_imported = time.time()
 inputs = {k: (v if isinstance(v, str) else list(v)) for k, v in snakemake.input.items() if k != "code"}  # noqa: F821
 try:
     func(**inputs, outputs=list(snakemake.output), **dict(snakemake.params.get("kw", {}) or {}))  # noqa: F821
@@ -35,3 +40,4 @@ except (InputError, RunFileError) as err:
     print(f"error: {err}", file=sys.stderr)
     sys.exit(2)
 print(f"{snakemake.params.func}: wrote {', '.join(snakemake.output)}", file=sys.stderr)  # noqa: F821
+timing.record(snakemake.rule, snakemake.output[0], _script_start, _imported)  # noqa: F821

@@ -1,10 +1,14 @@
-"""Snakemake script of the rule `run`: one tank run of any method through isaflow.run, its declaration
-passed as data (never through a shell line).  stderr (progress, the outcome, input errors as one line)
-goes to the rule's log; the exit status is isaflow.run's (0 written, 1 outcome not accepted, 2 bad input,
-3 the file could not be written)."""
+"""Snakemake script of the rules `run` (one tank run) and `block_*` (a block of short runs in one process):
+each run through isaflow.run, its declaration passed as data (never through a shell line), in the order
+given (a run continuing another of the block comes after it).  stderr (progress, outcomes, input errors as
+one line) goes to the rule's log.  Exit status: 0 if every run was written, else the largest of
+isaflow.run's codes (1 outcome not accepted, 2 bad input, 3 the file could not be written); every run of a
+block is tried.  The job's timing goes to logs/timing/jobs.jsonl (isaflow.timing)."""
 import os
 import sys
+import time
 
+_script_start = time.time()
 # BLAS/OpenMP/numba threads = the rule's threads, set before numpy loads (byte-identical outputs)
 for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
     os.environ[_var] = str(snakemake.threads)  # noqa: F821
@@ -14,14 +18,19 @@ sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 # the checked-out code without an (editable) install tied to one checkout
 sys.path.insert(0, os.path.realpath(os.path.join(os.path.dirname(__file__), "..", "..", "src")))
 
-from isaflow import run  # noqa: E402
+from isaflow import run, timing  # noqa: E402
 
-decl = snakemake.params.decl  # noqa: F821
-wc = snakemake.wildcards  # noqa: F821
-command = ["snakemake", f"rule run: {wc.method}/{wc.run}", "->", snakemake.output[0]]  # noqa: F821
-code = run.run(wc.method, snakemake.input.tank, decl["variant"], decl["resolution"], snakemake.output[0],  # noqa: F821
-               settings_path=snakemake.input.settings, overrides=decl.get("set", {}),  # noqa: F821
-               start=snakemake.input.get("start"), accept=decl.get("accept", ["converged"]),  # noqa: F821
-               threads=snakemake.threads, run_id=wc.run, command=command, label=decl.get("label", ""),  # noqa: F821
-               stability=decl.get("stability", False), max_hours=decl.get("max_hours"))
-sys.exit(code)
+_imported = time.time()
+codes, solve_s = [], 0.0
+for (method, run_id, decl), out in zip(snakemake.params.runs, snakemake.output):  # noqa: F821
+    command = ["snakemake", f"rule {snakemake.rule}: {method}/{run_id}", "->", out]  # noqa: F821
+    code, result = run.run_with_result(method, decl["tank_file"], decl["variant"], decl["resolution"], out,
+                           settings_path=decl["settings_file"], overrides=decl.get("set", {}),
+                           start=decl.get("start_file"), accept=decl.get("accept", ["converged"]),
+                           threads=snakemake.threads, run_id=run_id, command=command,  # noqa: F821
+                           label=decl.get("label", ""), stability=decl.get("stability", False),
+                           max_hours=decl.get("max_hours"))
+    codes.append(code)
+    solve_s += result.wall_time if result is not None else 0.0
+timing.record(snakemake.rule, snakemake.output[0], _script_start, _imported, solve_s, len(codes))  # noqa: F821
+sys.exit(max(codes))

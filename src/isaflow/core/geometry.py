@@ -5,7 +5,7 @@ liquid on its left.
 """
 
 import numpy as np
-from numba import njit
+from .jit import njit
 
 JIT = dict(cache=True, nogil=True)
 

@@ -7,7 +7,7 @@ stored by rows of a cell-sorted particle order (counting sort into the cells of
 """
 
 import numpy as np
-from numba import njit
+from .jit import njit
 
 JIT = dict(cache=True, nogil=True)
 

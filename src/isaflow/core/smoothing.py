@@ -19,7 +19,7 @@ the radial derivative dW/dr).  Python API: :func:`kernel_id`, :func:`W`,
 """
 
 import numpy as np
-from numba import njit
+from .jit import njit
 from numpy.polynomial import Polynomial as P
 
 JIT = dict(cache=True, nogil=True)

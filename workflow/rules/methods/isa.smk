@@ -566,13 +566,11 @@ rule isa_timing:
         "../../scripts/call.py"
 
 
-# the paper's own outputs: Figures 5-10, Table 1, the report's single-vessel and flow sections and the
-# paper's claims (quick start: snakemake -c2 paper)
+# the paper's own outputs, Figures 5-10 and Table 1, and only what they need (quick start: snakemake -c2
+# paper); the report's sections and the claims need the full run
 PAPER_TARGETS = [f for name in ("fig05_inputs_coarse", "fig06_single_coarse", "fig07_inputs_refined",
                                 "fig08_single_refined", "fig09_flow_incomplete", "fig10_flow_complete")
-                 for f in figure(name)] + ["results/isa/table1.csv", "results/isa/table1.md",
-                                           "results/report/10_single.md", "results/report/20_flow.md",
-                                           "results/report/findings.md"]
+                 for f in figure(name)] + ["results/isa/table1.csv", "results/isa/table1.md"]
 
 
 rule paper:
@@ -580,15 +578,17 @@ rule paper:
         with_report_copies(PAPER_TARGETS),
 
 
-INTEGRATION_TARGETS = [f for name in ("fig05_inputs_coarse", "fig06_single_coarse", "fig09_flow_incomplete",
-                                      "fig10_flow_complete") for f in figure(name)]
-
-
 # the smallest target set CI runs (.tests/integration/config.yaml): the paper's coarse Figures 5, 6, 9 and 10
-# from their three coarse runs (7 jobs)
+# from their three coarse runs, and a coarse single-vessel run of every other ISA update rule and of the first
+# compared SPH and MPS runs, in parallel from an empty kernel cache (each method compiled once, rule compile)
+INTEGRATION_TARGETS = [f for name in ("fig05_inputs_coarse", "fig06_single_coarse", "fig09_flow_incomplete",
+                                      "fig10_flow_complete") for f in figure(name)] + [
+    isa_file(f"single_coarse_{v}") for v in REGISTRY["isa"].variants if v != "paper"]
+
+
 rule integration:
     input:
-        with_report_copies(INTEGRATION_TARGETS),
+        lambda wc: with_report_copies(INTEGRATION_TARGETS + [first_run(m, "single") for m in TANK_METHODS if m != "isa"]),
 
 
 register(targets=PAPER_TARGETS + figure("calibration_free_surface") + figure("convergence_single")

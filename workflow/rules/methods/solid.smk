@@ -52,26 +52,28 @@ register(SOLID_RUNS + SOLID_NEW_RUNS + SOLID_CLAIM_RUNS + SOLID_FIGURES, ["resul
          timing=["results/timing/65_solid.md"])
 
 
-rule solid_run:
+# the bar, shear and Hertz cases (SOLID_RUNS, SOLID_CLAIM_RUNS) solve in seconds each: one job, one process
+SOLID_CASE_RUNS = SOLID_RUNS + SOLID_CLAIM_RUNS
+
+
+rule solid_cases:
     input:
         cfg=SOLID_CFG,
         code=SOLID_CODE,
     output:
-        "results/solid/{case}_{variant}.nc",
-    wildcard_constraints:
-        case="|".join(re.escape(c) for c in SOLID_CASES + SOLID_CLAIM_CASES),
-        variant="paper|hooke",
+        SOLID_CASE_RUNS,
     params:
-        func="methods.solid.outputs.run_case",
-        kw=lambda wc: dict(case=wc.case, variant=wc.variant),
+        func="methods.solid.outputs.run_cases",
+        kw={"cases": [os.path.basename(f)[:-3].rsplit("_", 1) for f in SOLID_CASE_RUNS]},
     conda:
         "../../envs/isaflow.yaml"
     message:
-        JOB
+        f"solid_cases: {len(SOLID_CASE_RUNS)} runs in one process"
     resources:
-        **SOLID,
+        mem_mb=SOLID["mem_mb"],
+        runtime=SOLID["runtime"] * 3,
     log:
-        "logs/solid/{case}_{variant}.log",
+        "logs/solid/cases.log",
     script:
         "../../scripts/call.py"
 

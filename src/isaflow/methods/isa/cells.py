@@ -10,7 +10,9 @@ Units: cm.
 """
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
+
+from ...core.jit import njit
 
 from ...core.neighbours import cell_grid, cell_of, cell_rows
 

@@ -24,7 +24,7 @@ test), so forces are evaluated exactly as for the other update rules.  Units: cm
 """
 
 import numpy as np
-from numba import njit
+from ...core.jit import njit
 
 from ...core.neighbours import cell_rows
 from .relax import (CONVERGED, CROSSED, NONFINITE, RUNNING, _evaluate, _first_crossing, _near_walls, _pair_scratch,
@@ -69,6 +69,7 @@ def overdamped_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u
     force_n = np.empty((n, 2))
     weight_c = np.empty(n)
     one = np.empty(1, np.int64)  # the serial pass's block scratch (relax._evaluate, _first_crossing with nb = 1)
+    serial = np.int64(1)  # one block, typed int64 as relax_resume passes it (a literal 1 compiles a second overload)
     one_b, one_w, one_bad, fmax_b, none = one.copy(), one.copy(), one.copy(), np.empty(1), np.empty(0)
     if not resume:
         pos_build[:, :] = pos
@@ -88,6 +89,7 @@ def overdamped_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u
     t = state[1]
     quiet = state[2]
     move = n < 0  # False, computed (relax_resume's one specialisation of _evaluate)
+    fire = move  # no FIRE sums: False, computed for the same reason
     ke = 0.0
     for i in range(n):  # caller order, as the sums below
         q = rank[i]
@@ -98,9 +100,9 @@ def overdamped_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u
     step_move = 0.0
     step = -1
     while True:  # evaluate at the new positions, then test and step
-        fmax, bad = _evaluate(1, one, pos_c, new_c, vel_c, dt, move, weight_c, walls, wall_l_u, wall_r_u, near_start,
+        fmax, bad = _evaluate(serial, one, pos_c, new_c, vel_c, dt, move, weight_c, walls, wall_l_u, wall_r_u, near_start,
                               near_part, near_wall, pair_l_u, pair_r_u, wall_p, pair_p, row_start, nbr, owner, gx, gy,
-                              force_n, False, order, vel_c, none, none, none, fmax_b, one_bad)
+                              force_n, fire, order, vel_c, none, none, none, fmax_b, one_bad)
         pos_c, new_c = new_c, pos_c
         force_c, force_n = force_n, force_c
         step += 1
@@ -127,7 +129,7 @@ def overdamped_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u
             vmax = max(vmax, abs(vel_c[q, 0]), abs(vel_c[q, 1]))
         max_move = np.sqrt(2.0) * dt * vmax
         step_move = max(step_move, dt * vmax)
-        i, w = _first_crossing(1, pos_c, vel_c, dt, walls, order, near_part, near_wall,
+        i, w = _first_crossing(serial, pos_c, vel_c, dt, walls, order, near_part, near_wall,
                                not (moved + max_move < reach), one_b, one_w)
         if i >= 0:  # tested before any particle moved: the step is not taken
             status = CROSSED

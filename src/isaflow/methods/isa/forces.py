@@ -12,7 +12,7 @@ Arrays: ``pos`` (N, 2) cm; ``weight`` (N,) N; ``walls`` (W, 4) cm.
 """
 
 import numpy as np
-from numba import njit
+from ...core.jit import njit
 
 from ...core.geometry import segment_closest
 

@@ -37,7 +37,7 @@ products) are counted separately.
 """
 
 import numpy as np
-from numba import njit
+from ...core.jit import njit
 
 from ...core.geometry import crossed_wall, segment_closest
 from ...core.neighbours import build_pairs
@@ -82,7 +82,7 @@ def energy_forces(pos, weight, walls, wall_l_u, wall_r_u, pair_l_u, pair_r_u, pi
             if d2 < wall_l_u * wall_l_u:
                 g = wall_l_u - np.sqrt(d2)
                 e_wall += 0.5 * kb * g * g
-                gx, gy = wall_push(px, py, walls[w, 0], walls[w, 1], walls[w, 2], walls[w, 3], wall_l_u, wall_r_u)
+                gx, gy = wall_push(px, py, walls[w, 0], walls[w, 1], walls[w, 2], walls[w, 3], wall_l_u, wall_r_u, 1.0)
                 fx += gx
                 fy += gy
         f[i, 0] = fx
@@ -97,7 +97,7 @@ def energy_forces(pos, weight, walls, wall_l_u, wall_r_u, pair_l_u, pair_r_u, pi
         if d2 < pair_l_u * pair_l_u:
             g = pair_l_u - np.sqrt(d2)
             e_pair += 0.5 * kp * g * g
-            gx, gy = pair_push(dx, dy, pair_l_u, pair_r_u)
+            gx, gy = pair_push(dx, dy, pair_l_u, pair_r_u, 1.0)
             f[i, 0] += gx
             f[i, 1] += gy
             f[j, 0] -= gx

@@ -57,11 +57,15 @@ def plan(study, spec):
     lat = study["lattices"]
     values = {name: resolution_values(spec, v["resolution"]) for name, v in lat.items()}
 
+    own = study.get("own_jobs", {})
+
     def add(sid, tank, variant, resolution, sets, **meta):
         if sid in out:
             raise ValueError(f"study run '{sid}' is planned twice")
         out[sid] = dict(tank=tank, variant=variant, resolution=resolution, set=sets, accept=acc,
                         stability=True, meta=dict(variant=variant, **meta))
+        if meta.get("lattice") not in own.get("lattices", ()) and meta.get("case") not in own.get("cases", ()):
+            out[sid]["block"] = "_".join(str(x) for x in (meta["group"], meta.get("lattice")) if x)
 
     er = study["error_runtime"]
     for block in er["blocks"]:
@@ -120,7 +124,7 @@ def calibration(cal, runs, spec):
                         **_set("solver.history", {}, "no history")}
                 out[f"cal_{run}_kb{kb:g}_r{ratio:g}"] = dict(
                     tank=decl["tank"], variant=cal["variant"], resolution=decl["resolution"], set=sets,
-                    accept=["converged", "cycle", "step_limit"],
+                    accept=["converged", "cycle", "step_limit"], block=f"calibration_{run}",
                     meta=dict(group="calibration", run=run, k_wall=kb, ratio=ratio, variant=cal["variant"]))
     return out
 

@@ -27,7 +27,9 @@ they stay one serial loop (a split sum would round differently).
 """
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
+
+from ...core.jit import njit
 
 from ...core.geometry import crossed_wall, segment_closest
 from .cells import cell_rows_par

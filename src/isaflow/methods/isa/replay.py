@@ -11,7 +11,7 @@ Units: cm, N.
 """
 
 import numpy as np
-from numba import njit
+from ...core.jit import njit
 
 from ...core.geometry import bounding_box
 from ...core.neighbours import build_pairs

@@ -115,8 +115,7 @@ def warm_up(threads=1):
                             pos.copy(), np.array([0.0, 0.0, -1.0, 0.0, 0.0]), False, p, p)
         F.wall_contacts(pos, walls, 0.5, 1.0, p)
     NW.warm_up(threads)
-    if threads > 1:
-        R.start_threads(np.zeros(threads, np.int64))
+    R.start_threads(np.zeros(threads, np.int64))  # compiled whatever the count (one cache serves every count)
 
 
 class _History:

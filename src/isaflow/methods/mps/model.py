@@ -10,7 +10,9 @@ Units: cm, s, density N s^2 / cm^4 (2D), pressure N / cm^2.
 """
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
+
+from ...core.jit import njit
 
 from isaflow.core.geometry import crossed_wall, segment_closest
 

@@ -14,7 +14,9 @@ relative residual |b - A x| / |b| of the returned solution.
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
-from numba import njit, prange
+from numba import prange
+
+from ...core.jit import njit
 
 SOLVERS = ("cg_jacobi", "scipy_cg", "amg", "direct")
 BLOCK = 512  # entries per partial sum of a dot product (fixed: the sum order does not depend on the threads)

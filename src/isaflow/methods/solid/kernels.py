@@ -32,7 +32,7 @@ runs undamped (time histories).  fext (N, 3) [N]: prescribed external loads.
 """
 
 import numpy as np
-from numba import njit
+from ...core.jit import njit
 
 from isaflow.core.neighbours import build_pairs
 

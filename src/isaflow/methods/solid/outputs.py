@@ -12,6 +12,7 @@ import numpy as np
 import xarray as xr
 
 from isaflow import runfile
+from isaflow.core import jit
 from isaflow.methods import label
 
 from . import cases, settings, solve
@@ -66,8 +67,17 @@ def run_case(cfg, outputs, case, variant, loads=None):
     return write_run(cfg, case, variant, outputs[0], loads=loads)
 
 
+def run_cases(cfg, outputs, cases):
+    """Workflow entry point of a block of cases in one process: write_run of each [case, variant] in cases to
+    the output at the same place."""
+    logging.basicConfig(stream=sys.stderr, level=logging.INFO, format="%(asctime)s %(message)s")
+    for (case, variant), out in zip(cases, outputs):
+        write_run(cfg, case, variant, out)
+
+
 def write_run(config_path, case, variant, out, loads=None):
     """Run one case/variant from the settings file and write its run file to out."""
+    jit.use("solid")  # this process's kernels: the solid's cache generation (core.jit)
     log = logging.getLogger("isaflow.solid")
     cfg = settings.load(config_path)
     solve.warmup()

@@ -1,7 +1,7 @@
 """Small rotations of the solid particles from their links (numba; for the objective shear springs)."""
 
 import numpy as np
-from numba import njit
+from ...core.jit import njit
 
 JIT = dict(cache=True, nogil=True)
 

@@ -16,7 +16,7 @@ methods.sph.eos.pressure_of, linear: p = p0 + c0^2 (rho - rho0), c0^2 = K / rho0
 import time
 
 import numpy as np
-from numba import njit
+from ...core.jit import njit
 
 from isaflow.core import smoothing as SM
 from isaflow.core.neighbours import build_pairs

@@ -21,7 +21,7 @@ import math
 import time
 
 import numpy as np
-from numba import njit
+from ...core.jit import njit
 
 from ...contract import Result
 from ...core import smoothing

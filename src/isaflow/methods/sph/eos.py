@@ -3,7 +3,7 @@
 Units: densities N s^2/cm^4, pressures N/cm^2, sound speed cm/s.
 """
 
-from numba import njit
+from ...core.jit import njit
 
 JIT = dict(cache=True, nogil=True)
 

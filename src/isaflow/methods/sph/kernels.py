@@ -20,7 +20,9 @@ reduce chunk by chunk in chunk order, so they too do not depend on the thread co
 """
 
 import numpy as np
-from numba import njit, prange
+from numba import prange
+
+from ...core.jit import njit
 
 from ...core.geometry import crossed_wall
 from ...core.smoothing import dw as kernel_dw

@@ -20,7 +20,7 @@ first index is a liquid particle.
 """
 
 import numpy as np
-from numba import njit
+from ...core.jit import njit
 
 from ...core.neighbours import cell_grid
 

@@ -4,7 +4,7 @@ Units: cm, N, s.
 """
 
 import numpy as np
-from numba import njit
+from ...core.jit import njit
 
 JIT = dict(cache=True, nogil=True)
 

@@ -11,7 +11,7 @@ multipliers of column j at lu[2 kl + 1 : 3 kl + 1, j]; ``ipiv`` (N,) 0-based row
 """
 
 import numpy as np
-from numba import njit
+from ...core.jit import njit
 
 JIT = dict(cache=True, nogil=True)
 ITMAX = 5  # dlacn2's limit on the power iterations

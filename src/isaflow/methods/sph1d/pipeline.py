@@ -9,6 +9,7 @@ import pandas as pd
 import xarray as xr
 
 from isaflow import runfile
+from isaflow.core import jit
 from isaflow.methods import registry
 
 from . import claims, figures, report, settings, sweep
@@ -28,6 +29,7 @@ def run_sweep(settings_path, outputs, resolution=None):
     """Solve the sweep (the settings file's ``resolutions`` entry ``resolution`` applied if given); outputs:
     [the netCDF (with provenance)]."""
     (sweep_nc,) = outputs
+    jit.use("sph1d")  # this process's kernels: the 1D method's cache generation (core.jit)
     handler = _logging()
     try:
         s = settings.load(settings_path, resolution)

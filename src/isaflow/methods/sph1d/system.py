@@ -23,7 +23,7 @@ Units: z, H, dx, h in cm; rho g in N/cm^3; p in N/cm^2.
 """
 
 import numpy as np
-from numba import njit
+from ...core.jit import njit
 
 from isaflow.core.smoothing import NORM, SUPPORT, dw
 

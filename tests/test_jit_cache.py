@@ -1,0 +1,105 @@
+"""The kernel cache's rules (isaflow.core.jit) on a two-kernel module, one process per step: one process
+fills a generation and seals it, later processes only read it; a damaged or foreign generation is rebuilt;
+a process that finds another filling the same generation waits for it (runs) or compiles in memory."""
+
+import json
+import os
+import subprocess
+import sys
+import textwrap
+import time
+
+import pytest
+
+from conftest import ROOT
+
+KERNELS = textwrap.dedent('''
+    from isaflow.core.jit import njit
+
+    @njit(cache=True)
+    def inner(x):
+        return 2.0 * x
+
+    @njit(cache=True)
+    def outer(a):
+        s = 0.0
+        for v in a:
+            s += inner(v)
+        return s
+''')
+
+SCRIPT = textwrap.dedent('''
+    import json, sys, time
+    import numpy as np
+    from isaflow.core import jit
+    import tiny
+    sleep = float(sys.argv[2])
+    mode = jit.use(sys.argv[1], fill=(lambda: (tiny.outer(np.ones(3)), time.sleep(sleep))) if sleep >= 0 else None)
+    value = tiny.outer(np.arange(4.0))
+    print(json.dumps(dict(jit.counters(), mode=mode, value=value)))
+''')
+
+
+@pytest.fixture()
+def env(tmp_path):
+    (tmp_path / "tiny.py").write_text(KERNELS)
+    return dict(os.environ, NUMBA_CACHE_DIR=str(tmp_path / "cache"),
+                PYTHONPATH=os.pathsep.join([str(tmp_path), str(ROOT / "src")]))
+
+
+def start(env, generation="tiny", sleep=0.0):
+    return subprocess.Popen([sys.executable, "-c", SCRIPT, generation, str(sleep)], env=env, text=True,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+
+
+def result(p):
+    out, err = p.communicate(timeout=300)
+    assert p.returncode == 0, err
+    return json.loads(out.splitlines()[-1]), err
+
+
+def test_one_process_fills_and_seals_then_others_only_read(env, tmp_path):
+    first, _ = result(start(env))
+    assert first["mode"] == "read" and first["compiled"] >= 2 and first["value"] == 12.0  # filled, then sealed
+    assert (tmp_path / "cache" / "tiny" / "MANIFEST.json").exists()
+    second, _ = result(start(env))
+    assert second["mode"] == "read" and second["compiled"] == 0 and second["loaded"] >= 1 and second["value"] == 12.0
+
+
+def test_a_damaged_generation_is_rebuilt_not_loaded(env, tmp_path):
+    result(start(env))
+    for p in (tmp_path / "cache" / "tiny").rglob("*.nbc"):
+        p.write_bytes(p.read_bytes()[::-1])
+    again, _ = result(start(env))
+    assert again["compiled"] >= 2 and again["value"] == 12.0
+    third, _ = result(start(env))
+    assert third["compiled"] == 0 and third["value"] == 12.0
+
+
+def test_a_generation_from_another_machine_is_rebuilt(env, tmp_path):
+    result(start(env))
+    manifest = tmp_path / "cache" / "tiny" / "MANIFEST.json"
+    m = json.loads(manifest.read_text())
+    m["machine"]["cpu"] = "another-cpu"
+    manifest.write_text(json.dumps(m))
+    again, _ = result(start(env))
+    assert again["compiled"] >= 2 and again["value"] == 12.0
+
+
+def test_a_run_waits_for_the_process_filling_its_generation(env):
+    writer = start(env, sleep=3.0)  # fills, then holds the generation 3 s before sealing it
+    time.sleep(1.5)
+    reader = start(env)
+    w, _ = result(writer)
+    r, _ = result(reader)
+    assert w["compiled"] >= 2 and r["compiled"] == 0 and r["mode"] == "read" and r["value"] == 12.0
+
+
+def test_a_process_without_a_fill_compiles_in_memory_while_another_writes(env):
+    writer = start(env, generation="default", sleep=-1)  # a writer without fill: seals at exit
+    other = start(env, generation="default", sleep=-1)
+    a, _ = result(writer)
+    b, _ = result(other)
+    assert {a["mode"], b["mode"]} <= {"write", "private", "read"} and a["value"] == b["value"] == 12.0
+    third, _ = result(start(env, generation="default", sleep=-1))
+    assert third["mode"] == "read" and third["compiled"] == 0

@@ -1,0 +1,26 @@
+"""Snakemake script of the rule `compile`: fill one method's kernel cache in this one process (isaflow.core.jit:
+a generation is written by one process, then sealed) with every kernel signature its runs use (the method's
+warm-up), or find it sealed already.  The output lists what was compiled; the job's timing goes to
+logs/timing/jobs.jsonl (isaflow.timing)."""
+import os
+import sys
+import time
+
+_script_start = time.time()
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
+    os.environ[_var] = str(snakemake.threads)  # noqa: F821
+sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+sys.path.insert(0, os.path.realpath(os.path.join(os.path.dirname(__file__), "..", "..", "src")))
+
+from isaflow import run, timing  # noqa: E402
+from isaflow.core import jit  # noqa: E402
+
+_imported = time.time()
+run.compile_method(snakemake.wildcards.method, snakemake.threads)  # noqa: F821
+c = jit.counters()
+text = (f"method {snakemake.wildcards.method}: cache generation {c['generation']} ({c['mode']}), "  # noqa: F821
+        f"{c['compiled']} kernels compiled in {c['compile_s']:.1f} s, {c['loaded']} loaded in {c['load_s']:.2f} s\n")
+with open(snakemake.output[0], "w") as f:  # noqa: F821
+    f.write(text)
+print(text, file=sys.stderr, end="")
+timing.record(snakemake.rule, snakemake.output[0], _script_start, _imported)  # noqa: F821
