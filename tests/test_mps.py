@@ -175,21 +175,21 @@ def test_wall_pair_forces_are_the_momentum_the_walls_exchange(mode):
     """model.wall_forces: the boundary particles' terms of the liquid's pressure gradients, times -m / rho0, summed
     per panel.  For the pairwise antisymmetric forms the liquid's internal terms cancel, so the panels' total is the
     whole pressure force on the liquid, -(m / rho0) sum_i <grad P>_i (round-off); the K&O form (min) is not
-    pairwise and its total differs.  Every boundary particle of the block has a panel (owner)."""
+    pairwise and its total differs.  The force is on the boundary particles only."""
     l0, re = 1.0, 3.1
     pos, kind, p = disordered_wall_block(l0=l0)
     m = operators.GRADIENTS[mode]
     start, nbr, dist = lists(pos, re * l0 + 0.5, kind)
-    owner = np.where(kind == model.FLUID, -1, (pos[:, 0] > 0).astype(np.int64))  # two panels: left and right half
     n_g = model.gradient_norm(m, re)
     grad = model.gradient(pos, p, kind, start, nbr, dist, re * l0, n_g, m)
     total = -(l0**2) * grad[kind == model.FLUID].sum(0)
-    panels = model.wall_forces(pos, p, kind, start, nbr, dist, re * l0, n_g, m, owner, 2, l0**2)
+    forces = model.wall_forces(pos, p, kind, start, nbr, dist, re * l0, n_g, m, l0**2)
+    assert np.all(forces[kind == model.FLUID] == 0.0)
     if mode == "min":
-        assert np.abs(panels.sum(0) - total).max() > 1e-3 * np.abs(total).max()
+        assert np.abs(forces.sum(0) - total).max() > 1e-3 * np.abs(total).max()
     else:
-        assert np.abs(panels.sum(0) - total).max() < 1e-10 * np.abs(grad).max()
-        assert np.all(np.abs(panels[:, 1]) > 0)
+        assert np.abs(forces.sum(0) - total).max() < 1e-10 * np.abs(grad).max()
+        assert np.any(forces[kind == model.WALL, 1] > 0)
 
 
 def closed_box_kinetic_energy(gradient, steps=1500, L=50.0, l0=2.5):
@@ -505,14 +505,30 @@ def test_wall_particles_and_panels(path):
         grp = b["pos"][np.where(thin[b["wall"]], b["side"] == side, side == 1)]
         d = np.sort(np.hypot(*(grp[:, None] - grp[None]).T), axis=1)[:, 1]
         assert d.min() > 0.5 * l0 - 1e-9
-    pw, pc, ps, M, owner = boundary.load_map(tank.walls, b, 10.0)
+    pw, pc, ps, M, share = boundary.load_map(tank.walls, b, 10.0)
     unit = (M @ np.ones(len(b["pos"]))).reshape(-1, 2)  # P = 1: force = panel length x normal
     assert np.allclose(np.hypot(*unit.T), 10.0)
     assert np.count_nonzero(ps < 0) == np.count_nonzero(pw == r1) // 2
-    # the pair-force reading's panels: every boundary particle has one, of its own wall and face, within 10 cm plus
-    # the corner rows' reach (layers x l0) of the panel's centre
-    assert np.all(owner >= 0) and np.array_equal(pw[owner], b["wall"]) and np.array_equal(ps[owner], b["side"])
-    assert np.hypot(*(b["pos"] - pc[owner]).T).max() <= np.hypot(5.0 + 4 * l0, 4 * l0) + 1e-9
+    # the pair-force reading's split: every boundary particle's force goes whole to panels of its own wall and face
+    assert np.allclose(share.sum(0), 1.0) and np.all(share >= 0)
+    q, k = np.nonzero(share)
+    assert np.array_equal(pw[q], b["wall"][k]) and np.array_equal(ps[q], b["side"][k])
+
+
+def test_pair_forces_of_a_row_load_the_panels_by_their_length():
+    """The pair-force reading splits a boundary particle's force between panels by the overlap of the stretch of wall
+    it stands for (its row's spacing) with each panel, so a uniform force on the floor's first row loads each 10 cm
+    panel with 10 cm / l0 particles' worth (1.8 at l0 = 100/18 cm; exactly, the stretches and the panels tile the
+    floor), not with the 1 or 2 whole particles whose centres fall in it (the corner rows' particles under the side
+    walls go to the end panels)."""
+    tank = load_tank(TANK)
+    b = boundary.wall_particles(tank.walls, COARSE, 4, 2)
+    pw, _, _, _, share = boundary.load_map(tank.walls, b, 10.0)
+    floor = tank.wall_names.index("floor")
+    x = b["pos"][:, 0]
+    row = (b["wall"] == floor) & np.isclose(b["pos"][:, 1], -0.5 * COARSE) & (x > 0) & (x < 100)  # not the corners
+    load = share @ row.astype(float)
+    assert np.allclose(load[pw == floor], 10.0 / COARSE, rtol=1e-12)
 
 
 def test_no_particle_sees_across_a_thin_wall():

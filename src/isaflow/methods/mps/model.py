@@ -14,7 +14,7 @@ from numba import njit, prange
 
 from isaflow.core.geometry import crossed_wall, segment_closest
 
-from .operators import (DIM, DUMMY, FLUID, GRADIENTS, JIT, PAR, WALL, distances, divergence, divergence_hs,  # noqa: F401
+from .operators import (DIM, DUMMY, FLUID, GRADIENTS, JIT, PAIRWISE, PAR, WALL, distances, divergence, divergence_hs,  # noqa: F401
                         gradient, gradient_norm, lattice_constants, laplacian, neighbour_list, number_density, offsets,
                         probe_pressure, visible_distances, wall_forces, weight)
 

@@ -29,6 +29,9 @@ FLUID, WALL, DUMMY = 0, 1, 2
 DIM = 2
 # pressure gradients (settings name -> id)
 GRADIENTS = {"min": 0, "corrected": 1, "symmetric": 2, "cmps": 3, "variational": 4, "variational_dummies": 5}
+# the gradients whose pair terms are antisymmetric (momentum-conserving): their wall pair forces are the momentum the
+# walls exchange with the liquid (wall_forces)
+PAIRWISE = frozenset({2, 3, 4, 5})
 
 
 @njit(inline="always", **JIT)
@@ -401,16 +404,16 @@ def gradient(pos, p, kind, start, nbr, dist, re, n0, mode):
         gx *= a
         gy *= a
         if mode == 1:
-            gx, gy = corrected(gx, gy, i, pos, kind, start, nbr, dist, re, a)
+            gx, gy = corrected(gx, gy, corrective(i, pos, kind, start, nbr, dist, re, a))
         out[i, 0] = gx
         out[i, 1] = gy
     return out
 
 
 @njit(inline="always", **JIT)
-def corrected(gx, gy, i, pos, kind, start, nbr, dist, re, a):
-    """(gx, gy) times particle i's corrective matrix C_i = (a sum_j w r_ij r_ij^T / r^2)^-1 over its fluid and wall
-    neighbours (Khayyer & Gotoh 2011); unchanged where det C_i^-1 <= 0.01 (near singular)."""
+def corrective(i, pos, kind, start, nbr, dist, re, a):
+    """(mxx, mxy, myy, det): particle i's moment matrix a sum_j w r_ij r_ij^T / r^2 over its fluid and wall neighbours
+    and its determinant; corrected applies its inverse, the corrective matrix of Khayyer & Gotoh 2011."""
     mxx = mxy = myy = 0.0
     for k in range(start[i], start[i + 1]):
         if dist[k] >= re or kind[nbr[k]] == DUMMY:
@@ -425,38 +428,49 @@ def corrected(gx, gy, i, pos, kind, start, nbr, dist, re, a):
     mxx *= a
     mxy *= a
     myy *= a
-    det = mxx * myy - mxy * mxy
+    return mxx, mxy, myy, mxx * myy - mxy * mxy
+
+
+@njit(inline="always", **JIT)
+def corrected(gx, gy, m):
+    """(gx, gy) times the inverse of the moment matrix m = corrective(...); unchanged where det <= 0.01 (near
+    singular)."""
+    mxx, mxy, myy, det = m
     if det > 0.01:
         return (myy * gx - mxy * gy) / det, (mxx * gy - mxy * gx) / det
     return gx, gy
 
 
 @njit(**JIT)
-def wall_forces(pos, p, kind, start, nbr, dist, re, n0, mode, owner, npanel, mass_over_rho):
-    """(npanel, 2) force [N] of the boundary particles of each wall panel on the liquid: the terms of the fluid
-    particles' pressure gradients (gradient, same arguments) that come from boundary neighbours j with
-    owner[j] = panel (>= 0; -1 for fluid particles), times -m / rho0 (mass_over_rho [cm^2], l0^2 in 2D).  For
-    the pairwise antisymmetric forms (symmetric, cmps, variational) this is the momentum the walls exchange
-    with the liquid, and floor plus side walls carry the liquid's weight at rest; for the K&O forms it is the
-    boundary neighbours' share of sums that are not pairwise (the liquid's internal terms do not cancel).
-    Serial (a scatter into panels), evaluated at samples only."""
+def wall_forces(pos, p, kind, start, nbr, dist, re, n0, mode, mass_over_rho):
+    """(N, 2) force [N] of each boundary particle on the liquid (0 at liquid particles): the terms of the fluid
+    particles' pressure gradients (gradient, same arguments) that come from their boundary neighbours, times -m /
+    rho0 (mass_over_rho [cm^2], l0^2 in 2D).  For the pairwise antisymmetric forms (PAIRWISE: symmetric, cmps,
+    variational) this is the momentum the walls exchange with the liquid, and floor plus side walls carry the
+    liquid's weight at rest; for the K&O forms it is the boundary neighbours' share of sums that are not pairwise
+    (the liquid's internal terms do not cancel).  Serial (a scatter onto the boundary particles)."""
     pmin = neighbourhood_min(p, kind, start, nbr, dist, re) if mode in (0, 1, 3) else p
-    out = np.zeros((npanel, 2))
+    out = np.zeros((pos.shape[0], 2))
     a = DIM / n0
+    m = (1.0, 0.0, 1.0, 1.0)
     for i in range(pos.shape[0]):
         if kind[i] != FLUID:
             continue
+        first = True
         for k in range(start[i], start[i + 1]):
             j = nbr[k]
-            if owner[j] < 0 or dist[k] >= re or not in_gradient(mode, kind[j]):
+            if kind[j] == FLUID or dist[k] >= re or not in_gradient(mode, kind[j]):
                 continue
             q = a * pair_coefficient(mode, p[i], p[j], pmin[i], pmin[j], dist[k], re)
             gx = q * (pos[j, 0] - pos[i, 0])
             gy = q * (pos[j, 1] - pos[i, 1])
             if mode == 1:
-                gx, gy = corrected(gx, gy, i, pos, kind, start, nbr, dist, re, a)
-            out[owner[j], 0] -= mass_over_rho * gx
-            out[owner[j], 1] -= mass_over_rho * gy
+                if first:
+                    m = corrective(i, pos, kind, start, nbr, dist, re, a)
+                    first = False
+                gx, gy = corrected(gx, gy, m)
+            out[j, 0] -= mass_over_rho * gx
+            out[j, 1] -= mass_over_rho * gy
     return out
 
 

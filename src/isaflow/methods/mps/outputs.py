@@ -39,28 +39,39 @@ SIDE_LOAD = 3262.5  # N, rho g h^2 / 2 of the single tank (72.5 cm, 9000 N): the
 
 
 def side_loads(ds):
-    """Mean side-wall load [N] by the primary (pair-force) reading (wall_balance) and its error against SIDE_LOAD;
-    NaN for tanks other than the single vessel."""
-    load = wall_balance(ds, "pair")[0]
+    """Mean side-wall load [N] by the contacts' reading (pair forces for a momentum-conserving gradient, else the
+    panel pressures; run attribute wall_load_reading, wall_balance) and its error against SIDE_LOAD; NaN for tanks
+    other than the single vessel."""
+    load = wall_balance(ds, "pair" if ds.attrs.get("wall_load_reading") == "pair forces" else "panel")[0]
     return load, load / SIDE_LOAD - 1.0
 
 
-READINGS = {"pair": "hist_panel_force", "panel": "hist_panel_pressure_force"}  # wall-load readings: variable
+READINGS = {"pair": "hist_pair_force", "panel": "hist_panel_pressure_force"}  # wall-load readings: variable
+
+
+def wall_series(ds, reading="pair"):
+    """Wall loads of the single vessel per sample by one reading (READINGS: pair forces, the primary, or panel
+    pressures), each the mean over the steps of its sample interval: dict of (S,) arrays [N] side (the mean of
+    |sum of horizontal forces| on the left and right walls), floor (vertical force on the floor) and vertical (the
+    vertical forces of floor and side walls together: the liquid's weight at rest); None for other tanks, and
+    for the panel reading of a run file without it."""
+    if ds.attrs.get("scene") != "single" or READINGS[reading] not in ds:
+        return None
+    F = ds[READINGS[reading]].values
+    names = [str(n) for n in ds["wall"].values]
+    cw = ds["contact_wall"].values
+    left, floor, right = (F[:, cw == names.index(w)].sum(1) for w in ("left", "floor", "right"))
+    return dict(side=0.5 * (np.abs(left[:, 0]) + np.abs(right[:, 0])), floor=floor[:, 1],
+                vertical=left[:, 1] + floor[:, 1] + right[:, 1])
 
 
 def wall_balance(ds, reading="pair"):
-    """Window-mean wall loads of the single vessel by one reading (READINGS: pair forces, the primary, or panel
-    pressures): (side load [N], the mean of |sum of horizontal forces| on the left and right walls; floor load [N],
-    vertical force on the floor; vertical [N], the vertical forces of floor and side walls together, which carry
-    the liquid's weight at rest).  NaN for other tanks, and for the panel reading of a run file without it."""
-    if ds.attrs.get("scene") != "single" or READINGS[reading] not in ds:
+    """(side, floor, vertical) [N] of wall_series averaged over the run's averaging window; NaN where it has none."""
+    series = wall_series(ds, reading)
+    if series is None:
         return np.nan, np.nan, np.nan
     win = ds["in_window"].values.astype(bool)
-    F = ds[READINGS[reading]].values[win].mean(0)
-    names = [str(n) for n in ds["wall"].values]
-    cw = ds["contact_wall"].values
-    left, floor, right = (F[cw == names.index(w)].sum(0) for w in ("left", "floor", "right"))
-    return 0.5 * (abs(left[0]) + abs(right[0])), float(floor[1]), float(left[1] + floor[1] + right[1])
+    return tuple(float(series[k][win].mean()) for k in ("side", "floor", "vertical"))
 
 
 def pressure_profile(pos, p, l0, rho_g, depth, below=2.5):

@@ -102,10 +102,10 @@ class State:
         self.graze_depth = cfg["walls.graze_depth"] * l0  # cm: deeper crossings are escapes
         self.grazes, self.deepest_graze = 0, 0.0  # steps with a graze, deepest graze [cm]
         self.reflect_steps, self.reflections = 0, 0  # steps with a wall reflection, particles reflected (walls.reflect)
-        self.panel_wall, self.panel_centre, self.panel_side, self.load_matrix, owner = boundary.load_map(
+        self.panel_wall, self.panel_centre, self.panel_side, self.load_matrix, self.share = boundary.load_map(
             self.walls, self.bnd, cfg["walls.panel_length"])
-        self.owner = np.concatenate([np.full(self.nf, -1, np.int64), owner])  # panel of each boundary particle
         self.pair_state = None  # (positions, distances, list start, list) of the last pressure gradient
+        self.load_sum, self.p_sum, self.sum_time = np.zeros((2 * len(self.panel_wall), 2)), np.zeros(self.nf), 0.0
         self.surface_mode = model.SURFACE[cfg["model.surface_pressure"]]
         self.lap_mode = model.LAPLACIANS[cfg["model.pressure_laplacian"]]
         self.div_mode = model.DIVERGENCES[cfg["model.divergence"]]
@@ -150,6 +150,23 @@ class State:
         pressure times the length of wall it faces (the panel reading)."""
         return (self.load_matrix @ self.p[self.nf:]).reshape(-1, 2)
 
+    def accumulate(self, dt):
+        """Add this step's wall loads by both readings and the liquid's pressures, times dt, to the sums since the
+        last take_means (the momentum the walls exchanged, and the pressure's time integral)."""
+        self.load_sum += dt * np.concatenate([self.pair_forces(), self.panel_forces()])
+        self.p_sum += dt * self.p[: self.nf]
+        self.sum_time += dt
+
+    def take_means(self):
+        """(pair-force loads (P, 2) N, panel loads (P, 2) N, liquid pressures (nf,) N/cm^2): the means over the steps
+        since the last call (the current values if no step was taken), and start new sums."""
+        if self.sum_time > 0.0:
+            load, p = self.load_sum / self.sum_time, self.p_sum / self.sum_time
+        else:
+            load, p = np.concatenate([self.pair_forces(), self.panel_forces()]), self.p[: self.nf].copy()
+        self.load_sum, self.p_sum, self.sum_time = np.zeros((2 * len(self.panel_wall), 2)), np.zeros(self.nf), 0.0
+        return load[: len(self.panel_wall)], load[len(self.panel_wall):], p
+
     def pair_forces(self):
         """(P, 2) force of each wall panel's boundary particles on the liquid [N]: the wall-liquid pair terms of
         the last step's pressure gradient (model.wall_forces, at the positions and pressures it used; the
@@ -157,8 +174,9 @@ class State:
         if self.pair_state is None:
             return np.zeros((len(self.panel_wall), 2))
         pos, dist, start, nbr = self.pair_state
-        return model.wall_forces(pos, self.p, self.kind, start, nbr, dist, self.re_g, self.n_grad, self.grad_mode,
-                                 self.owner, len(self.panel_wall), self.weight / units.G / self.rho0)
+        f = model.wall_forces(pos, self.p, self.kind, start, nbr, dist, self.re_g, self.n_grad, self.grad_mode,
+                              self.weight / units.G / self.rho0)
+        return self.share @ f[self.nf:]
 
 
 def step(s, dt, source, cfg, timers=None):
@@ -249,6 +267,7 @@ def step(s, dt, source, cfg, timers=None):
         s.count_reflections(hit)
     bad, graze = model.check(pos_old, pos, vel, s.kind, s.walls, s.escape_box, s.graze_depth)
     s.pos, s.vel, s.p = pos, vel, p
+    s.accumulate(dt)  # wall loads: the momentum exchanged over a sample interval, not one step's force
     s.surf = surf
     if graze > 0.0:
         s.grazes += 1
@@ -311,15 +330,11 @@ def _solve(tank, cfg, variant, l0, t_end, probes, start, snapshots, log, threads
     elapsed, next_sample, dt_min, short_steps = 0.0, sample_dt, dt0, 0
     monitor = rest.Monitor(rest_cfg["energy_ratio"], rest_cfg["window"])
     probes = np.asarray(probes, float).reshape(-1, 2)
-    rec = {k: [] for k in ("time", "panel", "pressure_panel", "probe", "rms", "vmax", "energy", "count", "resid", "iters",
-                           "surf")}
+    rec = {k: [] for k in ("time", "pair", "panel", "probe", "rms", "vmax", "energy", "count", "resid", "iters", "surf")}
     snaps, snap_t = [], []
     fail_tol = cfg["pressure.rtol"] * cfg["pressure.fail_factor"]
     status, message, max_resid, iters = None, "", 0.0, []
     timers = np.zeros(3)
-    npanel = len(s.panel_wall)
-    impulse, impulse_time = np.zeros((2 * npanel, 2)), 0.0  # [N s], [s] since the last sample
-    p_sum = np.zeros(s.nf)  # [N s / cm^2] liquid pressures integrated since the last sample
     p_means = collections.deque(maxlen=int(np.ceil(cfg["time.average_window"] / sample_dt)) + 2)  # (t, interval mean)
     wall0 = time.perf_counter()
     last_log = wall0
@@ -334,10 +349,6 @@ def _solve(tank, cfg, variant, l0, t_end, probes, start, snapshots, log, threads
                 dt_min = min(dt_min, dt)
                 short_steps += 1
         bad, resid, its = step(s, dt, variant, cfg, timers)
-        if np.isfinite(resid):  # wall loads: the momentum exchanged over the sample interval, not one step's force
-            impulse += dt * np.concatenate([s.pair_forces(), s.panel_forces()])
-            p_sum += dt * s.p[: s.nf]
-            impulse_time += dt
         max_resid = max(max_resid, resid)
         iters.append(its)
         elapsed += dt
@@ -367,11 +378,10 @@ def _solve(tank, cfg, variant, l0, t_end, probes, start, snapshots, log, threads
             e = rest.energy_ratio(0.5 * speed2.sum() * s.weight / units.G, s.weight * s.nf, depth0)
             at_rest = monitor.update(t, e)
             rec["time"].append(t)
-            scale = 1.0 / impulse_time if impulse_time > 0 else 1.0
-            rec["panel"].append(impulse[:npanel] * scale)
-            rec["pressure_panel"].append(impulse[npanel:] * scale)
-            p_means.append((t, p_sum * scale if impulse_time > 0 else s.p[: s.nf].copy()))
-            impulse, impulse_time, p_sum = np.zeros_like(impulse), 0.0, np.zeros(s.nf)
+            pair, panel, p_mean = s.take_means()
+            rec["pair"].append(pair)
+            rec["panel"].append(panel)
+            p_means.append((t, p_mean))
             rec["probe"].append(model.probe_pressure(s.pos, s.p, s.kind, probes, s.re_n))
             rec["rms"].append(np.sqrt(speed2.mean()))
             rec["vmax"].append(np.sqrt(speed2.max()))
@@ -407,15 +417,20 @@ def _solve(tank, cfg, variant, l0, t_end, probes, start, snapshots, log, threads
                    f"{monitor.window:g} s: mean {e_mean:.3g}, max {e_max:.3g} (rms speed {rms_window:.3g} cm/s; rest: below "
                    f"{monitor.limit:g} for {monitor.window:g} s)")
     t_rest = monitor.time_to_rest() - t0 if status == "converged" else np.nan
-    panels = np.array(rec["panel"])
+    pairwise = s.grad_mode in model.PAIRWISE  # momentum exchange is defined: the pair forces are the contacts
+    panels = np.array(rec["pair" if pairwise else "panel"])
     window = times >= times[-1] - cfg["time.average_window"] + 1e-12
     hist = {
         "hist_time": (("sample",), times, "s", "time of sample"),
         "hist_panel_force": (("sample", "contact", "xy"), panels, "N",
-                             "force of each wall panel's boundary particles on the liquid: the wall-liquid pair terms of "
-                             "the pressure gradient (pair-force reading, model.wall_forces), mean over the steps since "
-                             "the previous sample (momentum exchanged / interval)"),
-        "hist_panel_pressure_force": (("sample", "contact", "xy"), np.array(rec["pressure_panel"]), "N",
+                             "force of each wall panel on the liquid, the contacts' reading: " + ("pair forces (hist_pair_force)"
+                             if pairwise else "panel pressures (hist_panel_pressure_force; this gradient's pair terms are "
+                             "not antisymmetric, so they are no momentum exchange)")),
+        "hist_pair_force": (("sample", "contact", "xy"), np.array(rec["pair"]), "N",
+                            "force of each wall panel's boundary particles on the liquid: the wall-liquid pair terms of "
+                            "the pressure gradient (pair-force reading, model.wall_forces), mean over the steps since the "
+                            "previous sample (momentum exchanged / interval)"),
+        "hist_panel_pressure_force": (("sample", "contact", "xy"), np.array(rec["panel"]), "N",
                                       "force of each wall panel on the liquid: first-row wall pressure times the wall "
                                       "length it faces (panel reading), mean over the steps since the previous sample"),
         "hist_probe_pressure": (("sample", "probe"), np.array(rec["probe"]).reshape(len(times), -1), "N cm-2", "pressure at fixed probe",
@@ -470,7 +485,7 @@ def _solve(tank, cfg, variant, l0, t_end, probes, start, snapshots, log, threads
         "rest_energy_ratio": monitor.limit, "rest_window": monitor.window, "rest_depth_cm": depth0,
         "time_to_rest": t_rest, "final_energy_ratio": monitor.last, "final_rms_speed_cm_s": rms,
         "window_energy_ratio_mean": e_mean, "window_energy_ratio_max": e_max, "window_rms_speed_cm_s": rms_window,
-        "wall_load_reading": "pair forces (hist_panel_force, contact_force); panel pressures: hist_panel_pressure_force",
+        "wall_load_reading": "pair forces" if pairwise else "panel pressures",
     }
     return Result(
         method="mps", variant=variant, pos0=pos0, pos=s.pos[: s.nf].copy(), weight=np.full(s.nf, s.weight),
