@@ -1,5 +1,6 @@
 """MPS cost per step against N: predict (numba: neighbour lists, explicit step, collision, number density,
-free surface, source term, CSR assembly), pressure solve and correct (numba: gradient, update, wall check),
+free surface, source term, CSR assembly), pressure solve and correct (numba: gradient, update, wall check, the
+wall loads of both readings summed every step),
 each timed separately, for the pressure solvers (cg_jacobi: compiled, bit-identical for any thread count;
 scipy_cg, amg, direct) and for 1 and 2 numba threads (cg_jacobi).
 
