@@ -5,8 +5,8 @@ wall loads over 0.1-0.3 s and over the last 0.5 s, against rho g h^2 / 2 = 3262.
 tests/test_mps.py::test_every_flow_runs_without_an_escape (which runs the first escape's flow for 1 s); too
 slow for the test suite (about 10 minutes on one core).
 
-Writes benchmarks/results/mps_flow_escapes.csv.  Run: python benchmarks/mps_flow_escapes.py [setting=value ...]
-(settings overrides, e.g. walls.reflect=false).
+Writes benchmarks/results/mps_flow_escapes.csv (or --out=PATH).  Run: python benchmarks/mps_flow_escapes.py
+[--out=PATH] [setting=value ...] (settings overrides, e.g. walls.reflect=false).
 """
 
 import sys
@@ -35,7 +35,14 @@ def side_loads(r):
     return early / 3262.5 - 1, late / 3262.5 - 1
 
 
-def main(overrides):
+def main(args):
+    out = ROOT / "benchmarks" / "results" / "mps_flow_escapes.csv"
+    overrides = []
+    for arg in args:
+        if arg.startswith("--out="):
+            out = Path(arg.removeprefix("--out="))
+        else:
+            overrides.append(arg)
     numba.set_num_threads(1)
     quiet = lambda *a: None  # noqa: E731
     rows = []
@@ -48,6 +55,7 @@ def main(overrides):
                                   cfg["time.single_time"], cfg["probes.single"], threads=1, log=quiet)
             early, late = side_loads(single)
             rows.append(dict(run=f"single_{variant}_{res}", status=single.status, t_end_s=single.sim_time,
+                             time_to_rest_s=single.params["time_to_rest"],
                              side_err_early=early, side_err_late=late, reflected=single.params["reflected_particles"],
                              ms_per_step=1e3 * (time.perf_counter() - w0) / single.steps))
             print(rows[-1], flush=True)
@@ -60,11 +68,12 @@ def main(overrides):
                 steps = r.steps - r.start_step
                 rows.append(dict(run=f"{name}_{variant}_{res}", status=r.status, t_end_s=r.sim_time - single.sim_time,
                                  reflected=r.params["reflected_particles"], reflect_steps=r.params["reflect_steps"],
+                                 graze_steps=r.params["graze_steps"], deepest_graze_cm=r.params["deepest_graze_cm"],
                                  max_speed_cm_s=float(np.max(r.history["hist_max_speed"][1])),
                                  ms_per_step=1e3 * (time.perf_counter() - w0) / max(1, steps),
                                  message=r.message))
                 print(rows[-1], flush=True)
-    out = ROOT / "benchmarks" / "results" / "mps_flow_escapes.csv"
+    out.parent.mkdir(parents=True, exist_ok=True)
     pd.DataFrame(rows).to_csv(out, index=False, float_format="%.6g")
     print(f"wrote {out}")
 

@@ -102,11 +102,15 @@ def _mps_state(variant="standard", l0=100.0 / 18.0, seed=0):
 
 def test_rho_star_of_the_project_is_the_number_density_not_the_jacobian():
     """Uniform dilation of the lattice: d ln(n*/n0) / d ln(1/det) = (n0 + z) / (2 n0) for the MPS weight
-    re/r - 1 (z = 12 neighbours within 2.1 l0), not 1; the measure finds the source equal to eq. 6 with n*/n0."""
+    re/r - 1 (z lattice neighbours within the settings' r_e: 28 within 3.1 l0), not 1; the measure finds the source
+    equal to eq. 6 with n*/n0."""
     ds = _mps_state("hattori")
     d = mps_claims.dilation_sources(ds)
     n0 = d["n0"]
-    assert d["sensitivity"] == pytest.approx((n0 + 12) / (2 * n0), rel=1e-6)
+    re = mps_claims.run_settings(ds)["model.re_density"]
+    g = np.arange(-4, 5)
+    z = int(np.count_nonzero((np.hypot(*np.meshgrid(g, g)) > 0) & (np.hypot(*np.meshgrid(g, g)) < re)))
+    assert d["sensitivity"] == pytest.approx((n0 + z) / (2 * n0), rel=1e-6)
     assert abs(d["s_model"] - d["s_nd"]) < 1e-9 * abs(d["s_nd"]) < abs(d["s_model"] - d["s_det"])
     assert mps_claims.measure_rho_star(FakeContext(ds), REGISTRY["hat-eq4-rho-star"]).passed is False
     assert mps_claims.measure_rho_star(FakeContext(_mps_state()), REGISTRY["hat-eq4-rho-star"]).passed is None

@@ -39,6 +39,16 @@ def speed_at(ratio, depth):
     return math.sqrt(2.0 * G * depth * ratio)
 
 
+def window_stats(times, ratios, window):
+    """(mean, max) of e over the samples of the last ``window`` s (times [s] ascending, ratios e (1)): the final
+    state of a run is quoted over the rest window, never as a single sample.  (nan, nan) without samples."""
+    times, ratios = [float(t) for t in times], [float(e) for e in ratios]
+    if not times:
+        return math.nan, math.nan
+    last = [e for t, e in zip(times, ratios) if t >= times[-1] - float(window) + 1e-12]
+    return math.fsum(last) / len(last), max(last)
+
+
 class Monitor:
     """Tracks e(t) sample by sample; ``at_rest`` once every sample of the last window is below the ratio.
 

@@ -7,6 +7,7 @@ _MPS_RUNS = settings_runs("mps")
 declare_runs("mps", _MPS_RUNS)
 MPS_FILES = [run_file("mps", r) for r in _MPS_RUNS]
 MPS_SINGLE = [run_file("mps", r) for r in _MPS_RUNS if r.startswith("single_")]
+MPS_BEFORE = [run_file("mps", r) for r in _MPS_RUNS if r.startswith("kog_")]  # the settings before issue 30
 MPS_FLOW_FINEST = [run_file("mps", r) for r, d in _MPS_RUNS.items() if r.startswith("flow_") and d["resolution"] == "dx3.45"]
 
 
@@ -53,6 +54,7 @@ rule mps_figure_loads:
 rule mps_figure_rest:
     input:
         runs=MPS_SINGLE,
+        before=MPS_BEFORE,
         code=code("methods.mps.figures"),
     output:
         figure("mps_rest"),
@@ -64,6 +66,26 @@ rule mps_figure_rest:
         **SMALL,
     log:
         "logs/mps/figure_rest.log",
+    conda:
+        "../../envs/isaflow.yaml"
+    script:
+        "../../scripts/call.py"
+
+
+rule mps_figure_column:
+    input:
+        runs=MPS_SINGLE,
+        code=code("methods.mps.figures"),
+    output:
+        figure("mps_column"),
+    params:
+        func="methods.mps.figures.column",
+    message:
+        JOB
+    resources:
+        **SMALL,
+    log:
+        "logs/mps/figure_column.log",
     conda:
         "../../envs/isaflow.yaml"
     script:
@@ -135,5 +157,6 @@ rule mps_report:
         "../../scripts/call.py"
 
 
-register(MPS_FILES + ["results/mps/summary.csv"] + figure("mps_wall_loads") + figure("mps_flow") + figure("mps_rest"),
+register(MPS_FILES + ["results/mps/summary.csv"] + figure("mps_wall_loads") + figure("mps_flow") + figure("mps_rest")
+         + figure("mps_column"),
          ["results/report/55_mps.md"], timing=["results/timing/55_mps.md"])

@@ -149,11 +149,15 @@ def load_map(walls, bnd, panel_length):
     behind the wall line, on the liquid side they load, so that metrics.contact_in_vessel gives them to
     that vessel).  Each WALL particle carries its pressure over the wall length it faces (arc +- ds / 2),
     split between panels by overlap; the force on the liquid is P x length along the face's liquid-side
-    normal.  Returns (panel_wall (P,), panel_centre (P, 2) cm, panel_side (P,) +-1, M (2P, Nb)) with
-    force = (M @ P_bnd).reshape(P, 2) in N when P is in N/cm^2 (2D: per cm of thickness).
+    normal.  Returns (panel_wall (P,), panel_centre (P, 2) cm, panel_side (P,) +-1, M (2P, Nb), share (P, Nb))
+    with force = (M @ P_bnd).reshape(P, 2) in N when P is in N/cm^2 (2D: per cm of thickness); share: how the
+    force of every boundary particle (wall, dummy, a corner's row extension) is split between the panels of its
+    own wall and face, by the overlap of the stretch it stands for (its projection on the wall line +- half its
+    row's spacing, moved inside the wall's ends) with each panel (each column sums to 1): the panels of the
+    pair-force reading (operators.wall_forces).
     """
     walls = np.asarray(walls, float)
-    _, _, _, nrm = _frames(walls)
+    a, L, t, nrm = _frames(walls)
     pw, pc, s0, s1 = wall_panels(walls, panel_length)
     sides = sorted({(int(w), int(sd)) for w, sd in zip(bnd["face_wall"], bnd["face_side"])})
     back = np.array([w for w, sd in sides if sd < 0], int)
@@ -169,7 +173,17 @@ def load_map(walls, bnd, panel_length):
             overlap = min(hi, s1[q]) - max(lo, s0[q])
             if overlap > 0:
                 M[2 * q:2 * q + 2, b] += overlap * sd * nrm[w]
-    return panel_wall, panel_centre, panel_side, M
+    bw, bs = bnd["wall"], bnd["side"]
+    pitch = np.zeros(len(walls))  # the rows' spacing along each wall (its first row's stretches)
+    pitch[bnd["face_wall"]] = bnd["face_ds"]
+    half = 0.5 * pitch[bw]
+    mid = np.clip(np.einsum("ij,ij->i", bnd["pos"] - a[bw], t[bw]), half, L[bw] - half)
+    share = np.zeros((len(panel_wall), len(bw)))
+    for q in range(len(panel_wall)):
+        on = (bw == panel_wall[q]) & (bs == panel_side[q])
+        share[q, on] = np.clip(np.minimum(mid[on] + half[on], s1[q]) - np.maximum(mid[on] - half[on], s0[q]), 0.0, None)
+    share /= share.sum(0)
+    return panel_wall, panel_centre, panel_side, M, share
 
 
 def assemble_particles(fluid_pos, walls, l0, layers=4, pressure_layers=2, thin=None):

@@ -66,6 +66,12 @@ def plausible(tank, s, stability=False):
     finite(path, "time.courant", dt, "time step dt [s]")
     within(path, "model.kinematic_viscosity", s["model.kinematic_viscosity"] * dt / l0**2, *DIFFUSION,
            stability=stability)
+    # a stability case may set the radii apart (its point is to go outside the method's range)
+    variational = s["model.gradient"].startswith("variational")
+    require(stability or not variational or s["model.re_gradient"] == s["model.re_density"], path,
+            "model.re_gradient", f"the variational gradient is the derivative of the number density, so its radius is "
+            f"the number density's: re_gradient {s['model.re_gradient']:g} l0 against re_density "
+            f"{s['model.re_density']:g} l0")
     t_key = "time.flow_time" if _flow(tank) else "time.single_time"
     require(s["time.average_window"] <= s[t_key], path, "time.average_window",
             f"{s['time.average_window']:g} s is longer than the run ({t_key} = {s[t_key]:g} s)")

@@ -70,7 +70,7 @@ def one_step(ds):
     def grad_at(pos):
         s.neighbours(pos)
         d = model.distances(pos, s.start, s.nbr)
-        return model.gradient(pos, s.p, s.kind, s.start, s.nbr, d, s.re_g, s.n0_g, s.grad_mode)
+        return model.gradient(pos, s.p, s.kind, s.start, s.nbr, d, s.re_g, s.n_grad, s.grad_mode)
 
     g_star, g_new = grad_at(u_star), grad_at(s.pos)
     lhs = (s.vel[f] - vel_n[f]) / dt
@@ -240,7 +240,7 @@ def dilation_sources(ds, e=DILATION):
     sens = (np.log(density(1.0 + e)) - np.log(density(1.0 - e))) / (2 * np.log(1 - e) - 2 * np.log(1 + e))
     return dict(s_model=s_model, s_det=eq6(rho0 / det), s_nd=eq6(rho0 * n_star / n0), sensitivity=float(sens),
                 n0=n0, n0_file=float(ds.attrs["n0_density"]), relax=cfg["model.relaxation"],
-                relax_all=bool(cfg["model.relax_all_sources"]), source=str(ds.attrs["source_term"]))
+                scope=str(cfg["model.relaxation_scope"]), source=str(ds.attrs["source_term"]))
 
 
 def measure_rho_star(ctx, entry):
@@ -252,8 +252,10 @@ def measure_rho_star(ctx, entry):
     off_det = abs(d["s_model"] - d["s_det"]) / abs(d["s_det"])
     off_nd = abs(d["s_model"] - d["s_nd"]) / abs(d["s_det"])
     ok = off_det < off_nd
-    relax = (f"; the run also multiplies the source by the relaxation {d['relax']:g} (model.relax_all_sources), "
-             "which eq. (6) does not have") if d["relax_all"] and d["relax"] != 1 else ""
+    a_d, a_v = model.relaxation_factors(model.SOURCES["hattori"], model.RELAX_SCOPES[d["scope"]], d["relax"])
+    relax = (f"; the run also multiplies eq. (6)'s density term by {a_d:g} and its divergence term by {a_v:g} "
+             f"(model.relaxation {d['relax']:g}, relaxation_scope '{d['scope']}'), which eq. (6) does not have"
+             ) if (a_d, a_v) != (1.0, 1.0) else ""
     return Measurement(
         measured=f"source term '{d['source']}' of {key.split(':', 1)[1]} on a uniform dilation e = {DILATION:g} of its "
                  f"lattice (l0 = {float(ds.attrs['spacing']):.4g} cm): differs from eq. (6) with Rho* = rho0/det by "

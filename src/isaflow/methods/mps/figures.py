@@ -1,10 +1,12 @@
 """MPS figures from run files: wall loads per panel against hydrostatics (Fig. 6-like, with the noise band),
-the rms speed of the liquid at rest against time (every single-vessel run, with its rest limit), and the
-flow (Fig. 10-like snapshots and the final state)."""
+the kinetic energy of the liquid started at rest against time (every single-vessel run, with its rest limit and
+the runs before issue 30), the column at rest (pressure against depth, wall loads against time by both readings),
+and the flow (Fig. 10-like snapshots and the final state)."""
 
 import numpy as np
 
 from isaflow import metrics, runfile
+from isaflow.core import units
 from isaflow.figures.style import plt, save
 from isaflow.methods import registry
 
@@ -90,22 +92,77 @@ def flow(runs, outputs):
     save(fig, out)
 
 
-def rest(runs, outputs):
-    """One panel per source term: kinetic energy / (W h) of the liquid started at rest against time, one line
-    per spacing; dashed: the rest limit of isaflow.rest (config/rest.yaml)."""
-    dss = [runfile.read(p) for p in runs]
-    fig, axes = plt.subplots(1, len(VARIANTS), figsize=(4.2 * len(VARIANTS), 3.4), squeeze=False, sharey=True)
+def _by_variant(dss, name):
+    """The runs of source term ``name``, coarsest spacing first, with each one's colour (by spacing)."""
+    mine = sorted((ds for ds in dss if ds.attrs["variant"] == name), key=lambda d: -float(d.attrs["spacing"]))
+    spacings = sorted({float(d.attrs["spacing"]) for d in dss}, reverse=True)
+    return [(ds, plt.cm.viridis(spacings.index(float(ds.attrs["spacing"])) / max(1, len(spacings) - 1) * 0.85))
+            for ds in mine]
+
+
+def rest(runs, outputs, before=()):
+    """One panel per source term: kinetic energy / (W h) of the liquid started at rest against time, one line per
+    spacing, solid the settings' gradient, dashed the runs ``before`` (the K&O gradient and radii before issue 30);
+    black dashed: the rest limit of isaflow.rest (config/rest.yaml)."""
+    dss = [runfile.read(p) for p in list(runs) + list(before)]
+    fig, axes = plt.subplots(1, len(VARIANTS), figsize=(4.4 * len(VARIANTS), 3.6), squeeze=False, sharey=True)
     for ax, name in zip(axes[0], VARIANTS):
-        mine = sorted((ds for ds in dss if ds.attrs["variant"] == name), key=lambda d: -float(d.attrs["spacing"]))
-        for k, ds in enumerate(mine):
-            c = plt.cm.viridis(k / max(1, len(mine) - 1) * 0.85)
-            ax.semilogy(ds["hist_time"].values, ds["hist_energy_ratio"].values, color=c, lw=1.2,
-                        label=f"l0 = {float(ds.attrs['spacing']):.3g} cm ({ds.attrs['status']})")
+        mine = _by_variant(dss, name)
+        for ds, c in mine:
+            old = ds.attrs["gradient_model"] != "variational"
+            e_mean = float(ds.attrs["window_energy_ratio_mean"])
+            ax.semilogy(ds["hist_time"].values, ds["hist_energy_ratio"].values, color=c, lw=0.9 if old else 1.2,
+                        ls="--" if old else "-", label=f"l0 = {float(ds.attrs['spacing']):.3g} cm, {ds.attrs['gradient_model']} "
+                                                         f"({ds.attrs['status']}; last {float(ds.attrs['rest_window']):g} s: mean {e_mean:.1e})")
         if mine:
-            ax.axhline(float(mine[0].attrs["rest_energy_ratio"]), color="k", ls="--", lw=0.8)
+            ax.axhline(float(mine[0][0].attrs["rest_energy_ratio"]), color="k", ls=":", lw=0.8)
         ax.set_title(f"source term: {name}", fontsize=9)
         ax.set_xlabel("time t [s]")
-        ax.legend(fontsize=7, loc="lower right")
-    axes[0, 0].set_ylabel("kinetic energy / (W h)\n(dashed: rest limit)")
+        ax.set_ylim(1e-7, 10.0)  # room above the lines for the legend
+        ax.legend(fontsize=6, loc="upper right")
+    axes[0, 0].set_ylabel("kinetic energy / (W h) [1]\n(dotted: rest limit)")
+    fig.tight_layout()
+    save(fig, outputs)
+
+
+def column(runs, outputs):
+    """The column at rest, one column of panels per source term, one colour per spacing: (a) the liquid's pressure
+    (mean over the averaging window) against depth below its top (top particle centre + l0/2) with rho0 g depth;
+    (b) floor plus side walls' vertical force over the weight, (c) side-wall load over rho g h^2 / 2, both against
+    time by the pair-force reading (solid) and the panel reading (dotted)."""
+    from .outputs import SIDE_LOAD, wall_series
+
+    dss = [runfile.read(p) for p in runs]
+    fig, axes = plt.subplots(3, len(VARIANTS), figsize=(4.4 * len(VARIANTS), 9.0), squeeze=False, sharey="row")
+    for k, name in enumerate(VARIANTS):
+        for ds, c in _by_variant(dss, name):
+            l0 = float(ds.attrs["spacing"])
+            pos, p = ds["pos"].values, ds["pressure_mean"].values
+            depth = pos[:, 1].max() + 0.5 * l0 - pos[:, 1]
+            rho_g = float(ds.attrs["rho0_N_s2_cm4"]) * units.G
+            axes[0, k].plot(depth, p, ".", color=c, ms=2.5, label=f"l0 = {l0:.3g} cm ({ds.attrs['status']})")
+            d = np.array([0.0, depth.max()])
+            axes[0, k].plot(d, rho_g * d, "-", color=c, lw=0.7)
+            t = ds["hist_time"].values
+            for reading, ls in (("pair", "-"), ("panel", ":")):
+                series = wall_series(ds, reading)
+                if series is None:
+                    continue
+                axes[1, k].plot(t, 100 * (series["vertical"] / float(ds.attrs["tank_weight"]) - 1), ls=ls, color=c,
+                                lw=0.8, label=f"l0 = {l0:.3g} cm, {reading} reading")
+                axes[2, k].plot(t, 100 * (series["side"] / SIDE_LOAD - 1), ls=ls, color=c, lw=0.8,
+                                label=f"l0 = {l0:.3g} cm, {reading} reading")
+        axes[0, k].axvline(0, color="k", lw=0.5)
+        axes[0, k].set_title(f"source term: {name}", fontsize=9)
+        axes[0, k].set_xlabel("depth below the liquid's top [cm]")
+        axes[0, k].legend(fontsize=7, loc="upper left", title="lines: rho0 g depth", title_fontsize=7)
+        for row in (1, 2):
+            axes[row, k].axhline(0, color="k", lw=0.5)
+            axes[row, k].set_xlabel("time t [s]")
+            axes[row, k].set_ylim(-15, 15)
+        axes[1, k].legend(fontsize=6, loc="lower right")
+    axes[0, 0].set_ylabel("pressure P [N/cm^2]")
+    axes[1, 0].set_ylabel("floor + side walls, vertical,\nagainst W [%]")
+    axes[2, 0].set_ylabel("side-wall load against\nrho g h^2 / 2 = 3262.5 N [%]")
     fig.tight_layout()
     save(fig, outputs)

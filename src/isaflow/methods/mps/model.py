@@ -16,9 +16,9 @@ from ...core.jit import njit
 
 from isaflow.core.geometry import crossed_wall, segment_closest
 
-from .operators import (DIM, DUMMY, FLUID, GRADIENTS, JIT, PAR, WALL, distances, divergence, divergence_hs,  # noqa: F401
-                        gradient, lattice_constants, laplacian, neighbour_list, number_density, offsets, probe_pressure,
-                        visible_distances, weight)
+from .operators import (DIM, DUMMY, FLUID, GRADIENTS, JIT, PAIRWISE, PAR, WALL, distances, divergence, divergence_hs,  # noqa: F401
+                        gradient, gradient_norm, lattice_constants, laplacian, neighbour_list, number_density, offsets,
+                        probe_pressure, visible_distances, wall_forces, weight)
 
 # source terms of the pressure equation (settings name -> id)
 SOURCES = {"standard": 0, "hattori": 1, "mixed": 2}
@@ -30,32 +30,56 @@ LAPLACIANS = {"mps": 0, "hl": 1}
 DIVERGENCES = {"mps": 0, "hs": 1}
 
 
-@njit(**JIT)
-def source_term(n_star, div_star, n0, rho0, dt, source, gamma, relax=1.0):
-    """Right-hand side of lap P = b [N / cm^4] per particle.
+# which terms of the source the relaxation gamma multiplies (settings name -> id): density, the density-deviation
+# terms only (never a velocity-divergence term); source, the whole hattori and mixed source terms (the defaults
+# before issue 30); standard, the standard source's alone (MPS-Basic, which has only that source)
+RELAX_SCOPES = {"density": 0, "source": 1, "standard": 2}
 
-    source 0 standard: relax rho0 / dt^2 (n0 - n*) / n0 (Koshizuka & Oka 1996; relax: MPS-Basic's relaxation);
-    1 hattori: (rho0 - Rho*) / dt^2 + (rho0 - Rho*) / dt div V*, Rho* = rho0 n* / n0
-    (eq. 6 of Hattori et al.); 2 mixed: rho0 / dt div V* + gamma rho0 / dt^2 (n0 - n*) / n0
-    (Tanaka & Masunaga 2010).
+
+@njit(**JIT)
+def relaxation_factors(source, scope, relax):
+    """(a_d, a_v): the factors of the density-deviation and of the velocity-divergence terms of source term
+    ``source`` (SOURCES) under relaxation scope ``scope`` (RELAX_SCOPES) with relaxation ``relax``.  density:
+    (relax, 1) for standard and hattori, (1, 1) for mixed (its density term has its own gamma_m, Tanaka &
+    Masunaga 2010); source: (relax, relax) for hattori and mixed; standard: (1, 1) for hattori and mixed.  The
+    standard source is (relax, 1) under every scope."""
+    if source == 0:
+        return relax, 1.0
+    if scope == 1:
+        return relax, relax
+    if scope == 0 and source == 1:
+        return relax, 1.0
+    return 1.0, 1.0
+
+
+@njit(**JIT)
+def source_term(n_star, div_star, n0, rho0, dt, source, gamma, a_d=1.0, a_v=1.0):
+    """Right-hand side of lap P = b [N / cm^4] per particle; a_d, a_v the factors of its density-deviation and
+    velocity-divergence terms (relaxation_factors; 1, 1: the sources as their papers print them).
+
+    source 0 standard: a_d rho0 / dt^2 (n0 - n*) / n0 (Koshizuka & Oka 1996; a_d: MPS-Basic's relaxation);
+    1 hattori: a_d (rho0 - Rho*) / dt^2 + a_v (rho0 - Rho*) / dt div V*, Rho* = rho0 n* / n0
+    (eq. 6 of Hattori et al.; its second term holds div V*, a velocity-divergence term);
+    2 mixed: a_v rho0 / dt div V* + a_d gamma rho0 / dt^2 (n0 - n*) / n0 (Tanaka & Masunaga 2010, gamma their
+    small relaxation of the density term).
     """
     drho = rho0 * (n0 - n_star) / n0  # rho0 - Rho*
     if source == 0:
-        return relax * drho / dt**2
+        return a_d * drho / dt**2
     if source == 1:
-        return drho / dt**2 + drho / dt * div_star
-    return rho0 / dt * div_star + gamma * drho / dt**2
+        return a_d * drho / dt**2 + a_v * drho / dt * div_star
+    return a_v * rho0 / dt * div_star + a_d * gamma * drho / dt**2
 
 
 @njit(**PAR)
-def source_term_all(n_star, div_star, n0, rho0, dt, source, gamma, relax, relax_all):
-    """(N,) source_term of every particle (dummies' rows are never used); relax_all: the hattori and mixed
-    source terms are multiplied by relax too (the relaxation applied equally to every source term)."""
+def source_term_all(n_star, div_star, n0, rho0, dt, source, gamma, relax, scope):
+    """(N,) source_term of every particle (dummies' rows are never used), relaxed by ``relax`` under relaxation
+    scope ``scope`` (RELAX_SCOPES, relaxation_factors)."""
     n = n_star.shape[0]
     out = np.empty(n)
-    scale = relax if relax_all and source != 0 else 1.0
+    a_d, a_v = relaxation_factors(source, scope, relax)
     for i in prange(n):
-        out[i] = scale * source_term(n_star[i], div_star[i], n0, rho0, dt, source, gamma, relax)
+        out[i] = source_term(n_star[i], div_star[i], n0, rho0, dt, source, gamma, a_d, a_v)
     return out
 
 

@@ -3,7 +3,9 @@
 - weight w(r) = r_e / r - 1 for r < r_e, else 0;
 - number density n_i = sum_j w(r_ij);
 - gradient <grad phi>_i = d / n0 sum_j (phi_j - phi^_i) r_ij / |r_ij|^2 w(r_ij), phi^_i = min(phi_i, phi_j)
-  (K&O 1996's stabilised pressure gradient), or with the corrective matrix (Khayyer & Gotoh 2011);
+  (K&O 1996's stabilised pressure gradient), or with the corrective matrix (Khayyer & Gotoh 2011), or the
+  variational one, C sum_j (phi_i + phi_j) (-w'(r_ij)) r_ij / |r_ij| = sum_k phi_k dn_k/dx_i times C (the
+  transpose of the number density's Jacobian: Suzuki, Koshizuka & Oka 2007's Hamiltonian MPS);
 - Laplacian <lap phi>_i = 2 d / (lambda n0) sum_j (phi_j - phi_i) w(r_ij);
 - divergence <div u>_i = d / n0 sum_j (u_j - u_i) . r_ij / |r_ij|^2 w(r_ij).
 r_ij = r_j - r_i.  Particle kinds: FLUID, WALL (in the pressure equation and the gradient), DUMMY (number
@@ -27,6 +29,11 @@ JIT = dict(cache=True, nogil=True)
 PAR = dict(cache=True, nogil=True, parallel=True)
 FLUID, WALL, DUMMY = 0, 1, 2
 DIM = 2
+# pressure gradients (settings name -> id)
+GRADIENTS = {"min": 0, "corrected": 1, "symmetric": 2, "cmps": 3, "variational": 4, "variational_dummies": 5}
+# the gradients whose pair terms are antisymmetric (momentum-conserving): their wall pair forces are the momentum the
+# walls exchange with the liquid (wall_forces)
+PAIRWISE = frozenset({2, 3, 4, 5})
 
 
 @njit(inline="always", **JIT)
@@ -37,19 +44,34 @@ def weight(r, re):
     return re / max(r, 1e-6 * re) - 1.0
 
 
+def _lattice_radii(re_over_l0):
+    """Distances [l0] of the square lattice's points j != 0 closer than re_over_l0."""
+    k = int(np.ceil(re_over_l0)) + 1
+    g = np.arange(-k, k + 1, dtype=float)
+    x, y = np.meshgrid(g, g)
+    r = np.hypot(x, y).ravel()
+    return r[(r > 0) & (r < re_over_l0)]
+
+
 def lattice_constants(re_over_l0, l0=1.0):
     """(n0, lambda [cm^2]) of a full square lattice of spacing l0 for radius r_e = re_over_l0 l0.
 
     n0 = sum_j w(|r_j|), lambda = sum_j |r_j|^2 w / sum_j w over the lattice
     points j != 0 (Koshizuka & Oka 1996).  n0 does not depend on l0.
     """
-    k = int(np.ceil(re_over_l0)) + 1
-    g = np.arange(-k, k + 1, dtype=float)
-    x, y = np.meshgrid(g, g)
-    r = np.hypot(x, y).ravel()
-    r = r[(r > 0) & (r < re_over_l0)]
+    r = _lattice_radii(re_over_l0)
     wts = re_over_l0 / r - 1.0
     return float(wts.sum()), float((r**2 * wts).sum() / wts.sum() * l0**2)
+
+
+def gradient_norm(mode, re_over_l0):
+    """The lattice sum n_g that normalises the gradient of mode (GRADIENTS), d / n_g its constant: the number
+    density n0 = sum_j w(r_j) for the Koshizuka-Oka forms (sum_j r_j r_j^T / r_j^2 w = n0 / d I), and
+    sum_j r_e / r_j for the variational one (its weight -w'(r) r = r_e / r: sum_j r_e r_j r_j^T / r_j^3 =
+    (1/d) sum_j r_e / r_j I), so that each is exact for a linear field on the lattice.  Does not depend on l0."""
+    if mode >= GRADIENTS["variational"]:
+        return float((re_over_l0 / _lattice_radii(re_over_l0)).sum())
+    return lattice_constants(re_over_l0)[0]
 
 
 # --- neighbour lists ------------------------------------------------------------------------------------
@@ -311,70 +333,146 @@ def laplacian(f, kind, start, nbr, dist, re, n0, lam):
     return out
 
 
-GRADIENTS = {"min": 0, "corrected": 1, "symmetric": 2, "cmps": 3}
+@njit(inline="always", **JIT)
+def in_gradient(mode, kind_j):
+    """Whether a neighbour of this kind enters the gradient: fluid and wall particles (the pressure-carrying ones);
+    dummy particles too in variational_dummies (mode 5, with their P = 0: they are in the number density)."""
+    return kind_j != DUMMY or mode == 5
+
+
+@njit(**PAR)
+def neighbourhood_min(p, kind, start, nbr, dist, re):
+    """(N,) p^_i: the minimum of p_i and its fluid and wall neighbours' p within re (K&O 1996's gradient)."""
+    pmin = p.copy()
+    for i in prange(p.shape[0]):
+        if kind[i] == DUMMY:
+            continue
+        m = p[i]
+        for k in range(start[i], start[i + 1]):
+            j = nbr[k]
+            if kind[j] != DUMMY and dist[k] < re:
+                m = min(m, p[j])
+        pmin[i] = m
+    return pmin
+
+
+@njit(inline="always", **JIT)
+def pair_coefficient(mode, pi, pj, mi, mj, r, re):
+    """q of pair (i, j) at distance r < re in the gradient sum sum_j q r_ij (before the constant d / n_g):
+    0, 1 (p_j - p^_i) w / r^2; 2 (p_i + p_j) w / r^2; 3 ((p_i - p^_i) + (p_j - p^_j)) w / r^2;
+    4, 5 (p_i + p_j) r_e / r^3 (-w'(r) / r, the variational forms).  mi, mj: p^_i, p^_j."""
+    if mode >= 4:
+        rr = max(r, 1e-6 * re)
+        return (pi + pj) * re / (rr * rr * rr)
+    wt = weight(r, re)
+    if mode <= 1:
+        return (pj - mi) / (r * r) * wt
+    if mode == 2:
+        return (pj + pi) / (r * r) * wt
+    return ((pj - mj) + (pi - mi)) / (r * r) * wt
 
 
 @njit(**PAR)
 def gradient(pos, p, kind, start, nbr, dist, re, n0, mode):
     """(N, 2) MPS pressure gradient [N/cm^3] at the fluid particles (0 elsewhere), over fluid and wall
-    neighbours (not dummies).  mode (GRADIENTS): 0 K&O 1996, sum (p_j - p^_i), p^_i the minimum of p_i and
-    its neighbours' (MPS-Basic's calPressureGradient); 1 the same with the corrective matrix
-    C_i = (d/n0 sum_j w r_ij r_ij^T / r^2)^-1 (Khayyer & Gotoh 2011; the plain sum where det C_i^-1 < 0.01);
-    2 sum (p_i + p_j) (pairwise antisymmetric: momentum-conserving); 3 CMPS (Khayyer & Gotoh 2008, Coastal
-    Eng. J. 50, 179), sum [(p_i + p_j) - (p^_i + p^_j)]: momentum-conserving and, both shifted pressures being
-    >= 0, repulsive for every pair.
+    neighbours (not dummies, but for mode 5).  n0: the lattice sum that normalises the mode (gradient_norm).
+    mode (GRADIENTS): 0 K&O 1996, sum (p_j - p^_i), p^_i the minimum of p_i and its neighbours' (MPS-Basic's
+    calPressureGradient); 1 the same with the corrective matrix C_i = (d/n0 sum_j w r_ij r_ij^T / r^2)^-1
+    (Khayyer & Gotoh 2011; the plain sum where det C_i^-1 < 0.01); 2 sum (p_i + p_j) (pairwise antisymmetric:
+    momentum-conserving); 3 CMPS (Khayyer & Gotoh 2008, Coastal Eng. J. 50, 179), sum [(p_i + p_j) - (p^_i +
+    p^_j)]: momentum-conserving and, both shifted pressures being >= 0, repulsive for every pair; 4 variational
+    (Suzuki, Koshizuka & Oka 2007): C sum_j (p_i + p_j) r_e r_ij / r^3 over fluid and wall neighbours = C sum_k
+    p_k dn'_k/dx_i, n' the number density over fluid and wall particles (the full one but for the dummies'
+    share, a fixed function of x_i for a fluid particle within r_e of a dummy row), C = d / sum_lattice r_e / r:
+    antisymmetric pair terms, and its power on the liquid is -C / rho0 sum_k p_k dn'_k/dt (pressure works only
+    by changing number densities); 5 the same over every neighbour, dummies (P = 0) included: C sum_k p_k
+    dn_k/dx_i with n the full number density of the source term.
     """
     n = pos.shape[0]
-    pmin = p.copy()
-    if mode != 2:
-        for i in prange(n):
-            if kind[i] == DUMMY:
-                continue
-            m = p[i]
-            for k in range(start[i], start[i + 1]):
-                j = nbr[k]
-                if kind[j] != DUMMY and dist[k] < re:
-                    m = min(m, p[j])
-            pmin[i] = m
+    pmin = neighbourhood_min(p, kind, start, nbr, dist, re) if mode in (0, 1, 3) else p
     out = np.zeros((n, 2))
     a = DIM / n0
     for i in prange(n):
         if kind[i] != FLUID:
             continue
         gx = gy = 0.0
-        mxx = mxy = myy = 0.0
         for k in range(start[i], start[i + 1]):
             j = nbr[k]
-            if kind[j] == DUMMY:
+            if dist[k] >= re or not in_gradient(mode, kind[j]):
                 continue
-            wt = weight(dist[k], re)
-            if wt == 0.0:
-                continue
-            dx = pos[j, 0] - pos[i, 0]
-            dy = pos[j, 1] - pos[i, 1]
-            r2 = dist[k] * dist[k]
-            if mode <= 1:
-                q = (p[j] - pmin[i]) / r2 * wt
-            elif mode == 2:
-                q = (p[j] + p[i]) / r2 * wt
-            else:
-                q = ((p[j] - pmin[j]) + (p[i] - pmin[i])) / r2 * wt
-            gx += q * dx
-            gy += q * dy
-            mxx += dx * dx / r2 * wt
-            mxy += dx * dy / r2 * wt
-            myy += dy * dy / r2 * wt
+            q = pair_coefficient(mode, p[i], p[j], pmin[i], pmin[j], dist[k], re)
+            gx += q * (pos[j, 0] - pos[i, 0])
+            gy += q * (pos[j, 1] - pos[i, 1])
         gx *= a
         gy *= a
         if mode == 1:
-            mxx *= a
-            mxy *= a
-            myy *= a
-            det = mxx * myy - mxy * mxy
-            if det > 0.01:
-                gx, gy = (myy * gx - mxy * gy) / det, (mxx * gy - mxy * gx) / det
+            gx, gy = corrected(gx, gy, corrective(i, pos, kind, start, nbr, dist, re, a))
         out[i, 0] = gx
         out[i, 1] = gy
+    return out
+
+
+@njit(inline="always", **JIT)
+def corrective(i, pos, kind, start, nbr, dist, re, a):
+    """(mxx, mxy, myy, det): particle i's moment matrix a sum_j w r_ij r_ij^T / r^2 over its fluid and wall neighbours
+    and its determinant; corrected applies its inverse, the corrective matrix of Khayyer & Gotoh 2011."""
+    mxx = mxy = myy = 0.0
+    for k in range(start[i], start[i + 1]):
+        if dist[k] >= re or kind[nbr[k]] == DUMMY:
+            continue
+        j = nbr[k]
+        dx = pos[j, 0] - pos[i, 0]
+        dy = pos[j, 1] - pos[i, 1]
+        wr = weight(dist[k], re) / (dist[k] * dist[k])
+        mxx += dx * dx * wr
+        mxy += dx * dy * wr
+        myy += dy * dy * wr
+    mxx *= a
+    mxy *= a
+    myy *= a
+    return mxx, mxy, myy, mxx * myy - mxy * mxy
+
+
+@njit(inline="always", **JIT)
+def corrected(gx, gy, m):
+    """(gx, gy) times the inverse of the moment matrix m = corrective(...); unchanged where det <= 0.01 (near
+    singular)."""
+    mxx, mxy, myy, det = m
+    if det > 0.01:
+        return (myy * gx - mxy * gy) / det, (mxx * gy - mxy * gx) / det
+    return gx, gy
+
+
+@njit(**JIT)
+def wall_forces(pos, p, kind, start, nbr, dist, re, n0, mode, mass_over_rho):
+    """(N, 2) force [N] of each boundary particle on the liquid (0 at liquid particles): the terms of the fluid
+    particles' pressure gradients (gradient, same arguments) that come from their boundary neighbours, times -m /
+    rho0 (mass_over_rho [cm^2], l0^2 in 2D).  For the pairwise antisymmetric forms (PAIRWISE: symmetric, cmps,
+    variational) this is the momentum the walls exchange with the liquid, and floor plus side walls carry the
+    liquid's weight at rest; for the K&O forms it is the boundary neighbours' share of sums that are not pairwise
+    (the liquid's internal terms do not cancel).  Serial (a scatter onto the boundary particles)."""
+    pmin = neighbourhood_min(p, kind, start, nbr, dist, re) if mode in (0, 1, 3) else p
+    out = np.zeros((pos.shape[0], 2))
+    a = DIM / n0
+    m = (1.0, 0.0, 1.0, 1.0)
+    for i in range(pos.shape[0]):
+        if kind[i] != FLUID:
+            continue
+        first = True
+        for k in range(start[i], start[i + 1]):
+            j = nbr[k]
+            if kind[j] == FLUID or dist[k] >= re or not in_gradient(mode, kind[j]):
+                continue
+            q = a * pair_coefficient(mode, p[i], p[j], pmin[i], pmin[j], dist[k], re)
+            gx = q * (pos[j, 0] - pos[i, 0])
+            gy = q * (pos[j, 1] - pos[i, 1])
+            if mode == 1:
+                if first:
+                    m = corrective(i, pos, kind, start, nbr, dist, re, a)
+                    first = False
+                gx, gy = corrected(gx, gy, m)
+            out[j, 0] -= mass_over_rho * gx
+            out[j, 1] -= mass_over_rho * gy
     return out
 
 

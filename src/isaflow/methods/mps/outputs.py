@@ -13,6 +13,7 @@ import numpy as np
 import pandas as pd
 
 from isaflow import metrics, runfile
+from isaflow.core.units import G
 
 
 def noise(ds):
@@ -38,15 +39,53 @@ SIDE_LOAD = 3262.5  # N, rho g h^2 / 2 of the single tank (72.5 cm, 9000 N): the
 
 
 def side_loads(ds):
-    """Mean side-wall load [N] (left and right wall of the first vessel, |panel force| summed over the wall,
-    averaged over the window) and its error against SIDE_LOAD; NaN for tanks other than the single vessel."""
-    if ds.attrs.get("scene") != "single":
-        return np.nan, np.nan
-    names = [str(n) for n in ds["wall"].values]
-    mag = np.hypot(*ds["contact_force"].values.T)
-    cw = ds["contact_wall"].values
-    load = float(np.mean([mag[cw == names.index(w)].sum() for w in ("left", "right")]))
+    """Mean side-wall load [N] by the contacts' reading (pair forces for a momentum-conserving gradient, else the
+    panel pressures; run attribute wall_load_reading, wall_balance) and its error against SIDE_LOAD; NaN for tanks
+    other than the single vessel."""
+    load = wall_balance(ds, "pair" if ds.attrs.get("wall_load_reading") == "pair forces" else "panel")[0]
     return load, load / SIDE_LOAD - 1.0
+
+
+READINGS = {"pair": "hist_pair_force", "panel": "hist_panel_pressure_force"}  # wall-load readings: variable
+
+
+def wall_series(ds, reading="pair"):
+    """Wall loads of the single vessel per sample by one reading (READINGS: pair forces, the primary, or panel
+    pressures), each the mean over the steps of its sample interval: dict of (S,) arrays [N] side (the mean of
+    |sum of horizontal forces| on the left and right walls), floor (vertical force on the floor) and vertical (the
+    vertical forces of floor and side walls together: the liquid's weight at rest); None for other tanks, and
+    for the panel reading of a run file without it."""
+    if ds.attrs.get("scene") != "single" or READINGS[reading] not in ds:
+        return None
+    F = ds[READINGS[reading]].values
+    names = [str(n) for n in ds["wall"].values]
+    cw = ds["contact_wall"].values
+    left, floor, right = (F[:, cw == names.index(w)].sum(1) for w in ("left", "floor", "right"))
+    return dict(side=0.5 * (np.abs(left[:, 0]) + np.abs(right[:, 0])), floor=floor[:, 1],
+                vertical=left[:, 1] + floor[:, 1] + right[:, 1])
+
+
+def wall_balance(ds, reading="pair"):
+    """(side, floor, vertical) [N] of wall_series averaged over the run's averaging window; NaN where it has none."""
+    series = wall_series(ds, reading)
+    if series is None:
+        return np.nan, np.nan, np.nan
+    win = ds["in_window"].values.astype(bool)
+    return tuple(float(series[k][win].mean()) for k in ("side", "floor", "vertical"))
+
+
+def pressure_profile(pos, p, l0, rho_g, depth, below=2.5):
+    """(slope / rho g, rms scatter / (rho g depth)) of the liquid pressures p [N/cm^2] against depth below the
+    liquid's top (top particle centre + l0/2) for the particles deeper than ``below`` l0 (a least-squares line;
+    the top rows, where the free surface's P = 0 sits, are left out).  rho_g [N/cm^3], depth [cm]."""
+    d = pos[:, 1].max() + 0.5 * l0 - pos[:, 1]
+    deep = d > below * l0
+    if deep.sum() < 3:
+        return np.nan, np.nan
+    A = np.column_stack([d[deep], np.ones(int(deep.sum()))])
+    coef = np.linalg.lstsq(A, p[deep], rcond=None)[0]
+    res = p[deep] - A @ coef
+    return float(coef[0] / rho_g), float(np.sqrt(np.mean(res**2)) / (rho_g * depth))
 
 
 def escape_depth(ds):
@@ -82,6 +121,18 @@ def summary_row(path):
                deepest_graze_cm=float(a.get("deepest_graze_cm", 0.0)),
                reflected_particles=int(a.get("reflected_particles", 0)), reflect_steps=int(a.get("reflect_steps", 0)),
                ms_per_step=1e3 * float(ds["wall_time"]) / max(1, int(ds["force_evals"])))
+    W = float(ds.attrs.get("tank_weight", np.nan))
+    for reading in READINGS:
+        side_r, floor_r, vert_r = wall_balance(ds, reading)
+        row.update({f"side_err_{reading}": side_r / SIDE_LOAD - 1.0, f"floor_err_{reading}": floor_r / W - 1.0,
+                    f"vertical_err_{reading}": vert_r / W - 1.0})
+    if "pressure_mean" in ds:
+        rho_g = float(a["rho0_N_s2_cm4"]) * G
+        row["p_slope"], row["p_scatter"] = pressure_profile(ds["pos"].values, ds["pressure_mean"].values,
+                                                            float(a["spacing"]), rho_g, float(a["initial_depth"]))
+    row.update(window_energy_mean=float(a.get("window_energy_ratio_mean", np.nan)),
+               window_energy_max=float(a.get("window_energy_ratio_max", np.nan)),
+               gradient=a.get("gradient_model", ""))
     rel, absn, probe = noise(ds)
     u = ds["hist_rms_speed"].values
     row.update(panel_noise_rel=rel, panel_noise_N=absn, min_rms_speed_cm_s=float(u.min()),

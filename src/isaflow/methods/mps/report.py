@@ -7,6 +7,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from ...core.units import G
 from . import settings
 
 def _fmt(x, f="{:.3g}"):
@@ -90,16 +91,23 @@ def fragment(df, cfg):
     lines = ["## MPS with three pressure source terms", "",
              "Koshizuka & Oka's semi-implicit MPS as the public MPS-Basic code implements it (pressure equation over "
              "fluid and wall particles, dummies excluded, free-surface particles P = 0, compressibility term on the "
-             "diagonal, negative pressures clipped, gradient with the neighbourhood minimum, collision model), with "
-             f"K&O 1996's number-density radius {cfg['model.re_density']:g} l0 for the source term and the surface test "
-             "(only the outermost row is P = 0), wall and dummy rows behind both faces of the dividing wall (each face seen "
-             "only from its side), on the shared tank, with the pressure equation's source term as the variant: `standard` "
-             f"(rho0/dt^2)(n0 - n*)/n0, `hattori` (eq. 6 of Hattori et al., Rho* = rho0 n*/n0) and `mixed` (Tanaka & "
-             f"Masunaga 2010, gamma_m = {cfg['model.gamma_mixed']:g}), each multiplied by MPS-Basic's relaxation "
-             f"{cfg['model.relaxation']:g}.  For a liquid at rest div V* is about 0, so `hattori` is the standard source "
-             "on the tank; the flows are where they differ.  Wall loads are the first wall row's pressures integrated over "
-             f"10 cm panels, averaged over the last {cfg['time.average_window']:g} s; noise is the std over that window.  "
-             "Rest: isaflow.rest (one criterion for every dynamic method).", ""]
+             "diagonal, negative pressures clipped, collision model), with the pressure force of Hamiltonian MPS "
+             f"(Suzuki, Koshizuka & Oka 2007; `model.gradient` = `{cfg['model.gradient']}`): C sum_j (P_i + P_j) r_e r_ij / "
+             "r^3, the transpose of the number density's Jacobian, so pressure works only by changing number densities "
+             "(K&O's gradient with the neighbourhood minimum is a named option: the `kog_*` runs below).  One radius "
+             f"{cfg['model.re_density']:g} l0 for number density, gradient, surface test and Laplacian; wall and dummy rows "
+             "behind both faces of the dividing wall (each face seen only from its side), on the shared tank, with the "
+             "pressure equation's source term as the variant: `standard` (rho0/dt^2)(n0 - n*)/n0, `hattori` (eq. 6 of "
+             f"Hattori et al., Rho* = rho0 n*/n0) and `mixed` (Tanaka & Masunaga 2010, gamma_m = {cfg['model.gamma_mixed']:g}); "
+             f"MPS-Basic's relaxation {cfg['model.relaxation']:g} multiplies the density-deviation terms of standard and "
+             f"hattori (`relaxation_scope` = `{cfg['model.relaxation_scope']}`), never a velocity-divergence term.  For a "
+             "liquid at rest div V* is about 0, so `hattori` is the standard source on the tank; the flows are where they "
+             "differ.  Wall loads by two readings, each the mean over the steps of a sample interval (they alternate from "
+             "step to step): the pair-force reading (the wall particles' terms of the liquid's pressure gradients per 10 "
+             "cm panel, the momentum the walls exchange with the liquid; the contacts every comparison uses) and the panel "
+             "reading (first-row wall pressure times the wall length it faces); averaged over the last "
+             f"{cfg['time.average_window']:g} s.  Rest: isaflow.rest (one criterion for every dynamic method); a run's final "
+             "state is the mean and maximum of e = KE / (W h) over the rest window, never one sample.", ""]
     by_term = single.groupby("source_term", sort=False).agg(
         runs=("run", "size"), at_rest=("status", lambda x: int((x == "converged").sum())),
         escaped=("escapes", "sum"), side_err_min=("side_err_3262", "min"), side_err_max=("side_err_3262", "max"),
@@ -112,11 +120,39 @@ def fragment(df, cfg):
                               ("side_err_max", g), ("rms_min", g), ("rms_max", g), ("noise_median", g)],
                     ["source term", "runs", "at rest", "escaped", "side err min", "side err max", "final rms min cm/s",
                      "final rms max cm/s", "panel noise std/mean (median)"])
+    pct = lambda x: _fmt(100 * x, "{:+.1f}")  # noqa: E731
+    lines += ["", "Every single-vessel run: time to rest (from the start; n/a: not at rest), e over the last rest window "
+              "(mean, max), wall-load errors against the tank (side 3262.5 N, floor and floor + side-wall verticals W = "
+              "9000 N; %) by the pair-force and the panel reading, and the pressures below 2.5 l0 against depth (slope "
+              "over rho0 g, rms scatter over rho0 g h; window means):", ""]
+    lines += _table(single.sort_values(["source_term", "spacing_cm"], ascending=[True, False]),
+                    [("source_term", None), ("spacing_cm", g), ("status", None), ("time_to_rest_s", g),
+                     ("window_energy_mean", g), ("window_energy_max", g), ("side_err_pair", pct), ("side_err_panel", pct),
+                     ("floor_err_pair", pct), ("floor_err_panel", pct), ("vertical_err_pair", pct),
+                     ("vertical_err_panel", pct), ("p_slope", g), ("p_scatter", g)],
+                    ["source term", "l0 cm", "status", "rest from s", "e mean", "e max", "side % pair", "side % panel",
+                     "floor % pair", "floor % panel", "verticals % pair", "verticals % panel", "p slope / rho0 g",
+                     "p scatter / rho0 g h"])
+    before = df[df.case == "kog"]
+    if len(before):
+        lines += ["", "The same columns with the settings before issue 30 (`kog_*`: K&O gradient with the neighbourhood "
+                  "minimum, radii 2.1 / 2.1 / 3.1 / 2.1 l0, the whole hattori and mixed sources relaxed; "
+                  "figures/mps_rest.png, dashed).  Their contacts are the panel reading: the K&O gradient's sums are not "
+                  "pairwise, so its wall terms are no momentum exchange, and the pair column shows how little of the "
+                  "weight they carry (the liquid holds itself up by internal terms that do not cancel):", ""]
+        lines += _table(before.sort_values(["source_term", "spacing_cm"], ascending=[True, False]),
+                        [("source_term", None), ("spacing_cm", g), ("status", None), ("sim_time_s", g),
+                         ("window_energy_mean", g), ("window_energy_max", g), ("rms_speed_cm_s", g),
+                         ("side_err_pair", pct), ("side_err_panel", pct)],
+                        ["source term", "l0 cm", "status", "t end s", "e mean", "e max", "rms cm/s (window)",
+                         "side % pair", "side % panel"])
+    lines += ["", peer_comparison(df)]
     lines += [""] + _table(flow, [("run", None), ("tank", None), ("status", None), ("sim_time_s", g), ("mass_left_frac", g),
-                                  ("level", g), ("rms_speed_cm_s", g), ("time_to_rest_s", g), ("graze_steps", g),
-                                  ("message", None)],
+                                  ("level", g), ("rms_speed_cm_s", g), ("time_to_rest_s", g), ("escapes", g),
+                                  ("reflected_particles", g), ("reflect_steps", g), ("graze_steps", g), ("message", None)],
                            ["flow run", "tank", "status", "t end s", "mass left (fraction)", "second-vessel level cm",
-                            "final rms cm/s", "time to rest s", "graze steps", "why it stopped"])
+                            "rms cm/s (window)", "time to rest s", "escapes", "guard: particles reflected",
+                            "guard: steps", "graze steps", "why it stopped"])
     lines += ["", "Stiff and extreme cases (standard source, single vessel): " + "; ".join(
         f"{r.run.removeprefix('stiff_')}: {r.label}" for r in stiff.itertuples()) + ".", ""]
     lines += _table(stiff, [("run", None), ("status", None), ("rms_speed_cm_s", g), ("floor_err", g), ("message", None),
@@ -136,6 +172,34 @@ def fragment(df, cfg):
     lines += ["", "Settings and their sources: " + "; ".join(
         f"`{k}` = {v} ({cfg.sources[k]})" for k, v in cfg.items() if k.startswith(("model.", "time.courant", "pressure.solver"))), ""]
     return "\n".join(lines)
+
+
+# The peer MPS-Basic (C++, its default settings: K&O gradient, standard source with relaxation 0.2, collision model,
+# dt = 2 ms) on this project's single vessel at l0 = 1.25 cm (4,640 liquid particles), 3 s, measured by the
+# developers (../shared/peers.md, "MPS, hydrostatic column"): rms speed at 1 s and 3 s [cm/s], floor and side-wall
+# load errors averaged over 1-3 s against W and rho g h^2 / 2, ms per step on one thread.  Not at rest.
+PEER = dict(code="MPS-Basic", spacing_cm=1.25, rms_1s=8.3, rms_3s=8.7, floor_err=0.018, side_err=0.023, ms_per_step=46.0)
+
+
+def peer_comparison(df):
+    """Sentence: the peer MPS-Basic against the project's standard-source single runs (the run at the peer's spacing
+    when there is one), numbers from the table and PEER."""
+    depth = 72.5  # cm, the tank's depth (the peer's 58 rows of 1.25 cm are exactly the tank's liquid)
+    e_peer = PEER["rms_3s"] ** 2 / (2 * G * depth)  # KE / (W h) of equal masses (isaflow.rest)
+    mine = df[(df.source_term == "standard") & df.case.isin(["single", "peer"])].sort_values("spacing_cm")
+    if not len(mine):
+        return ""
+    parts = [f"l0 = {r.spacing_cm:.3g} cm: {r.status}" + (f" from {r.time_to_rest_s:.3g} s" if r.status == "converged" else "")
+             + f", e over the last rest window {r.window_energy_mean:.2g} (max {r.window_energy_max:.2g}), side "
+             f"{100 * r.side_err_pair:+.1f} %, floor {100 * r.floor_err_pair:+.1f} % (pair forces; panel reading "
+             f"{100 * r.side_err_panel:+.1f} / {100 * r.floor_err_panel:+.1f} %), {r.ms_per_step:.3g} ms per step"
+             for r in mine.itertuples()]
+    return (f"Peer: {PEER['code']} with its defaults on this tank at l0 = {PEER['spacing_cm']:g} cm (../shared/peers.md) is "
+            f"not at rest: rms {PEER['rms_1s']:g} / {PEER['rms_3s']:g} cm/s at 1 / 3 s, e = {e_peer:.2g} at 3 s, floor "
+            f"{100 * PEER['floor_err']:+.1f} %, side {100 * PEER['side_err']:+.1f} % (averages over 1-3 s, its own panel "
+            f"pressures), {PEER['ms_per_step']:g} ms per step on one thread.  This project's standard source: "
+            + "; ".join(parts) + ".  Same tank (weight, depth, rho g); the project's spacings other than the peer's hold "
+            "whole rows (72.22 / 72.41 cm, weight held at 9000 N).")
 
 
 def cost(bench, target_n=5000, target_ms=50.0):
@@ -168,8 +232,10 @@ def timing(df, cfg, bench):
 
 SINGLE_TABLE = "mps_single.csv"  # every single-vessel run, next to the report
 SINGLE_COLUMNS = ["run", "source_term", "spacing_cm", "particles", "status", "side_err_3262", "side_err", "floor_err",
-                  "contact_rms", "panel_noise_rel", "rms_speed_cm_s", "energy_ratio", "time_to_rest_s", "escapes",
-                  "graze_steps", "deepest_graze_cm"]
+                  "side_err_pair", "side_err_panel", "floor_err_pair", "floor_err_panel", "vertical_err_pair",
+                  "vertical_err_panel", "p_slope", "p_scatter", "contact_rms", "panel_noise_rel", "rms_speed_cm_s",
+                  "window_energy_mean", "window_energy_max", "time_to_rest_s", "escapes", "graze_steps",
+                  "deepest_graze_cm"]
 
 
 def write(summary, cfg, bench, outputs):

@@ -8,6 +8,7 @@ Rest: isaflow.rest (one criterion for every dynamic method).  Units: cm, N, s; p
 (2D, per cm of thickness).
 """
 
+import collections
 import os
 import time
 
@@ -76,6 +77,7 @@ class State:
         self.tside = np.ones(n, np.int64)
         self.tw[self.nf:] = thin_idx[self.bnd["wall"]]
         self.tside[self.nf:] = self.bnd["side"]
+        self.gravity = (0.0, -units.G)  # cm/s^2 (the energy test sets it to zero)
         self.vel = np.zeros_like(self.pos)
         self.vel[: self.nf] = fluid_vel
         self.p = np.zeros(n)
@@ -85,8 +87,10 @@ class State:
         self.re_s = cfg["model.re_surface"] * l0
         self.rmax = max(self.re_n, self.re_g, self.re_l, self.re_s)
         self.skin = cfg["model.list_skin"] * l0
+        self.grad_mode = model.GRADIENTS[cfg["model.gradient"]]
         self.n0_n, _ = model.lattice_constants(cfg["model.re_density"], l0)
-        self.n0_g, _ = model.lattice_constants(cfg["model.re_gradient"], l0)
+        self.n0_g, _ = model.lattice_constants(cfg["model.re_gradient"], l0)  # divergence, surface extrapolation
+        self.n_grad = model.gradient_norm(self.grad_mode, cfg["model.re_gradient"])  # the gradient's d / n_grad
         self.n0_s, _ = model.lattice_constants(cfg["model.re_surface"], l0)
         self.n0_l, self.lam = model.lattice_constants(cfg["model.re_laplacian"], l0)
         self.weight = tank.weight / self.nf  # N per particle
@@ -98,10 +102,11 @@ class State:
         self.graze_depth = cfg["walls.graze_depth"] * l0  # cm: deeper crossings are escapes
         self.grazes, self.deepest_graze = 0, 0.0  # steps with a graze, deepest graze [cm]
         self.reflect_steps, self.reflections = 0, 0  # steps with a wall reflection, particles reflected (walls.reflect)
-        self.panel_wall, self.panel_centre, self.panel_side, self.load_matrix = boundary.load_map(
+        self.panel_wall, self.panel_centre, self.panel_side, self.load_matrix, self.share = boundary.load_map(
             self.walls, self.bnd, cfg["walls.panel_length"])
+        self.pair_state = None  # (positions, distances, list start, list) of the last pressure gradient
+        self.load_sum, self.p_sum, self.sum_time = np.zeros((2 * len(self.panel_wall), 2)), np.zeros(self.nf), 0.0
         self.surface_mode = model.SURFACE[cfg["model.surface_pressure"]]
-        self.grad_mode = model.GRADIENTS[cfg["model.gradient"]]
         self.lap_mode = model.LAPLACIANS[cfg["model.pressure_laplacian"]]
         self.div_mode = model.DIVERGENCES[cfg["model.divergence"]]
         self.n_prev = None  # number density at the start of the previous step (ECS)
@@ -141,8 +146,37 @@ class State:
             self.reflections += n_hit
 
     def panel_forces(self):
-        """(P, 2) force of each wall panel on the liquid [N] from the wall particles' pressures."""
+        """(P, 2) force of each wall panel on the liquid [N] from the wall particles' pressures: the first row's
+        pressure times the length of wall it faces (the panel reading)."""
         return (self.load_matrix @ self.p[self.nf:]).reshape(-1, 2)
+
+    def accumulate(self, dt):
+        """Add this step's wall loads by both readings and the liquid's pressures, times dt, to the sums since the
+        last take_means (the momentum the walls exchanged, and the pressure's time integral)."""
+        self.load_sum += dt * np.concatenate([self.pair_forces(), self.panel_forces()])
+        self.p_sum += dt * self.p[: self.nf]
+        self.sum_time += dt
+
+    def take_means(self):
+        """(pair-force loads (P, 2) N, panel loads (P, 2) N, liquid pressures (nf,) N/cm^2): the means over the steps
+        since the last call (the current values if no step was taken), and start new sums."""
+        if self.sum_time > 0.0:
+            load, p = self.load_sum / self.sum_time, self.p_sum / self.sum_time
+        else:
+            load, p = np.concatenate([self.pair_forces(), self.panel_forces()]), self.p[: self.nf].copy()
+        self.load_sum, self.p_sum, self.sum_time = np.zeros((2 * len(self.panel_wall), 2)), np.zeros(self.nf), 0.0
+        return load[: len(self.panel_wall)], load[len(self.panel_wall):], p
+
+    def pair_forces(self):
+        """(P, 2) force of each wall panel's boundary particles on the liquid [N]: the wall-liquid pair terms of
+        the last step's pressure gradient (model.wall_forces, at the positions and pressures it used; the
+        pair-force reading, the momentum the walls exchange with the liquid)."""
+        if self.pair_state is None:
+            return np.zeros((len(self.panel_wall), 2))
+        pos, dist, start, nbr = self.pair_state
+        f = model.wall_forces(pos, self.p, self.kind, start, nbr, dist, self.re_g, self.n_grad, self.grad_mode,
+                              self.weight / units.G / self.rho0)
+        return self.share @ f[self.nf:]
 
 
 def step(s, dt, source, cfg, timers=None):
@@ -164,7 +198,7 @@ def step(s, dt, source, cfg, timers=None):
         n_now = model.number_density(s.start, s.nbr, dist, s.re_n)
         b_ecs = model.ecs_term(n_now, n_now if s.n_prev is None else s.n_prev, s.n0_n, s.rho0, dt)
         s.n_prev = n_now
-    ps, vs = model.explicit(s.pos, s.vel, s.kind, lap, dt, 0.0, -units.G, nu)
+    ps, vs = model.explicit(s.pos, s.vel, s.kind, lap, dt, s.gravity[0], s.gravity[1], nu)
     if not s.list_valid(ps):
         s.neighbours(ps)
     coll = cfg["model.collision_distance"] * s.l0
@@ -186,7 +220,7 @@ def step(s, dt, source, cfg, timers=None):
     dist_thr = cfg["model.surface_distribution"] * s.l0
     surf, normal = model.surface(ps, s.kind, s.start, s.nbr, dist, s.re_s, s.n0_s, cfg["model.beta"], dist_thr, s.rmax)
     b = model.source_term_all(n_star, div, s.n0_n, s.rho0, dt, model.SOURCES[source], cfg["model.gamma_mixed"],
-                              cfg["model.relaxation"], cfg["model.relax_all_sources"])
+                              cfg["model.relaxation"], model.RELAX_SCOPES[cfg["model.relaxation_scope"]])
     if ecs:
         b = b + b_ecs
     p_dir = np.zeros(len(ps))
@@ -219,7 +253,8 @@ def step(s, dt, source, cfg, timers=None):
     p[unk] = x[row[unk]]
     if cfg["model.clip_negative"]:
         p = np.maximum(p, 0.0)
-    g = model.gradient(ps, p, s.kind, s.start, s.nbr, dist, s.re_g, s.n0_g, s.grad_mode)
+    g = model.gradient(ps, p, s.kind, s.start, s.nbr, dist, s.re_g, s.n_grad, s.grad_mode)
+    s.pair_state = (ps, dist, s.start, s.nbr)
     pos, vel = model.update(ps, vs, s.kind, g, s.rho0, dt)
     c = cfg["model.shifting"]
     if c > 0.0:
@@ -232,6 +267,7 @@ def step(s, dt, source, cfg, timers=None):
         s.count_reflections(hit)
     bad, graze = model.check(pos_old, pos, vel, s.kind, s.walls, s.escape_box, s.graze_depth)
     s.pos, s.vel, s.p = pos, vel, p
+    s.accumulate(dt)  # wall loads: the momentum exchanged over a sample interval, not one step's force
     s.surf = surf
     if graze > 0.0:
         s.grazes += 1
@@ -294,11 +330,12 @@ def _solve(tank, cfg, variant, l0, t_end, probes, start, snapshots, log, threads
     elapsed, next_sample, dt_min, short_steps = 0.0, sample_dt, dt0, 0
     monitor = rest.Monitor(rest_cfg["energy_ratio"], rest_cfg["window"])
     probes = np.asarray(probes, float).reshape(-1, 2)
-    rec = {k: [] for k in ("time", "panel", "probe", "rms", "vmax", "energy", "count", "resid", "iters", "surf")}
+    rec = {k: [] for k in ("time", "pair", "panel", "probe", "rms", "vmax", "energy", "count", "resid", "iters", "surf")}
     snaps, snap_t = [], []
     fail_tol = cfg["pressure.rtol"] * cfg["pressure.fail_factor"]
     status, message, max_resid, iters = None, "", 0.0, []
     timers = np.zeros(3)
+    p_means = collections.deque(maxlen=int(np.ceil(cfg["time.average_window"] / sample_dt)) + 2)  # (t, interval mean)
     wall0 = time.perf_counter()
     last_log = wall0
     k = 0
@@ -341,7 +378,10 @@ def _solve(tank, cfg, variant, l0, t_end, probes, start, snapshots, log, threads
             e = rest.energy_ratio(0.5 * speed2.sum() * s.weight / units.G, s.weight * s.nf, depth0)
             at_rest = monitor.update(t, e)
             rec["time"].append(t)
-            rec["panel"].append(s.panel_forces())
+            pair, panel, p_mean = s.take_means()
+            rec["pair"].append(pair)
+            rec["panel"].append(panel)
+            p_means.append((t, p_mean))
             rec["probe"].append(model.probe_pressure(s.pos, s.p, s.kind, probes, s.re_n))
             rec["rms"].append(np.sqrt(speed2.mean()))
             rec["vmax"].append(np.sqrt(speed2.max()))
@@ -368,17 +408,31 @@ def _solve(tank, cfg, variant, l0, t_end, probes, start, snapshots, log, threads
             last_log = now
     wall = time.perf_counter() - wall0
     rms = float(np.sqrt((s.vel[: s.nf] ** 2).sum(1).mean()))
+    times = np.array(rec["time"])
+    e_mean, e_max = rest.window_stats(times, np.array(rec["energy"]), monitor.window)
+    rms_window = rest.speed_at(e_mean, depth0)  # rms speed of the window's mean kinetic energy
     if status is None:
         status = "step_limit"
-        message = (f"step {step0 + k}: t = {t0 + elapsed:.3f} s (time limit), rms speed {rms:.3g} cm/s, kinetic energy / "
-                   f"(W h) {monitor.last:.3g} (rest: below {monitor.limit:g} for {monitor.window:g} s)")
+        message = (f"step {step0 + k}: t = {t0 + elapsed:.3f} s (time limit), kinetic energy / (W h) over the last "
+                   f"{monitor.window:g} s: mean {e_mean:.3g}, max {e_max:.3g} (rms speed {rms_window:.3g} cm/s; rest: below "
+                   f"{monitor.limit:g} for {monitor.window:g} s)")
     t_rest = monitor.time_to_rest() - t0 if status == "converged" else np.nan
-    times = np.array(rec["time"])
-    panels = np.array(rec["panel"])
+    pairwise = s.grad_mode in model.PAIRWISE  # momentum exchange is defined: the pair forces are the contacts
+    panels = np.array(rec["pair" if pairwise else "panel"])
     window = times >= times[-1] - cfg["time.average_window"] + 1e-12
     hist = {
         "hist_time": (("sample",), times, "s", "time of sample"),
-        "hist_panel_force": (("sample", "contact", "xy"), panels, "N", "force of each wall panel on the liquid"),
+        "hist_panel_force": (("sample", "contact", "xy"), panels, "N",
+                             "force of each wall panel on the liquid, the contacts' reading: " + ("pair forces (hist_pair_force)"
+                             if pairwise else "panel pressures (hist_panel_pressure_force; this gradient's pair terms are "
+                             "not antisymmetric, so they are no momentum exchange)")),
+        "hist_pair_force": (("sample", "contact", "xy"), np.array(rec["pair"]), "N",
+                            "force of each wall panel's boundary particles on the liquid: the wall-liquid pair terms of "
+                            "the pressure gradient (pair-force reading, model.wall_forces), mean over the steps since the "
+                            "previous sample (momentum exchanged / interval)"),
+        "hist_panel_pressure_force": (("sample", "contact", "xy"), np.array(rec["panel"]), "N",
+                                      "force of each wall panel on the liquid: first-row wall pressure times the wall "
+                                      "length it faces (panel reading), mean over the steps since the previous sample"),
         "hist_probe_pressure": (("sample", "probe"), np.array(rec["probe"]).reshape(len(times), -1), "N cm-2", "pressure at fixed probe",
                                 {"missing": "no liquid particle within the probe's radius (a dry probe)"}),
         "hist_rms_speed": (("sample",), np.array(rec["rms"]), "cm s-1", "rms speed of the liquid particles"),
@@ -394,8 +448,12 @@ def _solve(tank, cfg, variant, l0, t_end, probes, start, snapshots, log, threads
     if snaps:
         hist["snap_time"] = (("snapshot",), np.array(snap_t), "s", "time of position snapshot")
         hist["snap_pos"] = (("snapshot", "particle", "xy"), np.array(snaps), "cm", "liquid particle positions at snapshot")
+    p_window = [q for tq, q in p_means if tq >= times[-1] - cfg["time.average_window"] + 1e-12]
     fields = {
         "pressure": (("particle",), s.p[: s.nf].copy(), "N cm-2", "pressure of each liquid particle at the end"),
+        "pressure_mean": (("particle",), np.mean(p_window, axis=0), "N cm-2",
+                          "pressure of each liquid particle, mean over the steps of the averaging window (the pressure "
+                          "alternates from step to step)"),
         "velocity": (("particle", "xy"), s.vel[: s.nf].copy(), "cm s-1", "velocity of each liquid particle at the end"),
     }
     nb = np.bincount(s.kind, minlength=3)
@@ -406,6 +464,7 @@ def _solve(tank, cfg, variant, l0, t_end, probes, start, snapshots, log, threads
         "short_steps": short_steps, "rho0_N_s2_cm4": s.rho0, "particle_weight_N": s.weight,
         "re_density_cm": s.re_n, "re_gradient_cm": s.re_g, "re_laplacian_cm": s.re_l, "re_surface_cm": s.re_s,
         "n0_density": s.n0_n, "n0_laplacian": s.n0_l, "n0_gradient": s.n0_g, "n0_surface": s.n0_s,
+        "gradient_norm": s.n_grad, "relaxation_scope": cfg["model.relaxation_scope"],
         "lambda_cm2": s.lam, "beta": cfg["model.beta"], "relaxation": cfg["model.relaxation"],
         "sound_speed_cm_s": cfg["model.sound_speed"], "surface_pressure": cfg["model.surface_pressure"],
         "gradient_model": cfg["model.gradient"], "shifting": cfg["model.shifting"],
@@ -425,10 +484,12 @@ def _solve(tank, cfg, variant, l0, t_end, probes, start, snapshots, log, threads
         "layer_pitch": l0, "held_weight": float(s.weight * s.nf), "initial_depth": depth0, "tank_difference": rows_note,
         "rest_energy_ratio": monitor.limit, "rest_window": monitor.window, "rest_depth_cm": depth0,
         "time_to_rest": t_rest, "final_energy_ratio": monitor.last, "final_rms_speed_cm_s": rms,
+        "window_energy_ratio_mean": e_mean, "window_energy_ratio_max": e_max, "window_rms_speed_cm_s": rms_window,
+        "wall_load_reading": "pair forces" if pairwise else "panel pressures",
     }
     return Result(
         method="mps", variant=variant, pos0=pos0, pos=s.pos[: s.nf].copy(), weight=np.full(s.nf, s.weight),
         contact_wall=s.panel_wall, contact_point=s.panel_centre, contact_force=panels[window].mean(0),
         status=status, message=message, steps=step0 + k, start_step=step0, wall_time=wall, force_evals=k,
-        residual=rms, residual_name="rms speed", residual_units="cm s-1", sim_time=t0 + elapsed,
+        residual=rms_window, residual_name=f"rms speed over the last {monitor.window:g} s", residual_units="cm s-1", sim_time=t0 + elapsed,
         history=hist, fields=fields, params=params)
