@@ -81,6 +81,11 @@ def code(*modules):
     """Source files (src/isaflow/...) of the given modules and everything they import (isaflow.deps), so
     editing any of them reruns the rule.  A module is a dotted name ('isaflow.run', 'methods.isa.tables')
     or a path glob under src/isaflow without '.py' ('methods/sph/*')."""
+    return list(_code(modules))
+
+
+@functools.cache
+def _code(modules):
     names = []
     for m in modules:
         if os.path.sep in m or "*" in m:
@@ -88,7 +93,7 @@ def code(*modules):
                       for f in sorted(glob.glob(f"src/isaflow/{m}.py"))]
         else:
             names.append(m)
-    return _deps.closure(*names)
+    return tuple(_deps.closure(*names))
 
 
 def func_code(func):
