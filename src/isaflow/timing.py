@@ -27,6 +27,18 @@ JOBS = Path("logs") / "timing" / "jobs.jsonl"
 PHASES = ("solve", "compile", "start-up", "other work", "scheduling")
 
 
+def job_start(job):
+    """Start of every job script (job: Snakemake's ``snakemake`` object), before numpy loads: BLAS, OpenMP and
+    numba run on the rule's threads (a threaded OpenBLAS sums in an order that varies from run to run, and two
+    runs of the same commit must give byte-identical physics outputs), stderr goes to the rule's log.
+    Returns the epoch time the script started (for :func:`record`)."""
+    started = time.time()
+    for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
+        os.environ[var] = str(job.threads)
+    sys.stderr = open(job.log[0], "w", buffering=1)
+    return started
+
+
 def process_start():
     """Epoch time [s] this process started (Linux /proc; the current time elsewhere)."""
     try:

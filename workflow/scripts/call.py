@@ -11,22 +11,15 @@ import os
 import sys
 import time
 
-_script_start = time.time()
-
-# BLAS/OpenMP threads = the rule's threads (1 unless it asks for more), set before numpy loads: a threaded
-# OpenBLAS sums in an order that varies from run to run, and two runs of the same commit must give
-# byte-identical physics outputs.
-for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
-    os.environ[_var] = str(snakemake.threads)  # noqa: F821
-
-sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 # the project's source of this checkout (src/ next to workflow/), ahead of any installed copy: the rules run
 # the checked-out code without an (editable) install tied to one checkout
 sys.path.insert(0, os.path.realpath(os.path.join(os.path.dirname(__file__), "..", "..", "src")))
+from isaflow import timing  # noqa: E402  (imports nothing numerical: threads are set before numpy loads)
+
+_script_start = timing.job_start(snakemake)  # noqa: F821
 # the command run files record: the rule and function, not Snakemake's temporary copy of this script
 sys.argv = ["snakemake", f"rule {snakemake.rule}:", f"isaflow.{snakemake.params.func}", "->", *snakemake.output]  # noqa: F821
 
-from isaflow import timing  # noqa: E402
 from isaflow.inputs import InputError  # noqa: E402
 from isaflow.runfile import RunFileError  # noqa: E402
 

@@ -6,13 +6,13 @@ import os
 import sys
 import time
 
-_script_start = time.time()
-for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
-    os.environ[_var] = str(snakemake.threads)  # noqa: F821
-sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
+# the project's source of this checkout (src/ next to workflow/), ahead of any installed copy: the rules run
+# the checked-out code without an (editable) install tied to one checkout
 sys.path.insert(0, os.path.realpath(os.path.join(os.path.dirname(__file__), "..", "..", "src")))
+from isaflow import timing  # noqa: E402  (imports nothing numerical: threads are set before numpy loads)
 
-from isaflow import run, timing  # noqa: E402
+_script_start = timing.job_start(snakemake)  # noqa: F821
+from isaflow import run  # noqa: E402
 from isaflow.core import jit  # noqa: E402
 
 _imported = time.time()

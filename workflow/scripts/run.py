@@ -8,28 +8,23 @@ import os
 import sys
 import time
 
-_script_start = time.time()
-# BLAS/OpenMP/numba threads = the rule's threads, set before numpy loads (byte-identical outputs)
-for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
-    os.environ[_var] = str(snakemake.threads)  # noqa: F821
-
-sys.stderr = open(snakemake.log[0], "w", buffering=1)  # noqa: F821
 # the project's source of this checkout (src/ next to workflow/), ahead of any installed copy: the rules run
 # the checked-out code without an (editable) install tied to one checkout
 sys.path.insert(0, os.path.realpath(os.path.join(os.path.dirname(__file__), "..", "..", "src")))
+from isaflow import timing  # noqa: E402  (imports nothing numerical: threads are set before numpy loads)
 
-from isaflow import run, timing  # noqa: E402
+_script_start = timing.job_start(snakemake)  # noqa: F821
+from isaflow import run  # noqa: E402
 
 _imported = time.time()
 codes, solve_s = [], 0.0
 for (method, run_id, decl), out in zip(snakemake.params.runs, snakemake.output):  # noqa: F821
     command = ["snakemake", f"rule {snakemake.rule}: {method}/{run_id}", "->", out]  # noqa: F821
-    code, result = run.run_with_result(method, decl["tank_file"], decl["variant"], decl["resolution"], out,
-                           settings_path=decl["settings_file"], overrides=decl.get("set", {}),
-                           start=decl.get("start_file"), accept=decl.get("accept", ["converged"]),
-                           threads=snakemake.threads, run_id=run_id, command=command,  # noqa: F821
-                           label=decl.get("label", ""), stability=decl.get("stability", False),
-                           max_hours=decl.get("max_hours"))
+    code, result = run.run_with_result(
+        method, decl["tank_file"], decl["variant"], decl["resolution"], out, settings_path=decl["settings_file"],
+        overrides=decl.get("set", {}), start=decl.get("start_file"), accept=decl.get("accept", ["converged"]),
+        threads=snakemake.threads, run_id=run_id, command=command, label=decl.get("label", ""),  # noqa: F821
+        stability=decl.get("stability", False), max_hours=decl.get("max_hours"))
     codes.append(code)
     solve_s += result.wall_time if result is not None else 0.0
 timing.record(snakemake.rule, snakemake.output[0], _script_start, _imported, solve_s, len(codes))  # noqa: F821
