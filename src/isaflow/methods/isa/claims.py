@@ -14,8 +14,13 @@ range is a *sweep* here (:data:`SWEEPS`): per value, the runs that stand in for 
 the value changes (a measure that needs one of them without a stand-in has no run for that value), and
 the parameters of readings that need no run (the level definition).  A measure is written once, as a
 core ``core(view, entry) -> Out``; the same core runs on a :class:`View` of the context per swept value,
-and ``sensitivity`` lists the test's outcome at every value ('passes' / 'fails' / 'no run').  Aggregate
+and ``sensitivity`` lists the test's outcome at every value ('passes' / 'fails' / 'no run'); the same outcomes
+go to the measurement's ``sweep`` (isaflow.claims.robustness decides robust or fragile from them).  Aggregate
 claims (every run converges) judge, in a sweep, the runs the value has (``partial``), and say so.
+
+The paper's version.  Where the project added something the paper does not have and the paper's version was
+run (:data:`PAPER_VERSION`: the cycle stop switched off), every row resting on that input is judged on the
+paper's version's runs; the project's kept value is then one more value of the sweep.
 
 Units: cm, N, s.
 """
@@ -169,12 +174,13 @@ SWEEPS = {
         ("+ a/4", {}, _never, {"level": "top centres + a/4"}),
         ("+ 5 cm (the paper's y_in)", {}, _never, {"level": "top centres + 5 cm"}),
     ],
-    "step_limit": [
-        (f"{f} x the paper's steps (cycle stop off)", _subs(NOCYCLE), _isa, {"n_u": f}) for f in (10, 25, 100)
+    "step_limit": [  # the paper's version of the stop rule (cycle stop off) runs to 100 x: the judged value
+        (f"{f} x the paper's steps{' (kept)' if f == 100 else ''} (cycle stop off)", _subs(NOCYCLE), _isa, {"n_u": f})
+        for f in (10, 25, 100)
     ],
     "cycle_detector": [
-        ("on (kept)", {}, _never, {}),
-        ("off (to 100 x the paper's steps)", _subs(NOCYCLE), _isa, {"n_u": 100}),
+        ("on (the project's addition)", {}, _never, {}),
+        ("off (the paper's stop rule, to 100 x the paper's steps)", _subs(NOCYCLE), _isa, {"n_u": 100}),
     ],
     "second_floor_drop": [_drop(20), _drop(32), ("50 cm (kept)", {}, _never, {}), _drop(80), _drop(100)],
     "flow_start_state": [
@@ -226,35 +232,73 @@ SWEEPS = {
     ],
 }
 PARTIAL = {"pap-abs-converges", "pap-7-isa-oscillations", "pap-5-rigid", "pap-5-incompressible"}  # aggregates: a sweep judges what it has
+# inputs whose paper's version was run: the label of that value in SWEEPS (rows resting on them are judged there)
+PAPER_VERSION = {"cycle_detector": "off (the paper's stop rule, to 100 x the paper's steps)"}
+
+
+def _value(name, label):
+    return next(v for v in SWEEPS[name] if v[0] == label)
+
+
+def judged_at(entry):
+    """{input: label} of the paper's versions a row is judged at (its inferred inputs in PAPER_VERSION)."""
+    return {n: PAPER_VERSION[n] for n in entry.get("inferred_inputs", []) if n in PAPER_VERSION}
+
+
+def base_view(ctx, entry):
+    """The view a row is judged on: the run substitutions of the paper's versions it rests on."""
+    subs, params = {}, {}
+    for name, label in judged_at(entry).items():
+        _, s, _, p = _value(name, label)
+        subs.update(s)
+        params.update(p)
+    return View(ctx, subs, None, params)
+
+
+def _kept(name, label, at):
+    """True when a sweep value is the one the row is judged at (the paper's version, else the kept value)."""
+    return label == at[name] if name in at else "(kept)" in label
 
 
 def sensitivity(ctx, entry, core, kept):
-    """'input: value -> passes / fails (short) / no run; ...' over every swept inferred input of the entry."""
-    parts, unswept = [], []
+    """('input: value -> passes / fails (short) / no run; ...' over every swept inferred input of the entry,
+    the same outcomes as ((input, value, passed), ...) for isaflow.claims.robustness)."""
+    parts, unswept, sweep = [], [], []
+    at = judged_at(entry)
+    base = base_view(ctx, entry)
     for name in entry.get("inferred_inputs", []):
         if name not in SWEEPS:
             unswept.append(name)
             continue
         vals = []
         for label, subs, affected, params in SWEEPS[name]:
-            if "(kept)" in label:
+            if _kept(name, label, at):
                 vals.append(f"{label}: {_word(kept.passed)}" + (f" ({kept.short})" if kept.short else ""))
+                sweep.append((name, label, kept.passed))
                 continue
-            view = View(ctx, subs, affected, params, partial=entry["id"] in PARTIAL)
+            if name in at:  # the other values of a paper's-version input replace its substitutions
+                view = View(ctx, subs, affected, params, partial=entry["id"] in PARTIAL)
+            else:
+                view = View(ctx, {**base.subs, **subs}, affected, {**base.params, **params},
+                            partial=entry["id"] in PARTIAL)
             try:
                 o = core(view, entry)
             except NoRun as err:
                 vals.append(f"{label}: no run ({err.args[0]})")
+                sweep.append((name, label, None))
                 continue
             except Missing as err:
                 vals.append(f"{label}: no run ({err.args[0]} missing)")
+                sweep.append((name, label, None))
                 continue
             vals.append(f"{label}: {_word(o.passed)}" + (f" ({o.short})" if o.short else "")
                         + (f" [{o.partial}]" if o.partial else ""))
+            # an aggregate ('every run ...') judged on part of its runs: a failure stands, a pass proves nothing
+            sweep.append((name, label, None if o.partial and o.passed else o.passed))
         parts.append(f"{name}: " + "; ".join(vals))
     if unswept:
         parts.append("not swept: " + ", ".join(unswept))
-    return " | ".join(parts)
+    return " | ".join(parts), tuple(sweep)
 
 
 def _word(passed):
@@ -269,13 +313,16 @@ def measure(evidence=""):
             return _claim_outcome(test(view, entry), entry)
 
         def fn(ctx, entry):
-            view = View(ctx)
+            view = base_view(ctx, entry)
             out = core(view, entry)
             runs = [_path(ctx, k) for k in view.read]
-            ev = "; ".join(x for x in [evidence, ", ".join(r for r in runs if r)] if x)
+            at = judged_at(entry)
+            judged = ("judged at the paper's version: " + "; ".join(f"{n} {v}" for n, v in at.items())) if at else ""
+            ev = "; ".join(x for x in [evidence, judged, ", ".join(r for r in runs if r)] if x)
+            text, sweep = sensitivity(ctx, entry, core, out)
             return Measurement(measured=out.measured, passed=None if out.passed is None else bool(out.passed),
                                evidence=ev, why=out.why if out.passed is False else "", margin=out.margin,
-                               sensitivity=sensitivity(ctx, entry, core, out))
+                               sensitivity=text, sweep=sweep)
 
         fn.core = core
         return fn
