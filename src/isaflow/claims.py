@@ -12,6 +12,10 @@ holding one of its own); :func:`verdict` turns that into the verdict:
   to match it (``calibrated_against`` in the registry's inputs);
 - ``reproduced`` / ``not reproduced``: the test passed / failed.
 
+A ``project deviation`` row (a point where this project departs from the paper by its own choice) is judged on
+the paper's version when that was run (``deviation.runs``); otherwise it is ``not testable here`` and its
+measurement describes what the project does instead.
+
 Robustness.  A verdict is ``robust`` when it holds at both ends of every inferred input it rests on and
 ``fragile`` when some value of an input's range flips it (the input and the values where it flips are named).
 The evidence is the measure's ``sweep`` (the test at other values of the inputs, from runs or readings) or,
@@ -133,8 +137,11 @@ def calibrated_inputs(entry, inputs):
 
 
 def verdict(entry, m, inputs):
-    """The verdict of one claim from its Measurement (module docstring)."""
+    """The verdict of one claim from its Measurement (module docstring).  A project deviation whose paper's
+    version is not run (no deviation.runs) is not testable here: its measure describes the project's choice."""
     if not entry.get("testable") or m is None or m.passed is None:
+        return "not testable here"
+    if entry["kind"] == "project deviation" and not entry["deviation"].get("runs"):
         return "not testable here"
     if not m.passed:
         return "not reproduced"
@@ -142,15 +149,17 @@ def verdict(entry, m, inputs):
     return f"reproduced only after calibrating {', '.join(cal)}" if cal else "reproduced"
 
 
-def robustness(entry, m):
+def robustness(entry, m, inputs=None):
     """(class, flips, evidence) of a judged row (module docstring): class one of ROBUSTNESS; flips 'input: values
-    where the verdict flips' ('; '-joined); evidence one line per input."""
+    where the verdict flips' ('; '-joined); evidence one line per input.  inputs: {input id: input} of the
+    registry (an input's own robustness argument stands for the rows whose measure does not sweep it)."""
     names = entry.get("inferred_inputs", [])
     if not entry.get("testable") or m is None or m.passed is None:
         return "robust", "", "no test runs on any value of its inputs: the verdict is 'not testable here' at every one"
     if not names:
         return "robust", "", "rests on no inferred input"
-    argued = entry.get("robustness", {})
+    argued = {n: (inputs or {}).get(n, {}).get("robustness") for n in names}
+    argued = {n: a for n, a in argued.items() if a} | entry.get("robustness", {})
     flips, evidence, unswept = [], [], []
     for name in names:
         vals = [(v, p) for i, v, p in m.sweep if i == name]
@@ -197,7 +206,7 @@ def judge(ctx, claims=None, inputs=None, found=None):
                 m = found[e["id"]](ctx, e)
             except Missing as err:
                 m = Measurement(f"needs {err.args[0]}, which this workflow did not make", None)
-        rob, flips, rob_ev = robustness(e, m)
+        rob, flips, rob_ev = robustness(e, m, inputs)
         post = (e.get("tolerance") or {}).get("post_hoc")
         rows.append(dict(id=e["id"], paper=e["paper"], section=e["section"], kind=e["kind"], half=e.get("half", ""),
                          claim=e.get("quote", ""), measured=m.measured, tolerance=tolerance_text(e),

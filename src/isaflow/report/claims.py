@@ -66,6 +66,11 @@ def units(df, registry):
         if c["kind"] != "method result" or c["id"] not in rows:
             continue
         targets = [c["id"]] if not c.get("depends_on") else list(root[c["id"]])
+        if len(targets) > 1:  # an aggregate over several roots: grouped under those that share its verdict
+            mine = verdict_class(rows[c["id"]]["verdict"])
+            same = [t for t in targets if kind[t] != "method result" or t not in rows
+                    or verdict_class(rows[t]["verdict"]) == mine]
+            targets = same or targets[:1]
         for t in targets:
             lst = out.setdefault(c["paper"], {})
             u = lst.setdefault(t, dict(id=t, kind=kind[t], members=[], row=rows.get(t)))

@@ -94,8 +94,11 @@ def entry_of(cid):
     return _entries()[cid]
 
 
-def measurement(measured, passed, evidence="", why="", margin="", sensitivity=""):
-    return C.Measurement(measured, None if passed is None else bool(passed), evidence, why, margin, sensitivity)
+def measurement(measured, passed, evidence="", why="", margin="", sensitivity="", sweep=()):
+    """sweep: ((input, value, passed), ...) for isaflow.claims.robustness (the readings a measure judges besides
+    the kept one)."""
+    return C.Measurement(measured, None if passed is None else bool(passed), evidence, why, margin, sensitivity,
+                         tuple(sweep))
 
 
 # ---------------------------------------------------------------------------------- abstract and section 3
@@ -326,7 +329,8 @@ def tension_hooke(ctx, e):
         margin=f"|error| {abs(p[kept]):.2e} against {lim:.1e}",
         sensitivity="bar_length: " + "; ".join(f"{k}: {x:+.2%}" for k, x in p.items())
         + " (the paper's own stress: mar-4.1-stress-vs-hooke); bar_grips: the printed model has no lateral coupling, so "
-        "sliding grips give the same axial stress (only clamped grips were run)")
+        "sliding grips give the same axial stress (only clamped grips were run)",
+        sweep=[("bar_length", k, st not in BROKEN and abs(x) <= lim) for k, x in p.items()])
 
 
 def width_change_um(ds):
@@ -374,7 +378,8 @@ def poisson_arith(ctx, e):
         evidence="eq. 17 inverted (theory.poisson_from_necking) on the page's numbers",
         why="" if abs(err) <= lim else "no reading of d and L gives the printed nu",
         margin=f"|error| {abs(err):.1e} against {lim:.1e}",
-        sensitivity="necking_reading: " + "; ".join(f"{k}: {v:.4f}" for k, v in nus.items()))
+        sensitivity="necking_reading: " + "; ".join(f"{k}: {v:.4f}" for k, v in nus.items()),
+        sweep=[("necking_reading", k, abs(v / num(e, "nu_eq") - 1) <= lim) for k, v in nus.items()])
 
 
 def poisson_error_claim(ctx, e):
@@ -900,7 +905,9 @@ def scale_contact_width(ctx, e):
                        evidence="arithmetic on the page's numbers",
                        why="" if ok else "the disk covers the whole plate: no Hertz contact, whatever the tolerance",
                        margin=f"{a[0]:.1f} mm against {half:.2f} mm",
-                       sensitivity="hertz_scale_reading: with the whole model scaled there is no inconsistency")
+                       sensitivity="hertz_scale_reading: with the whole model scaled there is no inconsistency",
+                       sweep=[("hertz_scale_reading", "same plate, radius varied", ok),
+                              ("hertz_scale_reading", "whole model scaled geometrically with the radius", True)])
 
 
 # ---------------------------------------------------------------------------------- 4.4 pressure vessel
