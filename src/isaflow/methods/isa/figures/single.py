@@ -111,7 +111,7 @@ def _level_lines(ax, x_span, level, paper_level, literal, initial=None):
         ax.plot(x_span, [initial] * 2, color="0.45", ls=(0, (2, 2)), lw=1.1, zorder=3,
                 label=f"initial (uncompacted) lattice, same reading: {initial:.1f} cm ({1 - level / initial:.0%} "
                       f"of the depth lost)")
-    ours = f"our level {level:.1f} cm"
+    ours = f"our surface {level:.1f} cm (top centres + half the layer pitch)"
     if paper_level is not None:
         ours += f": {CALIBRATED}"
         if literal is not None:
@@ -130,7 +130,7 @@ def single_vessel_figure(inputs, outputs, paper_level=None, calibration=None, in
     calibration: results/calibration.csv, for the level of the literal reading k_p = k_b / 2; inferred: the
     footer naming the inferred inputs the figure rests on."""
     ds = read(inputs[0])
-    e, (_, _, _, th) = metrics.contact_loads(ds, None, "level")
+    e, (_, _, _, th) = metrics.contact_loads(ds, None, "own")
     pos = ds["pos"].values
     walls = ds["wall_segment"].values
     literal = literal_levels(calibration).get(case_name(ds)) if calibration else None
@@ -164,9 +164,10 @@ def single_vessel_figure(inputs, outputs, paper_level=None, calibration=None, in
 
 
 def initial_level(ds):
-    """Level [cm] of the run's initial lattice (pos0) read as the final one (top particle centres, strips of
-    width a): the uncompacted liquid's level."""
-    return float(free_surface_level(ds["pos0"].values, float(ds.attrs["spacing"]), metrics.vessel_view(ds)["x_range"]))
+    """Surface [cm] of the run's initial lattice (pos0) read as the final one (top particle centres over strips of
+    width a, plus half the layer pitch: the one surface): the uncompacted liquid's."""
+    return float(free_surface_level(ds["pos0"].values, float(ds.attrs["spacing"]), metrics.vessel_view(ds)["x_range"])
+                 + metrics.layer_pitch(ds) / 2)
 
 
 def _pressure_panel(axp, ds, e, names, x0, x1):
@@ -200,7 +201,8 @@ def _pressure_panel(axp, ds, e, names, x0, x1):
 
 
 def calibration_figure(inputs, outputs, paper_levels=None, adopted=None):
-    """Free-surface level against wall stiffness and stiffness ratio, per resolution.
+    """Free surface (the one surface: top centres + half the layer pitch) against wall stiffness and stiffness ratio,
+    per resolution; the adopted k_p was calibrated on the top centres alone, whose reading is marked for it.
 
     adopted: {k_wall, ratio} of the scenes' reading, starred in the panels of the scenes
     that use it (those with a paper level); the literal reading k_p = k_b / 2 is ringed."""
@@ -231,8 +233,11 @@ def calibration_figure(inputs, outputs, paper_levels=None, adopted=None):
             pick = t[np.isclose(t["k_wall"], adopted["k_wall"]) & np.isclose(t["ratio"], adopted["ratio"])]
             h, = ax.plot(pick["k_wall"], pick["level"], "*", ms=16, mfc="none", mec="k", ls="none",
                          label=f"adopted: k_b = {adopted['k_wall']:g} N/cm, k_p/k_b = {adopted['ratio']:g} "
-                               f"(k_p calibrated to match the paper's level)")
+                               f"(k_p calibrated to match the paper's level with the top particle centres)")
             handles.setdefault("adopted", h)
+            h, = ax.plot(pick["k_wall"], pick["level_top"], "x", ms=9, color="k", ls="none",
+                         label="the adopted pair's top particle centres (the calibration's reading)")
+            handles.setdefault("adopted_top", h)
             lit = t[np.isclose(t["k_wall"], adopted["k_wall"]) & np.isclose(t["ratio"], 0.5)]
             h, = ax.plot(lit["k_wall"], lit["level"], "o", ms=14, mfc="none", mec="k", ls="none")
             literal[sc] = float(lit["level"].iloc[0]) if len(lit) else np.nan
@@ -244,13 +249,13 @@ def calibration_figure(inputs, outputs, paper_levels=None, adopted=None):
         ax.set_xlabel("wall stiffness $k_b = R_{bu}/l_{bu}$ (N/cm)")
         what = "" if sc in (paper_levels or {}) else ": alternative $l_{bu}$, not adopted"
         ax.set_title(f"{sc} ({t['variant'].iloc[0]}){what}")
-    axes[0, 0].set_ylabel("free-surface level (cm)")
+    axes[0, 0].set_ylabel("free surface: top centres + half the layer pitch (cm)")
     if "literal" in handles:
         handles["literal"].set_label("literal reading k_p = k_b/2 (page text: \"half\"): "
                                      + ", ".join(f"{v:.1f} cm {k}" for k, v in literal.items()))
     fig.legend(list(handles.values()), [h.get_label() for h in handles.values()], loc="upper center",
                bbox_to_anchor=(0.5, 0.0), ncol=3, fontsize=8, frameon=False)
-    fig.suptitle("Free-surface level vs force-law stiffness (filled: converged to f_tol, open: not converged)")
+    fig.suptitle("Free surface vs force-law stiffness (filled: converged to f_tol, open: not converged)")
     save(fig, outputs)
 
 
