@@ -30,10 +30,11 @@ CI_CONFIG = ROOT / "tests" / "data" / "study_ci.yaml"
 
 def hydrostatic_run(h=60.0, a=10.0, width=100.0, w=50.0):
     """A run Dataset whose wall contacts carry exactly the hydrostatic loads of a liquid
-    of level h [cm] (theory.contact_theory), with the free surface exactly at h."""
+    of level h [cm] (theory.contact_theory), with the free surface (the one surface: top centres + half the layer
+    pitch a) exactly at h."""
     walls = np.array([[0, 100, 0, 0], [0, 0, width, 0], [width, 0, width, 100]], float)
     xs = np.arange(a / 2, width, a)
-    pos = np.array([[x, y] for x in xs for y in np.arange(h, 0, -a)])  # top of every strip at h
+    pos = np.array([[x, y] for x in xs for y in np.arange(h - a / 2, 0, -a)])  # top of every strip at h - a/2
     W = w * len(pos)
     gamma = theory.specific_weight(W, width, h)
     ys = np.arange(a / 4, 100, a / 2)
