@@ -107,7 +107,7 @@ def test_assemble_puts_the_first_screen_first_and_every_part_after(tmp_path, reg
         p.write_text(f"## section {p.stem}\n")
     figs = tmp_path / "figures.yaml"
     figs.write_text(yaml.safe_dump({"fig06_single_coarse": dict(category="c", subcategory="s", caption="x" * 20,
-                                                                claims={}, viewed=dict(on="2026-11-28", shows="it"))}))
+                                                                claims={}, viewed=dict(date="2026-11-28", shows="it"))}))
     out = tmp_path / "replication.md"
     report.assemble([str(p) for p in parts], [str(f) for f in files[::-1]], str(counts), str(findings), [str(out)],
                     registry=str(registry), figures=str(figs))

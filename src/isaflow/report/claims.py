@@ -235,6 +235,6 @@ def closing(df, registry, figures=None):
         viewed = [(n, f) for n, f in figures.items() if f.get("viewed")]
         out += ["", f"**Figures viewed ({len(viewed)} of the {len(figures)} with a caption).** Each was opened as a "
                 "picture; what it shows:", ""]
-        out += [f"- `figures/{n}.png` (viewed {f['viewed']['on']}): {cell(f['viewed']['shows'])}" for n, f in viewed]
+        out += [f"- `figures/{n}.png` (viewed {f['viewed']['date']}): {cell(f['viewed']['shows'])}" for n, f in viewed]
     out.append("")
     return out
