@@ -114,7 +114,7 @@ def test_assemble_puts_the_first_screen_first_and_every_part_after(tmp_path, reg
     text = out.read_text()
     order = [text.index(s) for s in (
         "## Claims: the first screen", "marked post hoc", "`hat-a` (abc1234)",
-        "Method results: 5 rows, counted as 3", "root cause `pap-incons` (paper inconsistency)",
+        "Method results: 5 rows, counted as 3", "2 rows for one cause, `pap-incons` (paper inconsistency)",
         "1. **the root finding**", "## Besides the method results", "### Deviations of this project (1",
         "Paper: the paper says", "## Every row, by paper", "### Counts by paper and kind",
         "| `pap-incons` 1 | paper inconsistency |", "## Why not reproduced", "- a finding",
@@ -180,7 +180,7 @@ def test_committed_first_screen_counts_equal_a_count_of_the_registry_by_kind():
                 cls["not reproduced" if "not reproduced" in vs else vs.pop()] += 1
         screen = text[text.index(f"### {label}\n"):]
         line = next(ln for ln in screen.splitlines() if ln.startswith("Method results:"))
-        assert f"Method results: {len(mr)} rows, counted as {len(unit_ids)} " in line, (paper, line)
+        assert f"Method results: {len(mr)} rows, counted as {len(unit_ids)}:" in line, (paper, line)
         for k, short in RC.SHORT.items():
             n = cls[k]
             assert (f" {n} {short}" in line) == bool(n), (paper, short, n, line)

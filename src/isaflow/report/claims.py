@@ -24,6 +24,7 @@ from . import _cell as cell
 
 PAPERS = papers()
 ORDER = (VERDICTS[0], VERDICTS[1], VERDICTS[2], VERDICTS[3])  # reproduced, calibrated, not reproduced, not testable
+FIRST = (VERDICTS[2], VERDICTS[1], VERDICTS[0], VERDICTS[3])  # the first screen's rows: failures first
 SHORT = {VERDICTS[0]: "reproduced", VERDICTS[1]: "calibrated", VERDICTS[2]: "not reproduced",
          VERDICTS[3]: "not testable"}
 # what a verdict means for the kinds that are not method results (display only; the classes are the verdict's)
@@ -110,8 +111,26 @@ def _verdict_cell(r):
     return f"**{cell(r['verdict'])}**", f"{r['robustness']}{flips}"
 
 
+def _rows_word(n):
+    return f"{n} row" + ("" if n == 1 else "s")
+
+
+def _unit_line(u):
+    """One table row of the first screen: a method result (with the rows grouped under it) or a root cause outside
+    the method results (the rows that fail for it)."""
+    r = u["row"]
+    if u["kind"] == "method result" and r is not None:
+        v, rb = _verdict_cell(r)
+        same = f" (+ {_rows_word(len(u['members']))}, same cause: {', '.join(f'`{m}`' for m in u['members'])})" \
+            if u["members"] else ""
+        return f"| `{r['id']}` \"{cell(r['claim'], 70)}\"{same} | {cell(r['measured'], 110)} | {v} | {rb} |"
+    what = cell(r["measured"], 110) if r is not None else ""
+    return (f"| {len(u['members'])} rows for one cause, `{u['id']}` ({u['kind']}): "
+            f"{', '.join(f'`{m}`' for m in u['members'])} | {what} | **{u['verdict']}** | {u['robustness']} |")
+
+
 def first_screen(paper, df, registry, findings):
-    """Markdown lines: one paper's first screen."""
+    """Markdown lines: one paper's first screen (fits on a page: short cells; the untestable ones on one line)."""
     us = units(df, registry).get(paper, [])
     head = headline(df, registry).get(paper, Counter())
     rows = _rows(df)
@@ -123,33 +142,25 @@ def first_screen(paper, df, registry, findings):
     else:
         parts = ", ".join(f"{head[k]} {SHORT[k]}" for k in ORDER if head[k])
         rob = ", ".join(f"{head[k]} {k}" for k in ("robust", "fragile", "unswept") if head[k])
-        lines += [f"Method results: {head['rows']} rows, counted as {head['units']} (a root cause shared by "
-                  f"{head['grouped']} rows counted once): {parts}; {rob}.", "",
+        lines += [f"Method results: {head['rows']} rows, counted as {head['units']}: {parts}; {rob}. "
+                  f"({head['grouped']} rows that share a root cause are counted once, under it.)", "",
                   "| claim (quoted) | what we measured | verdict | robust / fragile |", "|---|---|---|---|"]
-        for u in sorted(us, key=lambda u: (ORDER.index(u["verdict"]), u["id"])):
-            if u["kind"] == "method result" and u["row"] is not None:
-                r = u["row"]
-                v, rb = _verdict_cell(r)
-                same = (f" Same cause: {', '.join(f'`{m}`' for m in u['members'])}." if u["members"] else "")
-                lines.append(f"| `{r['id']}` \"{cell(r['claim'], 110)}\"{same} | {cell(r['measured'], 170)} | {v} | "
-                             f"{rb} |")
-            else:
-                r = u["row"]
-                cause = f"`{u['id']}` ({u['kind']})" + (f": {cell(r['measured'], 130)}" if r is not None else "")
-                lines.append(f"| root cause {cause}. Method results: {', '.join(f'`{m}`' for m in u['members'])} | "
-                             f"{len(u['members'])} rows fail for this one cause | **{u['verdict']}** (counted once) | "
-                             f"{u['robustness']} |")
+        tested = [u for u in us if u["verdict"] != VERDICTS[3]]
+        for u in sorted(tested, key=lambda u: (FIRST.index(u["verdict"]), u["id"])):
+            lines.append(_unit_line(u))
+        untested = [u for u in us if u["verdict"] == VERDICTS[3]]
         lines.append("")
+        if untested:
+            ids = ", ".join(f"`{u['id']}`" + (f" (+ {len(u['members'])})" if u["members"] else "") for u in untested)
+            lines += [f"Not testable here ({len(untested)}): {ids}; why: the full rows below.", ""]
     found = [f for f in findings.get(paper, [])]
     if found:
         lines += ["The findings that matter:", ""]
         for k, f in enumerate(found, 1):
             lead = rows.get(f["claims"][0])
-            state = ""
-            if lead is not None:
-                state = f" (`{lead['id']}`: {cell(lead['verdict'])}, {lead['robustness']})"
-            lines.append(f"{k}. **{cell(f['title'])}**{state}. {cell(f['text'])} Figure: "
-                         f"[`{f['figure']}`](../{f['figure']}).")
+            state = f" (`{lead['id']}`: {cell(lead['verdict'])}, {lead['robustness']})" if lead is not None else ""
+            lines.append(f"{k}. **{cell(f['title'])}**{state}. {cell(f['text'])} "
+                         f"Figure: [`{f['figure']}`](../{f['figure']}).")
         lines.append("")
     return lines
 
