@@ -245,8 +245,8 @@ def floor_drops_figure(inputs, outputs, drops=None, kept=None, registry=None, in
         rows.append(dict(drop=float(d["drop"]), ds=ds, left=metrics.flow_measures(ds)["particles_left"],
                          sum_fx=metrics.flow_measures(di)["sum_fx_N"], steps_i=int(di["steps"])))
     n = len(rows)
-    fig = plt.figure(figsize=(3.3 * n, 8.6))
-    gs = fig.add_gridspec(2, n, height_ratios=[1.0, 0.9], hspace=0.45, wspace=0.08)
+    fig = plt.figure(figsize=(3.3 * n, 7.4))
+    gs = fig.add_gridspec(2, n, height_ratios=[0.8, 1.0], hspace=0.32, wspace=0.08, top=0.86, bottom=0.08)
     p14, t14 = claims["fourteen"]
     thr = claims["sum_fx"]
     for k, r in enumerate(rows):
@@ -282,10 +282,13 @@ def floor_drops_figure(inputs, outputs, drops=None, kept=None, registry=None, in
     ax_l.axhline(p14, color="tab:red", lw=1, ls="--")
     ax_l.plot(d, left, "o-", color="k", label="particles left in the first vessel at the end of application 4")
     fx = np.array([r["sum_fx"] for r in rows])
-    ax_f.axhspan(thr, max(fx.max(), thr) * 1.15, color="tab:red", alpha=0.12, lw=0,
+    ax_f.axhspan(thr, max(fx.max(), thr) * 1.35, color="tab:red", alpha=0.12, lw=0,
                  label=f"ΣF_x >= {thr:g} N (10 N f_tol, '>> 0'): pap-6.3-sum-fx passes")
     ax_f.axhline(thr / 10, color="0.4", lw=1, ls=":", label=f"equilibrium bound N f_tol = {thr / 10:g} N")
-    ax_f.plot(d, fx, "o-", color=RESULTANT, label=f"ΣF_x at step {rows[0]['steps_i']:,} (application 3)")
+    ax_f.plot(d, fx, "o-", color=RESULTANT, label="ΣF_x at the end of application 3 (step 100,000 or an earlier cycle)")
+    for r, y in zip(rows, fx):
+        ax_f.annotate(f"{y:+.0f} N\n(step {r['steps_i']:,})", (r["drop"], y), xytext=(0, 8), textcoords="offset points",
+                      ha="center", fontsize=7)
     for ax, what in ((ax_l, "particles"), (ax_f, "ΣF_x (N)")):
         ax.axvline(kept, color="0.5", lw=1, ls="--")
         ax.text(kept, 1.01, f"kept {kept:g} cm", transform=ax.get_xaxis_transform(), ha="center", va="bottom",
@@ -293,9 +296,11 @@ def floor_drops_figure(inputs, outputs, drops=None, kept=None, registry=None, in
         ax.set_xlabel("second vessel's floor below the first (cm), inferred: second_floor_drop")
         ax.set_ylabel(what)
         ax.set_xticks(d)
-        legend_below(ax, ncol=1)
-    ax_l.set_ylim(0, max(left.max(), p14 + t14) * 1.15)
-    ax_f.set_ylim(0, max(fx.max(), thr) * 1.15)
+        ax.legend(loc="upper right" if ax is ax_l else "upper left", fontsize=7.5, frameon=True, framealpha=0.9)
+    for r, y in zip(rows, left):
+        ax_l.annotate(f"{y}", (r["drop"], y), xytext=(6, 4), textcoords="offset points", fontsize=8)
+    ax_l.set_ylim(0, max(left.max(), p14 + t14) * 1.35)
+    ax_f.set_ylim(min(0.0, fx.min() * 1.3), max(fx.max(), thr) * 1.35)
     fig.suptitle("Figure 10 at every floor drop the claims sweep: the end of the complete flow (paper's update) and "
                  "the two rows whose verdict flips with the drop", fontsize=10)
     inferred_note(fig, inferred)
