@@ -168,7 +168,8 @@ def robustness(entry, m, inputs=None):
             flips.append(f"{name}: {', '.join(flip)}")
             evidence.append(f"{name}: flips at {', '.join(flip)}")
         elif len(vals) >= 2 and vals[0][1] is not None and vals[-1][1] is not None:
-            evidence.append(f"{name}: same verdict at {', '.join(v for v, p in vals if p is not None)}")
+            evidence.append(f"{name}: same verdict at {', '.join(v for v, p in vals if p is not None)}"
+                            + (f"; the rest of its range: {argued[name]}" if name in argued else ""))
         elif name in argued:
             evidence.append(f"{name}: {argued[name]}")
         else:
