@@ -153,6 +153,10 @@ def first_screen(paper, df, registry, findings):
         if untested:
             ids = ", ".join(f"`{u['id']}`" + (f" (+ {len(u['members'])})" if u["members"] else "") for u in untested)
             lines += [f"Not testable here ({len(untested)}): {ids}; why: the full rows below.", ""]
+    apart = Counter(c["kind"] for c in registry if c["paper"] == paper and c["kind"] != "method result")
+    if apart:
+        lines += ["Counted apart (the lists below): " + ", ".join(
+            f"{apart[k]} {t.lower()}" for k, t in LISTS if apart[k]) + ".", ""]
     found = [f for f in findings.get(paper, [])]
     if found:
         lines += ["The findings that matter:", ""]
