@@ -157,7 +157,8 @@ rule isa_fig_calibration:
 
 rule isa_fig_convergence:
     input:
-        inputs=[isa_file(r) for r in ["single_coarse", "single_coarse_capped", "single_refined", "single_refined_capped"]],
+        inputs=[isa_file(r) for r in ["single_coarse", "single_coarse_capped", "single_coarse_nocycle", "single_refined",
+                                      "single_refined_capped", "single_refined_nocycle"]],
         code=code("methods.isa.figures.single"),
     output:
         figure("convergence_single"),

@@ -260,12 +260,23 @@ def calibration_figure(inputs, outputs, paper_levels=None, adopted=None):
 
 
 def convergence_figure(inputs, outputs):
-    """max|F| against the step: the paper's update and the capped variant."""
+    """max|F| against the step: the paper's update and the capped variant; a run of the paper's update with the cycle
+    stop off (the paper's own stop rule, on which the claims are judged) is drawn as its last max|F| band at the
+    right edge, with the step it reached."""
     runs = [read(p) for p in inputs]
     scenes = list(dict.fromkeys(case_name(ds) for ds in runs))
     fig, axes = plt.subplots(1, len(scenes), figsize=(6 * len(scenes), 4.2), squeeze=False)
     for ax, sc in zip(axes[0], scenes):
-        for ds in (d for d in runs if case_name(d) == sc):
+        here = [d for d in runs if case_name(d) == sc]
+        xmax = max(int(d["steps"]) for d in here if int(d.attrs.get("stop_on_cycle", 1)))
+        for ds in (d for d in here if not int(d.attrs.get("stop_on_cycle", 1))):
+            lo, hi = float(ds["hist_fmax_lo"].values[-10:].min()), float(ds["hist_fmax_hi"].values[-10:].max())
+            ax.errorbar([xmax * 1.03], [np.sqrt(lo * hi)], yerr=[[np.sqrt(lo * hi) - lo], [hi - np.sqrt(lo * hi)]],
+                        color="tab:purple", capsize=4, lw=2,
+                        label=f"paper's update with the cycle stop off (its own stop rule; the claims are judged on "
+                              f"it):\n-> {ds.attrs['status']} at step {int(ds['steps']):,}, its last max|F| band "
+                              f"{lo:.3g}-{hi:.3g} N (drawn at the right edge)")
+        for ds in (d for d in here if int(d.attrs.get("stop_on_cycle", 1))):
             a = ds.attrs
             st = ds["hist_step"].values
             line, = ax.plot(st, ds["hist_fmax"].values, lw=0.8, label=f"{a['variant_label']}\n-> {a['status']} at step {int(ds['steps']):,}"
