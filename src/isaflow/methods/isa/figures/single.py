@@ -273,9 +273,8 @@ def convergence_figure(inputs, outputs):
             lo, hi = float(ds["hist_fmax_lo"].values[-10:].min()), float(ds["hist_fmax_hi"].values[-10:].max())
             ax.errorbar([xmax * 1.03], [np.sqrt(lo * hi)], yerr=[[np.sqrt(lo * hi) - lo], [hi - np.sqrt(lo * hi)]],
                         color="tab:purple", capsize=4, lw=2,
-                        label=f"paper's update with the cycle stop off (its own stop rule; the claims are judged on "
-                              f"it):\n-> {ds.attrs['status']} at step {int(ds['steps']):,}, its last max|F| band "
-                              f"{lo:.3g}-{hi:.3g} N (drawn at the right edge)")
+                        label=f"paper, cycle stop off (its own rule; claims judged on it):\n-> {ds.attrs['status']} "
+                              f"at step {int(ds['steps']):,}, last band {lo:.3g}-{hi:.3g} N (right edge)")
         for ds in (d for d in here if int(d.attrs.get("stop_on_cycle", 1))):
             a = ds.attrs
             st = ds["hist_step"].values
