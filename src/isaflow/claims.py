@@ -154,7 +154,8 @@ def robustness(entry, m, inputs=None):
     where the verdict flips' ('; '-joined); evidence one line per input.  inputs: {input id: input} of the
     registry (an input's own robustness argument stands for the rows whose measure does not sweep it)."""
     names = entry.get("inferred_inputs", [])
-    if not entry.get("testable") or m is None or m.passed is None:
+    deviation = entry.get("kind") == "project deviation"
+    if not entry.get("testable") or m is None or m.passed is None or (deviation and not entry["deviation"].get("runs")):
         return "robust", "", "no test runs on any value of its inputs: the verdict is 'not testable here' at every one"
     if not names:
         return "robust", "", "rests on no inferred input"
@@ -162,6 +163,10 @@ def robustness(entry, m, inputs=None):
     argued = {n: a for n, a in argued.items() if a} | entry.get("robustness", {})
     flips, evidence, unswept = [], [], []
     for name in names:
+        if deviation and (inputs or {}).get(name, {}).get("status") == "project addition":
+            evidence.append(f"{name}: the project's own addition is the deviation; the row is judged at the paper's "
+                            "version")
+            continue
         vals = [(v, p) for i, v, p in m.sweep if i == name]
         flip = [v for v, p in vals if p is not None and bool(p) != bool(m.passed)]
         if flip:

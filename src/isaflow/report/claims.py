@@ -80,16 +80,21 @@ def units(df, registry):
     for paper, lst in out.items():
         for u in lst.values():
             own = [rows[m] for m in u["members"]]
+            u["own"] = own
             if u["kind"] == "method result" and u["row"] is not None:
                 u["verdict"] = verdict_class(u["row"]["verdict"])
-                u["robustness"] = u["row"]["robustness"]
+                u["robustness"] = _worst([u["row"]["robustness"]] + [r["robustness"] for r in own])
             else:  # a cause outside the method results: the verdict its method results share
                 classes = Counter(verdict_class(r["verdict"]) for r in own)
                 u["verdict"] = VERDICTS[2] if classes[VERDICTS[2]] else classes.most_common(1)[0][0]
-                u["robustness"] = "fragile" if any(r["robustness"] == "fragile" for r in own) else (
-                    "unswept" if any(r["robustness"] == "unswept" for r in own) else "robust")
+                u["robustness"] = _worst([r["robustness"] for r in own])
         out[paper] = list(lst.values())
     return out
+
+
+def _worst(classes):
+    """A group is fragile if any of its rows is, else unswept if any is, else robust."""
+    return next((k for k in ("fragile", "unswept") if k in classes), "robust")
 
 
 def headline(df, registry):
@@ -121,12 +126,24 @@ def _unit_line(u):
     r = u["row"]
     if u["kind"] == "method result" and r is not None:
         v, rb = _verdict_cell(r)
+        if u["robustness"] != r["robustness"]:
+            rb = f"{rb}; the group: {_group_robustness(u)}"
         same = f" (+ {_rows_word(len(u['members']))}, same cause: {', '.join(f'`{m}`' for m in u['members'])})" \
             if u["members"] else ""
         return f"| `{r['id']}` \"{cell(r['claim'], 70)}\"{same} | {cell(r['measured'], 110)} | {v} | {rb} |"
     what = cell(r["measured"], 110) if r is not None else ""
     return (f"| {len(u['members'])} rows for one cause, `{u['id']}` ({u['kind']}): "
-            f"{', '.join(f'`{m}`' for m in u['members'])} | {what} | **{u['verdict']}** | {u['robustness']} |")
+            f"{', '.join(f'`{m}`' for m in u['members'])} | {what} | **{u['verdict']}** | {_group_robustness(u)} |")
+
+
+def _group_robustness(u):
+    """The group's class, with the rows that make it fragile or unswept and where they flip."""
+    odd = [m for m in u["own"] if m["robustness"] != "robust"]
+    if not odd:
+        return u["robustness"]
+    return f"{u['robustness']} (" + "; ".join(f"`{m['id']}` {m['robustness']}" + (f": {cell(m['flips'], 90)}" if
+                                                                                   m["flips"] else "")
+                                             for m in odd) + ")"
 
 
 def first_screen(paper, df, registry, findings):
