@@ -345,3 +345,15 @@ def test_quote_matching_is_ordered_and_whitespace_blind():
     assert reg.quote_found("Alpha beta gamma ... Delta", text)
     assert not reg.quote_found("Delta ... Alpha", text)
     assert not reg.quote_found("beta gamma delta", text)
+
+
+def test_every_figure_that_carries_a_claim_is_tracked_and_viewed():
+    """A claim-carrying figure is never git-ignored (a reader of the repository sees it) and was looked at (issue 31);
+    timing figures, which change from run to run and are ignored, carry no claim."""
+    figures = yaml.safe_load((ROOT / "workflow" / "report" / "figures.yaml").read_text())
+    ignored = [ln.strip().lstrip("/").removeprefix("figures/").split(".")[0].rstrip("*")
+               for ln in (ROOT / ".gitignore").read_text().splitlines() if ln.strip().lstrip("/").startswith("figures/")]
+    for name, spec in figures.items():
+        if spec["claims"]:
+            assert not any(name.startswith(i) for i in ignored), f"{name} carries claims but is git-ignored"
+            assert "viewed" in spec, f"{name} carries claims but was never viewed"

@@ -133,7 +133,7 @@ def _end_states(ax_n, ax_h, isa, ods):
             ax.text(k, y, f"{y:.3g}", ha="center", va="bottom", fontsize=8)
         ax.set_xticks(range(len(vals)), names, fontsize=8)
         ax.set_ylim(0, max(vals) * 1.25)
-        ax.set_title(f"{what}\n(shaded: the update's +- {band:g}{unit}, the claim's tolerance)", fontsize=9)
+        head = "(b) end states of every run of (a): " if ax is ax_n else ""
+        ax.set_title(f"{head}{what}\n(shaded: the update's +- {band:g}{unit}, the claim's tolerance)", fontsize=9)
     ax_n.set_ylabel("particles")
     ax_h.set_ylabel("cm")
-    ax_n.text(0.0, 1.35, "(b) end states, every run of (a)", transform=ax_n.transAxes, fontsize=10)

@@ -113,7 +113,7 @@ def _level_lines(ax, x_span, level, paper_level, literal, initial=None):
                       f"of the depth lost)")
     ours = f"our surface {level:.1f} cm (top centres + half the layer pitch)"
     if paper_level is not None:
-        ours += f": {CALIBRATED}"
+        ours += f":\n{CALIBRATED}"
         if literal is not None:
             ours += f";\nthe literal reading k_p = k_b/2 gives {literal:.1f} cm (results/calibration.csv)"
     # the paper's line under ours: both stay visible where they (almost) coincide
@@ -194,7 +194,7 @@ def _pressure_panel(axp, ds, e, names, x0, x1):
     axp.set_xlabel("x (cm)")
     axp.set_ylabel("y (cm)")
     axp.set_title("(b) theoretical hydrostatic pressure on the boundaries\n(2D, per unit depth; p = γ (h - y))")
-    axp.text(0.5, -0.15, f"γ = W/(B h) = {gamma:.3f} N/cm² (W: weight held, B: width, h: our level)\n"
+    axp.text(0.5, -0.15, f"γ = W/(B h) = {gamma:.3f} N/cm² (W: weight held, B: width, h: our surface)\n"
              f"floor: γhB = W = {e['theory_floor']:.0f} N\n"
              f"each side: γh²/2 = {e['theory_' + names[0]]:.0f} N, acting at h/3 = {h / 3:.1f} cm",
              transform=axp.transAxes, ha="center", va="top", fontsize=8)

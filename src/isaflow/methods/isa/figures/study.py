@@ -15,7 +15,8 @@ FLOOR = 1e-4  # smallest |error| drawn on the log axes (exact zeros sit on it)
 
 PANELS = [
     ("level_err_paper_cm", "|level - paper's level| (cm)",
-     "(a) free-surface level against the paper\n(k_p calibrated to match this level: config/inferred.yaml)"),
+     "(a) free surface (top centres + half the layer pitch) against the paper\n(k_p calibrated on the top centres: "
+     "config/inferred.yaml)"),
     ("level_err_hydro_cm", "|level - level implied by side loads| (cm)",
      "(b) level against hydrostatic consistency (2 B F_side / W)"),
     ("side_err", "|side-wall total / hydrostatic - 1| (-)", "(c) side-wall loads against hydrostatics"),
@@ -25,7 +26,7 @@ PANELS = [
 
 
 X_AXES = {"wall_time_s": ("solver wall-clock time (s)", "Error against run time"),
-          "particle_steps": ("particle-steps: particles x force evaluations (hardware-independent)", "Error against work")}
+          "particle_steps": ("particles x force evaluations", "Error against work (particle-steps, hardware-independent)")}
 
 
 def error_vs_runtime_figure(inputs, outputs, x="wall_time_s"):
