@@ -20,7 +20,6 @@ from collections import Counter
 from .. import claims_registry
 from ..claims import VERDICTS, verdict_class
 from ..methods import papers
-from . import _cell as cell
 
 PAPERS = papers()
 ORDER = (VERDICTS[0], VERDICTS[1], VERDICTS[2], VERDICTS[3])  # reproduced, calibrated, not reproduced, not testable
@@ -92,6 +91,12 @@ def units(df, registry):
     return out
 
 
+def cell(x, limit=None):
+    """Text for one Markdown table cell (one line, pipes escaped, cut at limit characters)."""
+    text = " ".join(str(x).split()).replace("|", "\\|")
+    return text if limit is None or len(text) <= limit else text[:limit - 3].rstrip() + "..."
+
+
 def _worst(classes):
     """A group is fragile if any of its rows is, else unswept if any is, else robust."""
     return next((k for k in ("fragile", "unswept") if k in classes), "robust")
@@ -159,8 +164,9 @@ def first_screen(paper, df, registry, findings):
     else:
         parts = ", ".join(f"{head[k]} {SHORT[k]}" for k in ORDER if head[k])
         rob = ", ".join(f"{head[k]} {k}" for k in ("robust", "fragile", "unswept") if head[k])
-        lines += [f"Method results: {head['rows']} rows, counted as {head['units']}: {parts}; {rob}. "
-                  f"({head['grouped']} rows that share a root cause are counted once, under it.)", "",
+        grouped = (f" ({head['grouped']} rows that share a root cause are counted once, under it.)"
+                   if head["grouped"] else "")
+        lines += [f"Method results: {head['rows']} rows, counted as {head['units']}: {parts}; {rob}.{grouped}", "",
                   "| claim (quoted) | what we measured | verdict | robust / fragile |", "|---|---|---|---|"]
         tested = [u for u in us if u["verdict"] != VERDICTS[3]]
         for u in sorted(tested, key=lambda u: (FIRST.index(u["verdict"]), u["id"])):
