@@ -188,17 +188,42 @@ def test_the_extended_sweep_is_the_sensitivity_to_the_window():
     assert m.passed and "n_window (sph1d:sweep_n8192, N = 256-2048): symmetric_hydrostatic: the test fails" in m.sensitivity
 
 
-def test_condition_association_follows_the_rank_correlation():
-    ds = synthetic_sweep(False)
-    rng = np.random.default_rng(1)
-    two = ds.neighbours.values == 2
-    cond = rng.uniform(1, 10, (2, 4, int(two.sum())))
-    ds.cond.values[:, :, two, -1] = cond * NS[-1]
-    ds.error.values[:, :, two, -1] = 0.01 * cond  # error rises with cond_1 / N
+def association_sweep(n=12, seed=1):
+    """Two-neighbour ratios only (n of them in (1, 1.5]): random cond_1 / N per (variant, kernel, ratio) at the largest
+    N; errors settled at 0.02 elsewhere."""
+    rng = np.random.default_rng(seed)
+    ratios = np.linspace(1.05, 1.5, n)
+    err = np.full((2, 4, n, 4), 0.02)
+    cond = np.ones((2, 4, n, 4)) * NS
+    c = rng.uniform(1, 10, (2, 4, n))
+    cond[..., -1] = c * NS[-1]
+    return xr.Dataset(
+        {"error": (("variant", "kernel", "ratio", "n"), err), "cond": (("variant", "kernel", "ratio", "n"), cond),
+         "neighbours": (("ratio",), np.full(n, 2))},
+        coords={"variant": VARIANTS, "kernel": KERNELS, "ratio": ratios, "n": NS},
+        attrs={"classify_window": 4, "variant_gradient": "symmetric plain",
+               "variant_floor": "mirror_hydrostatic mirror_hydrostatic", "height_cm": 100.0, "rho_g_N_cm3": 9.81e-3}), c
+
+
+def test_condition_association_is_judged_kernel_by_kernel_at_fixed_ratio():
+    """'The kernel influences the accuracy ... through ... the condition number': at each h/dx the kernel with the
+    larger cond_1 / N must have the larger error, at significantly more ratios than not; a correlation that only h/dx
+    carries (every kernel alike at a ratio) does not count."""
     entry = REGISTRY["mer-abs-cond-association"]
-    assert sph1d_claims.measure_cond_association(FakeContext(ds), entry).passed
-    ds.error.values[:, :, two, -1] = 0.1 / cond  # and falls
+    ds, c = association_sweep()
+    ds.error.values[..., -1] = 0.01 * c  # error rises with cond_1 / N, kernel by kernel
+    m = sph1d_claims.measure_cond_association(FakeContext(ds), entry)
+    assert m.passed and "agree at 12, disagree at 0" in m.measured
+    ds.error.values[..., -1] = 0.1 / c  # and falls
     assert sph1d_claims.measure_cond_association(FakeContext(ds), entry).passed is False
+    # cond and error both rise with h/dx, the kernels ordered against each other: pooled, a positive correlation
+    ratio = ds.ratio.values[None, None, :]
+    ds.cond.values[..., -1] = (ratio * 10 + np.arange(4)[None, :, None]) * NS[-1]
+    ds.error.values[..., -1] = ratio * 0.1 + 0.01 * (3 - np.arange(4))[None, :, None]
+    m = sph1d_claims.measure_cond_association(FakeContext(ds), entry)
+    assert m.passed is False and "agree at 0, disagree at 12" in m.measured
+    pooled = m.measured.split("pooled Spearman rho ")[1]  # which the earlier, pooled test would have passed
+    assert float(pooled.split()[0]) > 0 and float(pooled.split("(p ")[1].split(")")[0]) < 0.05
 
 
 def test_classification_of_the_sweep_table():

@@ -429,3 +429,21 @@ def test_scale_radii_come_from_the_settings():
     assert C.scale_radius_mm(CFG, "hertz_R50.8mm") == 50.8 and C.scale_radius_mm(CFG, "hertz_R20m") == 20000.0
     with pytest.raises(ValueError, match="scale_radii_mm"):
         C.scale_radius_mm(CFG, "hertz_R3m")
+
+
+def test_the_papers_stop_at_the_boundary_coupling_stops_an_approaching_particle_only():
+    """marko2017 section 3 (run as the case vessel_water_stop, claims deviation mar-3-coupling): a water particle
+    touching a ring particle and moving towards it gets m (v_rel . n) / dt, which stops its relative normal motion
+    within the step, and the ring particle the opposite force; a particle moving away or out of reach gets none."""
+    from isaflow.methods.solid.water import stop_contacts
+
+    m, dt, dx = 2.0, 1e-3, 1.0
+    xs = np.array([[0.0, 0.0]])
+    vs = np.zeros((1, 2))
+    xw = np.array([[0.99, 0.0], [-0.6, 0.6], [0.0, 1.5]])  # touching, touching, out of reach
+    vw = np.array([[-3.0, 2.0], [-1.0, 1.0], [0.0, -5.0]])  # towards, away (along the normal), towards but far
+    fw, fs = np.zeros((3, 2)), np.zeros((1, 2))
+    assert stop_contacts(xw, vw, xs, vs, m, dt, dx, fw, fs) == 1
+    v_after = vw[0] + dt * fw[0] / m
+    assert v_after[0] == pytest.approx(0.0, abs=1e-12) and v_after[1] == pytest.approx(2.0)  # tangential kept
+    assert np.allclose(fw[1:], 0.0) and np.allclose(fs[0], -fw[0])  # action = reaction

@@ -12,6 +12,16 @@ holding one of its own); :func:`verdict` turns that into the verdict:
   to match it (``calibrated_against`` in the registry's inputs);
 - ``reproduced`` / ``not reproduced``: the test passed / failed.
 
+A ``project deviation`` row (a point where this project departs from the paper by its own choice) is judged on
+the paper's version when that was run (``deviation.runs``); otherwise it is ``not testable here`` and its
+measurement describes what the project does instead.
+
+Robustness.  A verdict is ``robust`` when it holds at both ends of every inferred input it rests on and
+``fragile`` when some value of an input's range flips it (the input and the values where it flips are named).
+The evidence is the measure's ``sweep`` (the test at other values of the inputs, from runs or readings) or,
+for an input no run covers, the registry row's ``robustness`` argument; an input with neither is ``unswept``.
+A row that rests on no inferred input is robust by construction.
+
 A measure's ``passed`` always says whether the *quoted claim* holds.  For a ``paper inconsistency`` row
 the registry's test reads "inconsistent if ..."; when it finds the inconsistency the claim does not hold
 (the paper's own statements contradict it), so the row is ``not reproduced`` and says why.
@@ -29,8 +39,9 @@ from . import claims_registry, methods, runfile
 from .html import page
 
 VERDICTS = ("reproduced", "reproduced only after calibrating", "not reproduced", "not testable here")
-COLUMNS = ["id", "paper", "section", "kind", "half", "claim", "measured", "tolerance", "verdict", "evidence", "why",
-           "margin", "sensitivity"]
+ROBUSTNESS = ("robust", "fragile", "unswept")
+COLUMNS = ["id", "paper", "section", "kind", "half", "claim", "measured", "tolerance", "verdict", "robustness",
+           "flips", "robustness_evidence", "evidence", "why", "margin", "sensitivity", "depends_on", "post_hoc"]
 
 
 @dataclass
@@ -43,7 +54,8 @@ class Measurement:
     evidence: str = ""
     why: str = ""  # the explanation of a failure
     margin: str = ""  # where the verdict would flip (the threshold a referee would look at)
-    sensitivity: str = ""  # the verdict across the inferred inputs' ranges
+    sensitivity: str = ""  # the verdict across the inferred inputs' ranges (text)
+    sweep: tuple = ()  # ((input id, value label, passed True / False / None), ...) in range order, the kept value included
 
 
 class Context:
@@ -125,13 +137,52 @@ def calibrated_inputs(entry, inputs):
 
 
 def verdict(entry, m, inputs):
-    """The verdict of one claim from its Measurement (module docstring)."""
+    """The verdict of one claim from its Measurement (module docstring).  A project deviation whose paper's
+    version is not run (no deviation.runs) is not testable here: its measure describes the project's choice."""
     if not entry.get("testable") or m is None or m.passed is None:
+        return "not testable here"
+    if entry["kind"] == "project deviation" and not entry["deviation"].get("runs"):
         return "not testable here"
     if not m.passed:
         return "not reproduced"
     cal = calibrated_inputs(entry, inputs)
     return f"reproduced only after calibrating {', '.join(cal)}" if cal else "reproduced"
+
+
+def robustness(entry, m, inputs=None):
+    """(class, flips, evidence) of a judged row (module docstring): class one of ROBUSTNESS; flips 'input: values
+    where the verdict flips' ('; '-joined); evidence one line per input.  inputs: {input id: input} of the
+    registry (an input's own robustness argument stands for the rows whose measure does not sweep it)."""
+    names = entry.get("inferred_inputs", [])
+    deviation = entry.get("kind") == "project deviation"
+    if not entry.get("testable") or m is None or m.passed is None or (deviation and not entry["deviation"].get("runs")):
+        return "robust", "", "no test runs on any value of its inputs: the verdict is 'not testable here' at every one"
+    if not names:
+        return "robust", "", "rests on no inferred input"
+    argued = {n: (inputs or {}).get(n, {}).get("robustness") for n in names}
+    argued = {n: a for n, a in argued.items() if a} | entry.get("robustness", {})
+    flips, evidence, unswept = [], [], []
+    for name in names:
+        if deviation and (inputs or {}).get(name, {}).get("status") == "project addition":
+            evidence.append(f"{name}: the project's own addition is the deviation; the row is judged at the paper's "
+                            "version")
+            continue
+        vals = [(v, p) for i, v, p in m.sweep if i == name]
+        flip = [v for v, p in vals if p is not None and bool(p) != bool(m.passed)]
+        if flip:
+            flips.append(f"{name}: {', '.join(flip)}")
+            evidence.append(f"{name}: flips at {', '.join(flip)}")
+        elif len(vals) >= 2 and vals[0][1] is not None and vals[-1][1] is not None:
+            evidence.append(f"{name}: same verdict at {', '.join(v for v, p in vals if p is not None)}"
+                            + (f"; the rest of its range: {argued[name]}" if name in argued else ""))
+        elif name in argued:
+            evidence.append(f"{name}: {argued[name]}")
+        else:
+            unswept.append(name)
+            evidence.append(f"{name}: not swept" + (f" (judged at {', '.join(v for v, p in vals if p is not None)})"
+                                                     if any(p is not None for _, p in vals) else ""))
+    cls = "fragile" if flips else ("unswept" if unswept else "robust")
+    return cls, "; ".join(flips), "; ".join(evidence)
 
 
 def tolerance_text(entry):
@@ -161,10 +212,14 @@ def judge(ctx, claims=None, inputs=None, found=None):
                 m = found[e["id"]](ctx, e)
             except Missing as err:
                 m = Measurement(f"needs {err.args[0]}, which this workflow did not make", None)
+        rob, flips, rob_ev = robustness(e, m, inputs)
+        post = (e.get("tolerance") or {}).get("post_hoc")
         rows.append(dict(id=e["id"], paper=e["paper"], section=e["section"], kind=e["kind"], half=e.get("half", ""),
                          claim=e.get("quote", ""), measured=m.measured, tolerance=tolerance_text(e),
-                         verdict=verdict(e, m, inputs), evidence=m.evidence, why=m.why, margin=m.margin,
-                         sensitivity=m.sensitivity))
+                         verdict=verdict(e, m, inputs), robustness=rob, flips=flips, robustness_evidence=rob_ev,
+                         evidence=m.evidence, why=m.why, margin=m.margin, sensitivity=m.sensitivity,
+                         depends_on=" ".join(e.get("depends_on", [])),
+                         post_hoc=f"{post['commit']}: {post['seen']}" if post else ""))
     return pd.DataFrame(rows, columns=COLUMNS)
 
 
@@ -201,7 +256,7 @@ def write(outputs, registry, runs=None, tables=None, run_files=(), registry_file
 
 def html_table(df, title):
     """A self-contained HTML page of one paper's judged claims (read in a browser, e.g. the Snakemake report)."""
-    cols = ["id", "section", "kind", "claim", "measured", "verdict", "tolerance", "why", "margin", "evidence",
-            "sensitivity"]
+    cols = ["id", "section", "kind", "claim", "measured", "verdict", "robustness", "flips", "tolerance", "post_hoc",
+            "why", "margin", "evidence", "sensitivity", "robustness_evidence", "depends_on"]
     body = df[cols].fillna("").to_html(index=False, escape=True, border=0)
     return page(f"Claims: {title}", f"<h2>Claims of {title}: {len(df)} rows</h2>{body}")

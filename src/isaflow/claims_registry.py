@@ -13,8 +13,13 @@ Kinds: ``method result`` (a number or property the method produces), ``paper ari
 paper's own formula or number re-evaluated), ``holds by construction`` (true because of how the
 method or an inferred input was built; not evidence), ``input rule`` (how the paper chose an
 input, checked against the inputs the runs use), ``paper inconsistency`` (two statements of the
-paper that cannot both hold), and ``project check`` (a check of ours, quoted from no paper, never
-counted in a paper's tally).
+paper that cannot both hold), ``project deviation`` (a row whose outcome is decided by this project's own
+choice -- a stop rule, a reading, an unimplemented coupling: what the paper says, what the project does and
+why, and the paper's version where it can be run; a finding about this project, never counted in a paper's
+tally) and ``project check`` (a check of ours, quoted from no paper, never counted in a paper's tally).
+
+``depends_on`` names the rows whose root cause a row shares (its verdict follows from theirs); the report
+groups a row under its roots (:func:`roots`) and counts a root cause once.
 
 No verdict is computed here: this module is the data.  Units: cm, N, s unless a field says
 otherwise.
@@ -32,9 +37,10 @@ from .methods import papers
 SCHEMA = json.loads(resources.files("isaflow").joinpath("claims.schema.json").read_text())
 PAPERS = tuple(papers())  # the paper ids of the method registry, the paper replicated first
 PREFIX = {p: p[:3] for p in PAPERS}  # claim ids start with it: pap-, mar-, hat-, mer-
-KINDS = ("method result", "paper arithmetic", "holds by construction", "input rule", "paper inconsistency",
-         "project check")
-PAPER_KINDS = KINDS[:-1]  # the kinds counted in a paper's tally
+KINDS = ("method result", "paper inconsistency", "paper arithmetic", "input rule", "holds by construction",
+         "project deviation", "project check")
+PAPER_KINDS = KINDS[:-2]  # the kinds counted in a paper's tally (never the project's deviations or checks)
+OWN_KINDS = KINDS[-2:]  # findings about this project
 DEFAULT_DIRECTORY = "config/claims"
 _ROOT = Path(__file__).resolve().parents[2]
 
@@ -74,9 +80,17 @@ def _check_file(paper, spec, ids):
     if dup:
         raise InputError(f"{path}: input id '{dup[0]}' is defined twice")
     for i in spec.get("inputs", []):
+        values = [str(v) for v in i["range"]["values"]]
+        if "paper_version" in i and i["paper_version"] not in values:
+            raise InputError(f"{path}: input '{i['id']}': paper_version '{i['paper_version']}' is not a value of its range")
         for c in i.get("calibrated_against", []):
             if c not in ids:
                 raise InputError(f"{path}: input '{i['id']}': calibrated_against names no claim '{c}'")
+    own = {c["id"] for c in spec["claims"]}
+    for k, f in enumerate(spec.get("findings", [])):
+        for c in f["claims"]:
+            if c not in own:
+                raise InputError(f"{path}: findings.{k}: names no claim '{c}' of this file")
     for k, c in enumerate(spec["claims"]):
         where = f"{path}: claims.{k} ('{c['id']}')"
         if c["paper"] != paper:
@@ -89,6 +103,9 @@ def _check_file(paper, spec, ids):
         for d in c.get("depends_on", []):
             if d not in ids or d == c["id"]:
                 raise InputError(f"{where}: depends_on names no other claim '{d}'")
+        for name in c.get("robustness", {}):
+            if name not in c["inferred_inputs"]:
+                raise InputError(f"{where}: robustness argues for '{name}', which is not among its inferred_inputs")
         if c["testable"]:
             t = c["tolerance"]
             for field in ("derivation", "source", "test"):
@@ -114,7 +131,51 @@ def load(directory=DEFAULT_DIRECTORY):
     ids = set(seen)
     for p in PAPERS:
         _check_file(p, files[p], ids)
+    cycle = _depends_cycle(claims)
+    if cycle:
+        raise InputError(f"depends_on forms a cycle: {' -> '.join(cycle)}")
     return claims
+
+
+def _depends_cycle(claims):
+    """A depends_on cycle as a list of ids (empty if none)."""
+    deps = {c["id"]: c.get("depends_on", []) for c in claims}
+    state = {}
+
+    def visit(k, path):
+        if state.get(k) == 1:
+            return path[path.index(k):] + [k]
+        if state.get(k) == 2:
+            return []
+        state[k] = 1
+        for d in deps.get(k, []):
+            found = visit(d, path + [k])
+            if found:
+                return found
+        state[k] = 2
+        return []
+
+    for k in deps:
+        found = visit(k, [])
+        if found:
+            return found
+    return []
+
+
+def roots(claims):
+    """{claim id: tuple of root ids}: the rows with no depends_on that a row's depends_on leads to (a root is its
+    own root).  The report groups a row under its roots and counts each root cause once."""
+    deps = {c["id"]: c.get("depends_on", []) for c in claims}
+    out = {}
+
+    def walk(k):
+        if k not in out:
+            out[k] = (k,) if not deps[k] else tuple(dict.fromkeys(r for d in deps[k] for r in walk(d)))
+        return out[k]
+
+    for k in deps:
+        walk(k)
+    return out
 
 
 def inputs(directory=DEFAULT_DIRECTORY):
@@ -144,21 +205,21 @@ def quote_found(quote, text):
 
 
 def counts(claims=None, directory=DEFAULT_DIRECTORY):
-    """{paper: {kind: n}} over the registry (project checks under their own kind, never in a paper's
-    tally); 'testable' and 'independent' (testable, no depends_on) are added per paper."""
+    """{paper: {kind: n}} over the registry (project deviations and checks under their own kinds, never in a
+    paper's tally); 'testable' and 'independent' (testable, no depends_on) are added per paper."""
     claims = load(directory) if claims is None else claims
     out = {}
     for c in claims:
         row = out.setdefault(c["paper"], {k: 0 for k in KINDS} | {"testable": 0, "independent": 0})
         row[c["kind"]] += 1
-        if c["kind"] != "project check" and c["testable"]:
+        if c["kind"] in PAPER_KINDS and c["testable"]:
             row["testable"] += 1
             row["independent"] += not c.get("depends_on")
     return out
 
 
 def format_counts(table=None):
-    """The counts as a Markdown table (papers x kinds, with the paper tally = all kinds but project checks)."""
+    """The counts as a Markdown table (papers x kinds, with the paper tally = all kinds but the project's own)."""
     table = counts() if table is None else table
     heads = ["paper", *KINDS, "paper tally", "testable", "independent"]
     lines = ["| " + " | ".join(heads) + " |", "|" + "---|" * len(heads)]

@@ -25,7 +25,9 @@ in ``Result.params`` (run-file attributes), so that no difference is silent:
   nothing), e.g. "depth rounded to whole rows: 75 cm (tank 72.5 cm), weight held
   at 9000 N".
 Dynamic methods judge rest with isaflow.rest (one criterion for all) and
-record ``rest_energy_ratio``, ``rest_window`` and ``time_to_rest`` [s].
+record ``rest_energy_ratio``, ``rest_window`` and ``time_to_rest`` [s]: the start
+of the quiet stretch that made the run at rest, counted from the start of this run
+(its own t0: the release of its liquid, the opening for a flow), in every method.
 """
 
 from dataclasses import dataclass, field

@@ -6,8 +6,11 @@ the top particle centre, plus half the vertical pitch of its particle layers
 (``layer_pitch``: dy of a square lattice, l0 of MPS, a / 2 of ISA's rhombic
 lattice).  A lattice filling [floor, floor + h] with layers of pitch d has its
 top centres at h - d / 2, so this surface is exactly h (tests/test_metrics.py).
-``level`` keeps the top-centre mean alone: the reading one takes off the
-paper's figures, used only where a paper's own level is compared.
+It is the one convention of the project: every claims row, figure, table and
+the methods comparison read a free surface or level this way.
+:func:`level_of` is the top-centre mean alone, the building block of the
+surface and one value of the claims input ``level_definition`` (the reading
+the ISA pair stiffness was calibrated on), never a second convention.
 
 **Two theories of every wall load** (:func:`load_errors`):
 - ``reference="tank"``: the tank's liquid (run-file attributes ``tank_*``):
@@ -16,7 +19,7 @@ paper's figures, used only where a paper's own level is compared.
 - ``reference="own"``: the method's own liquid: the weight its particles hold
   in the vessel and the depth of its own free surface, gamma = W_v / (B h_v);
 - ``reference="level"``: as "own" with the top-centre level as the surface
-  (the paper's reading; ISA's claims of its own level only).
+  (a reading kept for sensitivity only; no table or figure uses it).
 Errors: ``floor_err`` (computed floor total - theory) / theory; ``side_err``
 (computed - theory) / theory of the wetted side walls' loads together; ``contact_rms`` RMS
 over wetted contacts of (computed - theory) / (gamma h a) (units of one floor
@@ -219,7 +222,7 @@ def flow_measures(ds):
     return out
 
 
-def hydrostatic_errors(ds, paper_level=None, vessel=None, reference="level"):
+def hydrostatic_errors(ds, paper_level=None, vessel=None, reference="own"):
     """Error measures of an equilibrium against a paper's level and hydrostatics.
 
     Keys (units in the names; relative errors are fractions): level_cm (the
@@ -303,13 +306,13 @@ def _side_walls(ds, vessel):
 
 def run_row(ds, vessel=None):
     """One row of any run file: comparison_row plus, for the vessel judged (the receiving one of a flow),
-    the loads against the level reading (load_errors 'level'), flow measures and surface flatness."""
+    the loads against its own liquid on the one surface (load_errors 'own'), flow measures and surface flatness."""
     row = comparison_row(ds)
     if vessel is None and "vessel" in ds.coords:
         vessel = vessels(ds)[-1]
     if "vessel" in ds.coords:
         row.update(flow_measures(ds))
     if np.isfinite(ds["pos"].values).all():
-        row.update(load_errors(ds, vessel, "level"))
+        row.update(load_errors(ds, vessel, "own"))
         row.update(surface_measures(ds, vessel))
     return row

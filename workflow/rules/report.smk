@@ -29,7 +29,9 @@ rule replication_report:
         claims=[f"results/claims/registry/{p}.csv" for p in CLAIM_PAPERS],
         counts="results/claims/registry/counts.csv",
         findings="results/report/findings.md",
-        code=code("report"),
+        registry=sorted(glob.glob("config/claims/*.yaml")),
+        figures="workflow/report/figures.yaml",
+        code=code("report", "report.claims"),
     output:
         "docs/replication.md",
         report_file("results/report/replication.html", "replication", "Report"),

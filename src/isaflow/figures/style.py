@@ -70,7 +70,7 @@ OURS_LEVEL = dict(color=COMPUTED, ls="-", lw=1.2)  # our measured level / surfac
 PAPER_LEVEL = dict(color=PAPER, ls=(0, (5, 3)), lw=1.6)  # a level the paper measured
 PAPER_EXPECTED = dict(color="tab:purple", ls=(0, (1, 2)), lw=1.8)  # a level the paper computed
 LABEL_BOX = dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.85)
-CALIBRATED = "k_p calibrated to match this level (config/inferred.yaml)"
+CALIBRATED = "k_p calibrated to match the paper's level with the top centres (config/inferred.yaml)"
 
 
 def state_phrase(ds):
@@ -111,7 +111,8 @@ def legend_below(ax, ncol=2, **kw):
 def surface_line(ax, ds, vessel, color, name=None):
     """Draw the measured free surface of a vessel: the top particle of each strip of width a
     (theory.surface_profile) and its least-squares line; the legend entry states slope (deg),
-    range (cm) and mean level (cm) from metrics.surface_measures / level_of."""
+    range (cm) and the mean depth of the one surface (metrics.surface_of: top centres + half the layer
+    pitch) from metrics.surface_measures."""
     from .. import metrics, theory
 
     v = metrics.vessel_view(ds, vessel)
@@ -119,10 +120,11 @@ def surface_line(ax, ds, vessel, color, name=None):
     if len(x) == 0:
         return None
     s = metrics.surface_measures(ds, vessel)
-    depth = metrics.level_of(ds, vessel) - v["floor_y"]
+    depth = metrics.surface_of(ds, vessel) - v["floor_y"]
     ax.plot(x, top, "-", color=color, lw=1.1, drawstyle="steps-mid", zorder=4,
-            label=f"measured surface, {name or vessel} vessel (top particle per {float(ds.attrs['spacing']):g} cm strip): "
-                  f"slope {s['slope_deg']:.1f}°{_falls(s['slope_deg'])}, range {s['surface_range_cm']:.1f} cm, mean depth {depth:.1f} cm")
+            label=f"top particles, {name or vessel} vessel (per {float(ds.attrs['spacing']):g} cm strip): "
+                  f"slope {s['slope_deg']:.1f}°{_falls(s['slope_deg'])}, range {s['surface_range_cm']:.1f} cm; "
+                  f"surface (+ half the layer pitch) at mean depth {depth:.1f} cm")
     if len(x) > 1:
         k = np.polyfit(x, top, 1)
         ax.plot(x, np.polyval(k, x), ":", color=color, lw=1, zorder=4)

@@ -27,13 +27,14 @@ SOLID_FIGURES = SOLID_FIGURES_41_43 + SOLID_FIGURES_44
 # runs the claims registry asks for (config/claims/marko2017.yaml): the 4.3 plate under disks of the other
 # stated radii, stepped by eq. 27 undamped (capped by eq. 26 and not), the 4.1 bar held in sustained tension
 # (the strain x step sweep of input tension_test_setup), the 4.4 vessel with water under the printed solid model
+# (the project's mirror-pressure coupling, and the paper's stop-at-the-boundary coupling: vessel_water_stop_paper)
 SOLID_CLAIM_RUN_IDS = ["hertz_R50.8mm_paper", "hertz_R127mm_paper", "hertz_R20m_paper", "hertz_R50m_paper",
                        "hertz_eq27_paper", "hertz_eq27_hooke", "hertz_eq27_uncapped_paper", "bar_tension_long_paper",
                        "bar_tension_long_e0.1_dt0.1_paper", "bar_tension_long_e0.1_dt0.25_paper",
                        "bar_tension_long_e0.1_dt0.5_paper", "bar_tension_long_e1_dt0.1_paper",
                        "bar_tension_long_e1_dt0.5_paper", "bar_tension_long_e5_dt0.1_paper",
                        "bar_tension_long_e5_dt0.25_paper", "bar_tension_long_e5_dt0.5_paper",
-                       "vessel_water_particles_paper"]
+                       "vessel_water_particles_paper", "vessel_water_stop_paper"]
 
 
 # the list above is what the settings give (hertz.scale_radii_mm, the bar_long sweep): refuse the rule file otherwise

@@ -14,8 +14,13 @@ range is a *sweep* here (:data:`SWEEPS`): per value, the runs that stand in for 
 the value changes (a measure that needs one of them without a stand-in has no run for that value), and
 the parameters of readings that need no run (the level definition).  A measure is written once, as a
 core ``core(view, entry) -> Out``; the same core runs on a :class:`View` of the context per swept value,
-and ``sensitivity`` lists the test's outcome at every value ('passes' / 'fails' / 'no run').  Aggregate
+and ``sensitivity`` lists the test's outcome at every value ('passes' / 'fails' / 'no run'); the same outcomes
+go to the measurement's ``sweep`` (isaflow.claims.robustness decides robust or fragile from them).  Aggregate
 claims (every run converges) judge, in a sweep, the runs the value has (``partial``), and say so.
+
+The paper's version.  Where the project added something the paper does not have and the paper's version was
+run (:data:`PAPER_VERSION`: the cycle stop switched off), every row resting on that input is judged on the
+paper's version's runs; the project's kept value is then one more value of the sweep.
 
 Units: cm, N, s.
 """
@@ -33,7 +38,7 @@ from . import metrics as IM
 from . import replay
 
 ISA = "isa:"
-LEVEL_KEPT = "top centres + 0"  # the kept level_definition (registry input): the paper's reading off its figures
+LEVEL_KEPT = "top centres + a/4"  # the kept level_definition: the project's one surface (metrics.surface_of)
 
 
 # ----------------------------------------------------------------------------------------------- views
@@ -165,16 +170,17 @@ SWEEPS = {
                 "flow_refined_complete": "flow_refined_literal_complete"}), _refined, {}),
     ],
     "level_definition": [
-        ("top centres + 0 (kept)", {}, _never, {"level": LEVEL_KEPT}),
-        ("+ a/4", {}, _never, {"level": "top centres + a/4"}),
+        ("top centres + 0 (the reading the k_p calibration used)", {}, _never, {"level": "top centres + 0"}),
+        ("+ a/4, half the layer pitch (kept: the one surface)", {}, _never, {"level": LEVEL_KEPT}),
         ("+ 5 cm (the paper's y_in)", {}, _never, {"level": "top centres + 5 cm"}),
     ],
-    "step_limit": [
-        (f"{f} x the paper's steps (cycle stop off)", _subs(NOCYCLE), _isa, {"n_u": f}) for f in (10, 25, 100)
+    "step_limit": [  # the paper's version of the stop rule (cycle stop off) runs to 100 x: the judged value
+        (f"{f} x the paper's steps{' (kept)' if f == 100 else ''} (cycle stop off)", _subs(NOCYCLE), _isa, {"n_u": f})
+        for f in (10, 25, 100)
     ],
     "cycle_detector": [
-        ("on (kept)", {}, _never, {}),
-        ("off (to 100 x the paper's steps)", _subs(NOCYCLE), _isa, {"n_u": 100}),
+        ("on (the project's addition)", {}, _never, {}),
+        ("off (the paper's stop rule, to 100 x the paper's steps)", _subs(NOCYCLE), _isa, {"n_u": 100}),
     ],
     "second_floor_drop": [_drop(20), _drop(32), ("50 cm (kept)", {}, _never, {}), _drop(80), _drop(100)],
     "flow_start_state": [
@@ -226,35 +232,73 @@ SWEEPS = {
     ],
 }
 PARTIAL = {"pap-abs-converges", "pap-7-isa-oscillations", "pap-5-rigid", "pap-5-incompressible"}  # aggregates: a sweep judges what it has
+# inputs whose paper's version was run: the label of that value in SWEEPS (rows resting on them are judged there)
+PAPER_VERSION = {"cycle_detector": "off (the paper's stop rule, to 100 x the paper's steps)"}
+
+
+def _value(name, label):
+    return next(v for v in SWEEPS[name] if v[0] == label)
+
+
+def judged_at(entry):
+    """{input: label} of the paper's versions a row is judged at (its inferred inputs in PAPER_VERSION)."""
+    return {n: PAPER_VERSION[n] for n in entry.get("inferred_inputs", []) if n in PAPER_VERSION}
+
+
+def base_view(ctx, entry):
+    """The view a row is judged on: the run substitutions of the paper's versions it rests on."""
+    subs, params = {}, {}
+    for name, label in judged_at(entry).items():
+        _, s, _, p = _value(name, label)
+        subs.update(s)
+        params.update(p)
+    return View(ctx, subs, None, params)
+
+
+def _kept(name, label, at):
+    """True when a sweep value is the one the row is judged at (the paper's version, else the kept value)."""
+    return label == at[name] if name in at else "(kept)" in label
 
 
 def sensitivity(ctx, entry, core, kept):
-    """'input: value -> passes / fails (short) / no run; ...' over every swept inferred input of the entry."""
-    parts, unswept = [], []
+    """('input: value -> passes / fails (short) / no run; ...' over every swept inferred input of the entry,
+    the same outcomes as ((input, value, passed), ...) for isaflow.claims.robustness)."""
+    parts, unswept, sweep = [], [], []
+    at = judged_at(entry)
+    base = base_view(ctx, entry)
     for name in entry.get("inferred_inputs", []):
         if name not in SWEEPS:
             unswept.append(name)
             continue
         vals = []
         for label, subs, affected, params in SWEEPS[name]:
-            if "(kept)" in label:
+            if _kept(name, label, at):
                 vals.append(f"{label}: {_word(kept.passed)}" + (f" ({kept.short})" if kept.short else ""))
+                sweep.append((name, label, kept.passed))
                 continue
-            view = View(ctx, subs, affected, params, partial=entry["id"] in PARTIAL)
+            if name in at:  # the other values of a paper's-version input replace its substitutions
+                view = View(ctx, subs, affected, params, partial=entry["id"] in PARTIAL)
+            else:
+                view = View(ctx, {**base.subs, **subs}, affected, {**base.params, **params},
+                            partial=entry["id"] in PARTIAL)
             try:
                 o = core(view, entry)
             except NoRun as err:
                 vals.append(f"{label}: no run ({err.args[0]})")
+                sweep.append((name, label, None))
                 continue
             except Missing as err:
                 vals.append(f"{label}: no run ({err.args[0]} missing)")
+                sweep.append((name, label, None))
                 continue
             vals.append(f"{label}: {_word(o.passed)}" + (f" ({o.short})" if o.short else "")
                         + (f" [{o.partial}]" if o.partial else ""))
+            # an aggregate ('every run ...') judged on part of its runs: a failure stands, a pass proves nothing
+            sweep.append((name, label, None if o.partial and o.passed else o.passed))
         parts.append(f"{name}: " + "; ".join(vals))
     if unswept:
         parts.append("not swept: " + ", ".join(unswept))
-    return " | ".join(parts)
+    return " | ".join(parts), tuple(sweep)
 
 
 def _word(passed):
@@ -269,13 +313,16 @@ def measure(evidence=""):
             return _claim_outcome(test(view, entry), entry)
 
         def fn(ctx, entry):
-            view = View(ctx)
+            view = base_view(ctx, entry)
             out = core(view, entry)
             runs = [_path(ctx, k) for k in view.read]
-            ev = "; ".join(x for x in [evidence, ", ".join(r for r in runs if r)] if x)
+            at = judged_at(entry)
+            judged = ("judged at the paper's version: " + "; ".join(f"{n} {v}" for n, v in at.items())) if at else ""
+            ev = "; ".join(x for x in [evidence, judged, ", ".join(r for r in runs if r)] if x)
+            text, sweep = sensitivity(ctx, entry, core, out)
             return Measurement(measured=out.measured, passed=None if out.passed is None else bool(out.passed),
                                evidence=ev, why=out.why if out.passed is False else "", margin=out.margin,
-                               sensitivity=sensitivity(ctx, entry, core, out))
+                               sensitivity=text, sweep=sweep)
 
         fn.core = core
         return fn
@@ -324,11 +371,15 @@ def paper_steps(key):
 
 
 # ------------------------------------------------------------------------------------- shared helpers
+def level_offset(view, ds):
+    """What the view's level definition adds to the top-centre level [cm] (level_definition input; the kept
+    one, half the layer pitch, makes level() the project's one surface metrics.surface_of)."""
+    return {"top centres + 0": 0.0, "top centres + a/4": M.layer_pitch(ds) / 2, "top centres + 5 cm": 5.0}[view.level]
+
+
 def level(view, ds, vessel=None):
     """Free-surface level [cm] under the view's level definition (level_definition input)."""
-    top = M.level_of(ds, vessel)
-    return top + {"top centres + 0": 0.0, "top centres + a/4": M.layer_pitch(ds) / 2,
-                  "top centres + 5 cm": 5.0}[view.level]
+    return M.level_of(ds, vessel) + level_offset(view, ds)
 
 
 def second(ds):
@@ -471,15 +522,26 @@ def initial_state(view, e):
                why="a particle starts inside a law's range: its initial force is not (0, -w)")
 
 
+def _stops(ds):
+    a = ds.attrs
+    cyc = int(a["stop_on_cycle"])
+    return cyc, (f"stops at max|F| < {float(a['f_tol']):g} N, at n_u = {int(a['max_steps']):,} steps"
+                 f"{', and on a detected cycle (an added stop)' if cyc else ''}; ended {a['status']} at step "
+                 f"{int(ds['steps']):,}")
+
+
 @measure("section 3.5")
 def stop_rule(view, e):
+    """Judged on the run the view gives (the paper's version: the cycle stop off); the project's default run
+    (the cycle stop on) is reported beside it."""
+    key = view.key("single_coarse")
     ds = view.run("single_coarse")
-    a = ds.attrs
-    cyc, ftol = int(a["stop_on_cycle"]), float(a["f_tol"])
-    ok = cyc == 0 and math.isclose(ftol, num(e, "f_tol_N"))
-    return Out(ok, f"the paper-variant solver of single_coarse stops at max|F| < {ftol:g} N, at n_u = "
-                   f"{int(a['max_steps']):,} steps{', and on a detected cycle (an added stop)' if cyc else ''}; "
-                   f"single_coarse ended: {a['status']}",
+    cyc, text = _stops(ds)
+    ok = cyc == 0 and math.isclose(float(ds.attrs["f_tol"]), num(e, "f_tol_N"))
+    kept = ""
+    if key != ISA + "single_coarse" and view.ctx.has(ISA + "single_coarse"):
+        kept = f"; the project's default run single_coarse: {_stops(view.ctx.run(ISA + 'single_coarse'))[1]}"
+    return Out(ok, f"the paper-variant solver of {key.removeprefix(ISA)} {text}{kept}",
                short="cycle stop on" if cyc else "cycle stop off",
                why="the solver adds a stop the paper does not have: a detected period-p cycle of max|F| "
                    "(cycle_detector); the runs that stop there never met the paper's criterion")
@@ -640,8 +702,7 @@ def incompressible(view, e):
 def _initial_level(view, ds):
     """Level [cm] of a run's initial lattice (pos0) under the view's level definition."""
     top = T.free_surface_level(ds["pos0"].values, float(ds.attrs["spacing"]), M.vessel_view(ds)["x_range"])
-    return top + {"top centres + 0": 0.0, "top centres + a/4": M.layer_pitch(ds) / 2,
-                  "top centres + 5 cm": 5.0}[view.level]
+    return top + level_offset(view, ds)
 
 
 # ================================================================================ section 6.1: application 1
@@ -693,22 +754,34 @@ def gap(view, e):
                why="with a convex law the reaction that carries the load needs a deeper approach to the wall")
 
 
+def _stiffness_ratio(ds):
+    a = ds.attrs
+    return (float(a["pair_r_u"]) / float(a["pair_l_u"])) / (float(a["wall_r_u"]) / float(a["wall_l_u"]))
+
+
 @measure()
 def rpu_half(view, e):
-    rows, worst = [], 0.0
+    """A project deviation judged on the paper's version, k_p = k_b / 2 (runs single_*_kp1000): the rule, and what
+    that version gives (levels, outcome) beside the project's calibrated k_p = k_b / 4."""
+    rows, worst, gives = [], 0.0, []
     for k in ("single_coarse", "single_refined"):
-        a = view.run(k).attrs
-        r = (float(a["pair_r_u"]) / float(a["pair_l_u"])) / (float(a["wall_r_u"]) / float(a["wall_l_u"]))
+        ds = view.run(f"{k}_kp1000")
+        r = _stiffness_ratio(ds)
         worst = max(worst, abs(r - num(e, "ratio")))
-        rows.append(f"{k}: k_p / k_b = {r:.6g}")
-    return Out(worst <= tol(e), "; ".join(rows) + f" (paper {num(e, 'ratio'):g})", short=rows[0].split("= ")[-1],
-               margin=f"off by {worst:.3g}", why="k_p = 500 N/cm was chosen (calibrated to the levels), "
-                                                 "half the literal k_b / 2 = 1000 N/cm")
+        rows.append(f"{k}_kp1000: k_p / k_b = {r:.6g}")
+        gives.append(f"{k}_kp1000 surface {level(view, ds):.2f} cm ({ds.attrs['status']})")
+    kept = [f"{k}: {_stiffness_ratio(view.ctx.run(ISA + k)):.6g}, surface {level(view, view.ctx.run(ISA + k)):.2f} cm"
+            for k in ("single_coarse", "single_refined") if view.ctx.has(ISA + k)]
+    return Out(worst <= tol(e), "paper's version: " + "; ".join(rows) + f" (paper {num(e, 'ratio'):g}); it gives "
+               + "; ".join(gives) + (f"; the project's calibrated k_p / k_b: {'; '.join(kept)}" if kept else ""),
+               short=rows[0].split("= ")[-1], margin=f"off by {worst:.3g}",
+               why="the paper's version does not follow the rule")
 
 
 @measure("replay of the paper's update step by step (methods.isa.replay)")
 def du_rule(view, e):
     rows, worst, ok = [], 0.0, True
+    typed = float(e["tolerance"]["parameters"]["typed_precision"])
     for k in ("single_coarse", "single_refined"):
         ds = view.run(k)
         r = replay.pair_increments(ds)
@@ -717,11 +790,12 @@ def du_rule(view, e):
         w = float(ds["weight"].values.max())
         x = r["max_pair_increment_N"] / w
         worst = max(worst, x)
-        ok &= x <= tol(e) + 1e-9
-        rows.append(f"{k}: largest pair-reaction change in one step {r['max_pair_increment_N']:.6g} N = {x:.6f} w "
+        ok &= x <= tol(e) * (1 + typed)
+        rows.append(f"{k}: largest pair-reaction change in one step {r['max_pair_increment_N']:.9g} N = {x:.9f} w "
                     f"(step {r['at_step']:,} of {r['steps']:,}; 2 k_p du = "
                     f"{2 * float(ds.attrs['pair_r_u']) / float(ds.attrs['pair_l_u']) * float(ds.attrs['du']):.3g} N)")
-    return Out(ok, "; ".join(rows), short=f"worst {worst:.6f} w", margin=f"flips above {tol(e):g} w (+1e-9)",
+    return Out(ok, "; ".join(rows), short=f"worst {worst:.9f} w",
+               margin=f"flips above {tol(e):g} w x (1 + {typed:g}), the precision R_pu and l_pu are typed with",
                why="a pair closes by up to 2 sqrt(2) du per step (both particles move du in each component), not 2 du: "
                    "the du rule 2 k_p du = w/5 bounds only the closing along one axis")
 
@@ -856,22 +930,37 @@ def same_liquid(view, e):
                margin=f"inconsistent beyond {tol(e):g} relative")
 
 
-@measure("config/methods/isa.yaml (resolutions refined, refined_lbu25, refined_literal)")
-def same_way(view, e):
-    ds = view.run("single_refined")
+def _refined_rules(ds, e):
+    """{rule: (the run's value, the section 6.1 rule applied to the run)} of a refined run."""
     a = ds.attrs
-    t = tol(e)
     rb = IM.wall_law_usage(ds)["max_wall_reaction_N"]
     gap0 = float(wall_distance(ds["pos0"].values, ds["wall_segment"].values).min())
     kb, kp = float(a["wall_r_u"]) / float(a["wall_l_u"]), float(a["pair_r_u"]) / float(a["pair_l_u"])
     w = float(ds["weight"].values.max())
-    checks = {"R_bu vs 10 max R_b": (float(a["wall_r_u"]), num(e, "rbu_factor") * rb),
-              "l_bu vs initial gap": (float(a["wall_l_u"]), gap0),
-              "k_p / k_b vs 1/2": (kp / kb, num(e, "kp_over_kb")),
-              "2 k_p du vs w/5": (2 * kp * float(a["du"]), w * num(e, "increment_over_w"))}
-    rel = {k: abs(x / y - 1) for k, (x, y) in checks.items()}
-    off = [k for k, r in rel.items() if r > t]
-    return Out(not off, "; ".join(f"{k}: {x:.4g} against {y:.4g} ({x / y - 1:+.1%})" for k, (x, y) in checks.items()),
+    return {"R_bu vs 10 max R_b": (float(a["wall_r_u"]), num(e, "rbu_factor") * rb),
+            "l_bu vs initial gap": (float(a["wall_l_u"]), gap0),
+            "k_p / k_b vs 1/2": (kp / kb, num(e, "kp_over_kb")),
+            "2 k_p du vs w/5": (2 * kp * float(a["du"]), w * num(e, "increment_over_w"))}
+
+
+def _rules_text(checks):
+    return "; ".join(f"{k}: {x:.4g} against {y:.4g} ({x / y - 1:+.1%})" for k, (x, y) in checks.items())
+
+
+@measure("config/methods/isa.yaml (resolutions refined, refined_lbu25, refined_literal)")
+def same_way(view, e):
+    """A project deviation judged on the paper's version of the refined wall law (single_refined_literal: l_bu =
+    the initial gap, R_bu = 10 max R_b of the run itself); its k_p is the project's (the deviation
+    pap-6.1-rpu-half), reported, not judged here.  The project's kept refined law is reported beside it."""
+    t = tol(e)
+    checks = _refined_rules(view.run("single_refined_literal"), e)
+    kp = checks.pop("k_p / k_b vs 1/2")
+    off = [k for k, (x, y) in checks.items() if abs(x / y - 1) > t]
+    kept = ""
+    if view.ctx.has(ISA + "single_refined"):
+        kept = f"; the project's kept refined law (single_refined): {_rules_text(_refined_rules(view.ctx.run(ISA + 'single_refined'), e))}"
+    return Out(not off, f"paper's version (single_refined_literal): {_rules_text(checks)}; k_p / k_b {kp[0]:.4g} "
+                        f"(the project's k_p: pap-6.1-rpu-half){kept}",
                short="off: " + ", ".join(off) if off else "all within",
                margin=f"each within {t:.0%} of its rule", why="not followed: " + ", ".join(off))
 
@@ -1086,15 +1175,22 @@ def cost_scaling(view, e):
 
 @measure("results/isa/table1.md")
 def refined_cost(view, e):
-    lo, hi = tol(e)
+    """'Saving of computing time ... by use of the coarse discretization': a direction, the refined complete flow
+    needs more particle-steps to the paper's criterion than the coarse one (ratio > the tolerance's 1); a coarse
+    flow that never meets the criterion saves nothing."""
+    lim = tol(e)
     a, da, wa = outcome(view, "flow_refined_complete")
     b, db, wb = outcome(view, "flow_complete")
-    if a is None or b is None:
-        return Out(False, f"flow_refined_complete: {wa}; flow_complete: {wb}", short="never converges",
-                   why="a run never meets max|F| < f_tol", margin=f"interval [{lo:g}, {hi:g}]")
+    if b is None:
+        return Out(False, f"flow_complete: {wb}; flow_refined_complete: {wa}", short="coarse never converges",
+                   why="the coarse flow never meets max|F| < f_tol, so it saves no time against the refined one",
+                   margin="flips only if the coarse flow converges")
+    if a is None:
+        return Out(True, f"flow_refined_complete: {wa}; flow_complete: {wb}", short="refined never converges",
+                   margin="the coarse flow converges, the refined one does not")
     r = (da.sizes["particle"] * a) / (db.sizes["particle"] * b)
-    return Out(lo <= r <= hi, f"({da.sizes['particle']} x {a:,}) / ({db.sizes['particle']} x {b:,}) = {r:.2f}",
-               short=f"{r:.2f}", margin=f"flips outside [{lo:g}, {hi:g}]")
+    return Out(r > lim, f"({da.sizes['particle']} x {a:,}) / ({db.sizes['particle']} x {b:,}) = {r:.2f} particle-steps",
+               short=f"{r:.2f}", margin=f"flips at {lim:g}")
 
 
 @measure("section 4")
@@ -1108,35 +1204,50 @@ def fortran(view, e):
 TAU = np.linspace(0.0, 5.0, 501)
 
 
+def backflow(f):
+    """Largest fall of a transferred fraction below its running maximum (particles flowing back)."""
+    f = np.asarray(f, float)
+    return float((np.maximum.accumulate(f) - f).max()) if len(f) else 0.0
+
+
 @measure("figures/isa_overdamped.png")
 def strong_damping(view, e):
-    t_curve, t_left, t_level = tol(e)
+    """'Approximates dynamic behavior with strong damping', a qualitative sentence: the same direction of motion
+    (no return flow beyond one floor row, what a sloshing liquid would show) and the same end states as overdamped
+    dynamics of the same particles; the course on the normalised axis is reported, not judged."""
+    t_back, t_left, t_level = tol(e)
     ti, fi = transfer(view, ["flow_incomplete", "flow_complete"])
     to, fo = transfer(view, ["flow_overdamped"])
     gi, s50 = normalised(ti, fi, TAU)
     go, t50 = normalised(to, fo, TAU)
     sup = float(np.abs(gi - go).max())
+    back = backflow(fi)
     fc, od = view.run("flow_complete"), view.run("flow_overdamped")
     li, lo = M.flow_measures(fc)["particles_left"], M.flow_measures(od)["particles_left"]
     yi = level(view, fc, second(fc)) - M.vessel_view(fc, second(fc))["floor_y"]
     yo = level(view, od, second(od)) - M.vessel_view(od, second(od))["floor_y"]
     si, so = view.run("single_coarse"), view.run("single_coarse_overdamped")
     ys_i, ys_o = level(view, si), level(view, so)
-    ok = sup <= t_curve and abs(li - lo) <= t_left and abs(yi - yo) <= t_level and abs(ys_i - ys_o) <= t_level
-    fails = [w for w, bad in (("transfer curve", sup > t_curve), ("particles left", abs(li - lo) > t_left),
+    ok = back <= t_back and abs(li - lo) <= t_left and abs(yi - yo) <= t_level and abs(ys_i - ys_o) <= t_level
+    fails = [w for w, bad in (("return flow", back > t_back), ("particles left", abs(li - lo) > t_left),
                               ("second-vessel level", abs(yi - yo) > t_level),
                               ("single-vessel level", abs(ys_i - ys_o) > t_level)) if bad]
-    return Out(ok, f"transfer curves on tau = t / t_50 (ISA t_50 = {s50:,.0f} steps, overdamped t_50 = {t50:.3g} s, "
-                   f"zeta {float(od.attrs['zeta']):g}): sup |f_isa - f_od| = {sup:.3f} (tolerance {t_curve:.4f}); "
-                   f"left {li} vs {lo} particles; second-vessel level {yi:.2f} vs {yo:.2f} cm; single vessel "
-                   f"{ys_i:.2f} vs {ys_o:.2f} cm ({si.attrs['status']} vs {so.attrs['status']})",
-               short=f"sup {sup:.3f}, left {li}/{lo}", margin=f"tolerances {t_curve:.4f}, {t_left:g}, {t_level:g} cm",
+    return Out(ok, f"end states: left {li} vs {lo} particles; second-vessel surface {yi:.2f} vs {yo:.2f} cm; single "
+                   f"vessel {ys_i:.2f} vs {ys_o:.2f} cm ({si.attrs['status']} vs {so.attrs['status']}); ISA's largest "
+                   f"return flow {back:.3f} of N (tolerance {t_back:.4f}); reported, not judged: transfer curves on "
+                   f"tau = t / t_50 (ISA t_50 = {s50:,.0f} steps, overdamped t_50 = {t50:.3g} s, zeta "
+                   f"{float(od.attrs['zeta']):g}) differ by sup {sup:.3f}",
+               short=f"left {li}/{lo}, return {back:.3f}",
+               margin=f"tolerances {t_back:.4f} of N, {t_left:g} particles, {t_level:g} cm",
                why="differs in: " + ", ".join(fails))
 
 
 @measure("figures/methods_tanks.png")
 def first_approx(view, e):
-    t_curve, t_left, t_level = tol(e)
+    """'A first approximation to 2D movement of a liquid', a qualitative sentence: the end state (the share left
+    in the first vessel within one floor row, the second-vessel surface within a/2); the course on the normalised
+    axis is reported, not judged."""
+    t_left, t_level = tol(e)
     ti, fi = transfer(view, ["flow_incomplete", "flow_complete"])
     ts, fs = transfer(view, ["sph:flow_wcsph_dx2.5"])
     gi, s50 = normalised(ti, fi, TAU)
@@ -1149,20 +1260,20 @@ def first_approx(view, e):
     v2 = second(fc)
     yi, ys = M.surface_of(fc, v2) - M.vessel_view(fc, v2)["floor_y"], M.surface_of(sph, v2) - M.vessel_view(sph, v2)["floor_y"]
     rng = M.surface_measures(sph, v2)["surface_range_cm"]
-    ok = sup <= t_curve and abs(li - ls) <= t_left and abs(yi - ys) <= t_level
+    ok = abs(li - ls) <= t_left and abs(yi - ys) <= t_level
     rep = []
     for k in ("mps:flow_standard_dx3.45",):
         x = view.opt(k)
         if x is not None:
             lx = M.flow_measures(x)["particles_left"] / x.sizes["particle"]
             rep.append(f"{k}: {lx:.1%} left ({x.attrs['status']})")
-    fails = [w for w, bad in (("transfer curve", sup > t_curve), ("share left", abs(li - ls) > t_left),
+    fails = [w for w, bad in (("share left", abs(li - ls) > t_left),
                               ("second-vessel level", abs(yi - ys) > t_level)) if bad]
     return Out(ok, f"ISA (flow_complete, {fc.attrs['status']}) against WCSPH ({view.key('sph:flow_wcsph_dx2.5')}, "
-                   f"{sph.attrs['status']}): sup |f_isa - f_sph| on tau = {sup:.3f} (ISA t_50 {s50:,.0f} steps, SPH "
-                   f"{t50:.3g} s); share left {li:.1%} vs {ls:.1%}; second-vessel surface {yi:.2f} vs {ys:.2f} cm (SPH "
-                   f"surface range {rng:.1f} cm)" + (f"; {'; '.join(rep)}" if rep else ""),
-               short=f"sup {sup:.3f}, left {li:.0%}/{ls:.0%}", margin=f"tolerances {t_curve:.4f}, {t_left:.4f}, {t_level:g} cm",
+                   f"{sph.attrs['status']}): share left {li:.1%} vs {ls:.1%}; second-vessel surface {yi:.2f} vs "
+                   f"{ys:.2f} cm (SPH surface range {rng:.1f} cm); reported, not judged: sup |f_isa - f_sph| on tau = "
+                   f"{sup:.3f} (ISA t_50 {s50:,.0f} steps, SPH {t50:.3g} s)" + (f"; {'; '.join(rep)}" if rep else ""),
+               short=f"left {li:.0%}/{ls:.0%}", margin=f"tolerances {t_left:.4f}, {t_level:g} cm",
                why="differs in: " + ", ".join(fails) + "; the static analysis stops in a jammed heap with stable floor "
                    "layers, the liquid drains to a film and levels")
 

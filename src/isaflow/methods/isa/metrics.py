@@ -10,8 +10,8 @@ metrics table's row.
 
 import numpy as np
 
-from ...metrics import (contact_in_vessel, contact_loads, flow_measures, hydrostatic_errors, level_of,  # noqa: F401
-                        load_errors, pairs, surface_measures, surface_of, vessel_view)
+from ...metrics import (contact_in_vessel, contact_loads, flow_measures, hydrostatic_errors, layer_pitch,  # noqa: F401
+                        level_of, load_errors, pairs, surface_measures, surface_of, vessel_view)
 from . import theory
 
 
@@ -109,7 +109,7 @@ def run_row(ds, vessel=None):
     if "vessel" in ds.coords:
         row.update(flow_measures(ds))
     row["loads_vessel"] = vessel or "all"
-    row.update(load_errors(ds, vessel, "level"))
+    row.update(load_errors(ds, vessel, "own"))  # the one surface (metrics.surface_of)
     row.update(surface_measures(ds, vessel))
     row["surface"] = surface_of(ds, vessel)
     for ref in ("tank", "own"):

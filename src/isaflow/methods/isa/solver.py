@@ -234,6 +234,7 @@ def _solve(scene, pos0, weight, start_step, progress, state, rest_depth, threads
                                                  "state_fire_n_pos")] + [0.0]) if restored else np.zeros(5)
     if overdamped and not restored:
         kernel[2] = -1.0  # no quiet stretch yet
+    t_start = float(kernel[1]) if overdamped else 0.0  # this run's clock at its start (a continued run's chain time)
     rest_cfg = REST.load() if overdamped else None
     e_norm = float(np.sum(weight)) * float(rest_depth)
     if overdamped and not e_norm > 0:
@@ -354,7 +355,8 @@ def _solve(scene, pos0, weight, start_step, progress, state, rest_depth, threads
         ke = 0.5 * float(np.sum(weight / G * np.sum(vel * vel, axis=1)))
         at_rest = kernel[2] >= 0 and sim_time - kernel[2] >= rest_cfg["window"] - 1e-12
         params.update(rest_energy_ratio=rest_cfg["energy_ratio"], rest_window=rest_cfg["window"], rest_depth=rest_depth,
-                      final_energy_ratio=ke / e_norm, time_to_rest=float(kernel[2]) if at_rest else float("nan"),
+                      final_energy_ratio=ke / e_norm, start_time=t_start,
+                      time_to_rest=max(float(kernel[2]) - t_start, 0.0) if at_rest else float("nan"),
                       particle_mass=float(weight[0] / G) if len(weight) else float("nan"))
         if status == "converged":
             message += (f", at rest (e = KE / (W h) < {rest_cfg['energy_ratio']:g} since t = {kernel[2]:.4g} s); "

@@ -131,7 +131,7 @@ def fire_tables(tuning, references, outputs, meta, paper, required_ratio):
         row = _base_row(sid, ds)
         row.update(lattice=m["lattice"], du_factor=m["du_factor"], dt_factor=m["dt_factor"],
                    dt_max_s=float(ds.attrs["dt_max"]), a_cm=float(ds.attrs["spacing"]),
-                   level_cm=metrics.level_of(ds))
+                   level_cm=metrics.surface_of(ds))
         grid.append(row)
     grid = pd.DataFrame(grid).sort_values(["lattice", "du_factor", "dt_factor"], key=_lattice_key)
     refs = {}
@@ -139,7 +139,7 @@ def fire_tables(tuning, references, outputs, meta, paper, required_ratio):
         m = meta[_stem(p)]
         ds = read(p)
         refs[m["lattice"], m["variant"]] = dict(steps=int(ds["steps"]), status=ds.attrs["status"],
-                                                level=metrics.level_of(ds))
+                                                level=metrics.surface_of(ds))
     ratio = []
     for lattice, g in grid.groupby("lattice", sort=False):
         ok = g[g["status"] == "converged"]
@@ -182,7 +182,7 @@ def stability_row(sid, ds, m):
                du_over_a=a["du"] / lat_a if np.isfinite(lat_a) else np.nan, positions_finite=finite,
                floor_cm=float(ds["wall_segment"].values[:, [1, 3]].min()),
                top_cm=float(pos[:, 1].max()) if finite else np.nan, top0_cm=float(ds["pos0"].values[:, 1].max()),
-               level_cm=metrics.level_of(ds) if finite and np.isfinite(lat_a) else np.nan)
+               level_cm=metrics.surface_of(ds) if finite and np.isfinite(lat_a) else np.nan)
     row.update(metrics.law_usage(ds))
     if "vessel" in ds.coords and finite:
         for name in ds["vessel"].values:
@@ -290,16 +290,18 @@ def metrics_table(runs, outputs):
 
 def calibration_table(runs, outputs):
     """results/calibration.csv: calibration runs cal_{run}_kb{k}_r{ratio}.nc: run, k_b [N/cm],
-    k_p / k_b, levels [cm] (the paper's top-centre reading), outcome."""
+    k_p / k_b, level [cm] (the one surface, metrics.surface_of), level_top [cm] (the top particle centres, the
+    reading the adopted k_p was calibrated on), outcome."""
     rows = []
     for p in runs:
         ds = read(p)
         kb = ds.attrs["wall_r_u"] / ds.attrs["wall_l_u"]
         kp = ds.attrs["pair_r_u"] / ds.attrs["pair_l_u"]
-        e = metrics.load_errors(ds, None, "level")
+        e = metrics.load_errors(ds, None, "own")
         rows.append(dict(run=Path(p).stem.removeprefix("cal_").rsplit("_kb", 1)[0], resolution=ds.attrs["resolution"],
                          variant=ds.attrs["variant"], k_wall=kb, ratio=round(kp / kb, 6),
-                         spacing=float(ds.attrs["spacing"]), level=e["level"], level_max=e["level_max"], level_implied=e["level_implied"],
+                         spacing=float(ds.attrs["spacing"]), level=e["level"], level_top=metrics.level_of(ds),
+                         level_max=e["level_max"], level_implied=e["level_implied"],
                          status=ds.attrs["status"], steps=int(ds["steps"]), residual=float(ds["residual"])))
     df = pd.DataFrame(rows).sort_values(["run", "k_wall", "ratio"])
     _write(df, outputs[0])

@@ -333,11 +333,13 @@ def run_case(cfg, case, variant, loads=None):
     'hertz_eq27_uncapped' (undamped, eq. 27 with and without eq. 26's cap), 'hertz_R<r>mm' / 'hertz_R<r>m'
     (other disk radii), 'bar_tension_long[_e<%>_dt<f>]' (sustained tension), 'vessel' (4.4; variant
     pressure_load or water_particles), 'vessel_water_particles' (4.4 with water, the solid model = the
-    variant) or 'floor_<source>' (elastic floor; loads: the rigid-floor run file of variant 'oneway')."""
-    if case == "vessel_water_particles":
+    variant), 'vessel_water_stop' (the same with the paper's stop-at-the-boundary coupling) or 'floor_<source>'
+    (elastic floor; loads: the rigid-floor run file of variant 'oneway')."""
+    if case in ("vessel_water_particles", "vessel_water_stop"):
         from .water import run_water_vessel
 
-        r = run_water_vessel({**cfg, "vessel": {**cfg["vessel"], "solid_model": variant}})
+        coupling = {"coupling": "stop_at_boundary"} if case == "vessel_water_stop" else {}
+        r = run_water_vessel({**cfg, "vessel": {**cfg["vessel"], "solid_model": variant, **coupling}})
         r.variant = variant
         r.params["case"] = case
         return r

@@ -90,10 +90,10 @@ def run_floor(cfg, variant, loads=None, case=None):
             raise ValueError(f"{loads}: floor length {length:g} cm, the plate spans {span:g} cm")
         P = nodal(x, fy, dx, nx)
         W = float(ds["weight"].values.sum())
-        try:  # the liquid's depth above the floor, for deflection / depth (one-way coupling's premise)
-            from isaflow.metrics import level_of
+        try:  # the liquid's depth above the floor (its one surface), for deflection / depth (the one-way premise)
+            from isaflow.metrics import surface_of
 
-            depth = float(level_of(ds)) - float(ds["wall_segment"].values[[str(w) for w in ds["wall"].values].index(
+            depth = float(surface_of(ds)) - float(ds["wall_segment"].values[[str(w) for w in ds["wall"].values].index(
                 "floor"), 1])
         except (KeyError, ValueError):
             depth = float("nan")

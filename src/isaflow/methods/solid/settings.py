@@ -32,7 +32,8 @@ SECTIONS = {
                            K_GPa=POS, rho_water_kg_m3=POS, steps=COUNT, dt_ns=POS,
                            solid_model={"enum": ["paper", "hooke", "objective"]}, history_us=POS, record_every=COUNT,
                            water_kernel={"enum": ["cubic_spline", "wendland_c2", "wendland_c4", "wendland_c6"]},
-                           water_h_over_dx=POS, water_alpha={"type": "number", "minimum": 0}),
+                           water_h_over_dx=POS, water_alpha={"type": "number", "minimum": 0},
+                           coupling={"enum": ["mirror_pressure", "stop_at_boundary"]}),
     "floor": dict(span_cm=POS, dx_cm=POS, layers=COUNT, supports={"enum": ["simply_supported"]},
                           solid_model={"enum": ["paper", "hooke", "objective"]}, weight_N=POS, max_steps=COUNT),
 }
@@ -69,11 +70,11 @@ def claim_run_ids(config_path):
     """The run ids '<case>_<variant>' the claims registry asks for, from the settings file: the Hertz plate under
     every hertz.scale_radii_mm disk, eqs. 26-27 stepping (paper, hooke) and eq. 27 alone, the bar in sustained
     tension at every bar_long strain x step (the kept pair named bar_tension_long), the vessel with water under
-    the printed solid model."""
+    the printed solid model, with the project's coupling and with the paper's (stop at the boundary)."""
     c = load(config_path)
     radii = [f"{r:g}mm" if r < 1000 else f"{r / 1000:g}m" for r in c["hertz"]["scale_radii_mm"]]
     lg = c["bar_long"]
     sweep = [f"bar_tension_long_e{100 * e:g}_dt{d:g}_paper" for e in lg["strain_sweep"] for d in lg["dt_sweep"]
              if (e, d) != (lg["strain"], lg["dt_over_dx_c"])]
     return ([f"hertz_R{r}_paper" for r in radii] + ["hertz_eq27_paper", "hertz_eq27_hooke", "hertz_eq27_uncapped_paper",
-            "bar_tension_long_paper"] + sweep + ["vessel_water_particles_paper"])
+            "bar_tension_long_paper"] + sweep + ["vessel_water_particles_paper", "vessel_water_stop_paper"])

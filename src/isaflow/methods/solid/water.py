@@ -10,7 +10,14 @@ ring, spread over the layers the kernel reaches.  The ring's velocity enters the
 equation, so as the ring expands the water's density and pressure drop (by K dA / A).  Monaghan
 artificial viscosity alpha (settings).  The kernel, the eq. 9 bracket with its viscosity and the
 equation of state are the SPH package's (methods.sph.kernels.kernel_wf, pair_momentum;
-methods.sph.eos.pressure_of, linear: p = p0 + c0^2 (rho - rho0), c0^2 = K / rho0).  Units cm, N, s.
+methods.sph.eos.pressure_of, linear: p = p0 + c0^2 (rho - rho0), c0^2 = K / rho0).
+
+Coupling 'stop_at_boundary' (the paper's section 3, run as its own case): the ring particles take no part in
+the water's sums; a water particle in contact with a ring particle (centres closer than one particle length
+dx, the cubic particles touching) that moves towards it is given the force that stops its relative normal
+motion within the step, m (v_rel . n) / dt along the line of centres, and the ring particle the opposite
+force ("a force on the particles in contact proportional to what is needed to stop the particle from
+crossing the boundary and stop it from further travel").  Units cm, N, s.
 """
 
 import time
@@ -32,12 +39,16 @@ def water_pressure(rho, rho0, c0, p0):
     return p0 + pressure_of(rho, rho0, c0, 1.0, False, False)
 
 
+COUPLINGS = {"mirror_pressure": 0, "stop_at_boundary": 1}
+
+
 @njit(**JIT)
-def water_forces(pos, vel, rho, nw, m, h, kind, norm, K, rho0, p0, alpha, c0, fw, fs, drho):
+def water_forces(pos, vel, rho, nw, m, h, kind, norm, K, rho0, p0, alpha, c0, fw, fs, drho, mirror=True):
     """Forces fw (nw, 2) on the water, fs (N - nw, 2) of the water on the ring [N], and drho/dt (nw,).
 
     pos, vel (N, 2): water first (nw), then the ring.  m: water particle mass; norm = sigma / h^2;
-    K = rho0 c0^2 the bulk modulus (the equation of state takes c0)."""
+    K = rho0 c0^2 the bulk modulus (the equation of state takes c0).  mirror: the ring particles stand in the
+    water's sums (coupling mirror_pressure); False: they do not (coupling stop_at_boundary, stop_contacts)."""
     box = np.empty(4)
     box[0] = pos[:, 0].min()
     box[1] = pos[:, 1].min()
@@ -55,6 +66,8 @@ def water_forces(pos, vel, rho, nw, m, h, kind, norm, K, rho0, p0, alpha, c0, fw
             continue
         if a >= nw:  # water first
             a, b = b, a
+        if b >= nw and not mirror:
+            continue
         dx = pos[a, 0] - pos[b, 0]
         dy = pos[a, 1] - pos[b, 1]
         r2 = dx * dx + dy * dy
@@ -84,6 +97,39 @@ def water_forces(pos, vel, rho, nw, m, h, kind, norm, K, rho0, p0, alpha, c0, fw
         else:
             fs[b - nw, 0] -= fx
             fs[b - nw, 1] -= fy
+
+
+@njit(**JIT)
+def stop_contacts(xw, vw, xs, vs, m, dt, reach, fw, fs):
+    """The stop-at-the-boundary coupling: for every water particle (positions xw, velocities vw after the water's own
+    forces) within reach of a ring particle (xs, vs) and moving towards it, the force m (v_rel . n) / dt along the line
+    of centres that stops the relative normal motion within the step, added to fw (N, on the water) and, opposite,
+    to fs (on the ring); contacts are taken one after the other, each on the velocity the previous ones left.
+    Returns the number of contacts that acted."""
+    nw, ns = xw.shape[0], xs.shape[0]
+    acted = 0
+    for a in range(nw):
+        vx, vy = vw[a, 0], vw[a, 1]
+        for b in range(ns):
+            dx = xw[a, 0] - xs[b, 0]
+            dy = xw[a, 1] - xs[b, 1]
+            r2 = dx * dx + dy * dy
+            if r2 >= reach * reach or r2 == 0.0:
+                continue
+            r = np.sqrt(r2)
+            nx, ny = dx / r, dy / r
+            vn = (vx - vs[b, 0]) * nx + (vy - vs[b, 1]) * ny
+            if vn >= 0.0:  # at rest or moving apart: no stop needed
+                continue
+            f = -m * vn / dt
+            fw[a, 0] += f * nx
+            fw[a, 1] += f * ny
+            fs[b, 0] -= f * nx
+            fs[b, 1] -= f * ny
+            vx -= vn * nx
+            vy -= vn * ny
+            acted += 1
+    return acted
 
 
 def water_sites(na, dx):
@@ -119,6 +165,9 @@ def coupled_history(cfg, dt, steps, every, outcome=None):
     norm = SM.NORM[kind, 2] / h**2
     vw, rho = np.zeros_like(xw), np.full(nw, rho0)
     fw, fs, drho = np.zeros((nw, 2)), np.zeros((st.block.n, 2)), np.zeros(nw)
+    stop = v.get("coupling", "mirror_pressure") == "stop_at_boundary"
+    fc, fcs = np.zeros((nw, 2)), np.zeros((st.block.n, 2))
+    contacts = 0
     t, ui, pw = [0.0], [0.0], [p0]
     ring_all = np.ones(st.block.n, bool)
     ur = [np.zeros(st.block.n)]  # radial displacement of every ring particle at every record
@@ -128,7 +177,13 @@ def coupled_history(cfg, dt, steps, every, outcome=None):
     for step in range(1, steps + 1):
         pos = np.vstack([xw, st.pos[:, :2]])
         vel = np.vstack([vw, st.vel[:, :2]])
-        water_forces(pos, vel, rho, nw, m, h, kind, norm, K, rho0, p0, v["water_alpha"], c0, fw, fs, drho)
+        water_forces(pos, vel, rho, nw, m, h, kind, norm, K, rho0, p0, v["water_alpha"], c0, fw, fs, drho, not stop)
+        if stop:  # the paper's coupling: the contact forces that stop the water at the ring (stop_contacts)
+            fc[:] = 0.0
+            fcs[:] = 0.0
+            contacts += stop_contacts(xw, vw + dt * fw / m, st.pos[:, :2], st.vel[:, :2], m, dt, dx * (1 + 1e-9), fc, fcs)
+            fw += fc
+            fs += fcs
         st.fext[:, :2] = fs
         ring, msg, _, _ = S.relax(st, 0.0, 1, dt=dt, min_steps=1, chunk=1, log_every=1e9)
         vw += dt * fw / m
@@ -151,8 +206,17 @@ def coupled_history(cfg, dt, steps, every, outcome=None):
     st.wall_time = time.perf_counter() - t0  # the coupled loop: water and ring
     if outcome is not None:
         outcome.update(status=status, message=message, steps=done, water_max_move_over_dx=wmove, ur=np.array(ur),
-                       ur_paper=ur_paper)
+                       ur_paper=ur_paper, contacts=contacts)
     return np.array(t), np.array(ui), np.array(pw), st, inner, rho
+
+
+COUPLING_TEXT = {
+    "mirror_pressure": "ring particles within 2h stand for water of the water particle's mass, pressure and density; "
+                       "the ring takes the opposite force (no stop-at-the-boundary force)",
+    "stop_at_boundary": "the paper's section 3 coupling: the ring takes no part in the water's sums; a water particle "
+                        "touching a ring particle (centres closer than dx) and moving towards it gets the force "
+                        "m (v_rel . n) / dt that stops its relative normal motion within the step, the ring particle "
+                        "the opposite force"}
 
 
 def run_water_vessel(cfg):
@@ -211,9 +275,8 @@ def run_water_vessel(cfg):
                  "water_kernel": v["water_kernel"], "water_h_cm": v["water_h_over_dx"] * dx,
                  "water_alpha": v["water_alpha"], "ring_lattice": "square lattice, centre radius in [a, b)",
                  "K_N_cm2": K, "rho_water_N_s2_cm4": v["rho_water_kg_m3"] * 1e-8, "dt_s": dt, "paper_steps": v["steps"],
-                 "history_steps": steps, "coupling": "mirror_pressure",
-                 "coupling_description": "ring particles within 2h stand for water of the water particle's mass, "
-                                         "pressure and density; the ring takes the opposite force (no stop-at-"
-                                         "the-boundary force)"})
+                 "history_steps": steps, "coupling": v.get("coupling", "mirror_pressure"),
+                 "coupling_description": COUPLING_TEXT[v.get("coupling", "mirror_pressure")],
+                 "stop_contacts": int(out["contacts"])})
     r.variant = "water_particles"
     return r

@@ -355,7 +355,7 @@ def _run(tank, s, resolution, start, on_wall, t_max, log, threads=1):
         resolution=str(resolution) if start is None else "continued", on_wall=str(bool(on_wall)),
         threads=int(threads), layer_pitch=st["dy"], held_weight=held, initial_depth=initial_depth,
         tank_difference="; ".join(diff), rest_energy_ratio=rest_cfg["energy_ratio"], rest_window=rest_cfg["window"],
-        time_to_rest=monitor.time_to_rest() if status == "converged" else math.nan, start_time=t0,
+        time_to_rest=monitor.time_to_rest() - t0 if status == "converged" else math.nan, start_time=t0,
         final_energy_ratio=monitor.last, final_rms_speed=math.sqrt(2 * ke / (st["mass"] * nf)),
         particles_left=left, list_builds=builds)
     return Result(

@@ -137,7 +137,7 @@ def flow_complete_figure(inputs, outputs, paper=None, inferred=None):
     fig, ax = plt.subplots(figsize=(12, 6.9))
     fm = _state_axes(ax, ds)
     second = str(ds["vessel"].values[-1])
-    e, (_, _, mag, _) = metrics.contact_loads(ds, second, "level")
+    e, (_, _, mag, _) = metrics.contact_loads(ds, second, "own")
     th = column_weights(ds, second)
     v = metrics.vessel_view(ds, second)
     bar_scale = 15.0 / np.nanmax(np.concatenate([mag, th]))
@@ -220,4 +220,88 @@ def flow_history_figure(inputs, outputs, chains=None):
         ax_m.text(0.0, -0.22, "\n".join(key), transform=ax_m.transAxes, va="top", ha="left", fontsize=8)
     fig.suptitle("Flow history (band: min-max of max|F| over each record stride; dotted: f_tol = 0.1 N;\n"
                  "numbers: the runs of each chain, listed under it; shading alternates between runs)")
+    save(fig, outputs)
+
+
+def floor_drops_figure(inputs, outputs, drops=None, kept=None, registry=None, inferred=None):
+    """Figure 10 at every floor drop of the second vessel the claims sweep (input second_floor_drop): top row, the
+    end of the complete flow at each drop (particles by vessel, the one surface); bottom row, what the fragile rows
+    read at each drop against their tolerances: particles left (pap-6.4-fourteen: the paper's 14, +- half a floor
+    row) and the horizontal resultant at 100,000 steps (pap-6.3-sum-fx: >= 10 N f_tol).
+
+    drops: [{drop, complete, incomplete}] (run ids; inputs: their run files); kept: the kept drop (cm); registry:
+    the claims registry's files (the paper's 14, the tolerances of both rows are read from it)."""
+    from ....claims_registry import load
+
+    by = {p.rsplit("/", 1)[-1].removesuffix(".nc"): p for p in inputs}
+    reg = {c["id"]: c for c in load(str(__import__("pathlib").Path(registry[0]).parent) if registry else
+                                     "config/claims")}
+    four, sfx = reg["pap-6.4-fourteen"], reg["pap-6.3-sum-fx"]
+    claims = {"fourteen": (four["numbers"]["particles_left"]["value"], four["tolerance"]["value"]),
+              "sum_fx": sfx["tolerance"]["value"]}
+    rows = []
+    for d in drops:
+        ds, di = read(by[d["complete"]]), read(by[d["incomplete"]])
+        rows.append(dict(drop=float(d["drop"]), ds=ds, left=metrics.flow_measures(ds)["particles_left"],
+                         sum_fx=metrics.flow_measures(di)["sum_fx_N"], steps_i=int(di["steps"])))
+    n = len(rows)
+    fig = plt.figure(figsize=(3.3 * n, 7.4))
+    gs = fig.add_gridspec(2, n, height_ratios=[0.8, 1.0], hspace=0.32, wspace=0.08, top=0.86, bottom=0.08)
+    p14, t14 = claims["fourteen"]
+    thr = claims["sum_fx"]
+    for k, r in enumerate(rows):
+        ax = fig.add_subplot(gs[0, k])
+        ds = r["ds"]
+        draw_walls(ax, ds)
+        pos = ds["pos"].values
+        for name, color in zip([str(v) for v in ds["vessel"].values], VESSEL_COLOURS):
+            x0, x1 = ds["vessel_x"].sel(vessel=name).values
+            sel = (pos[:, 0] >= x0) & (pos[:, 0] < x1)
+            ax.plot(pos[sel, 0], pos[sel, 1], "o", ms=1.6, color=color)
+            v = metrics.vessel_view(ds, name)
+            if sel.any():
+                ax.plot(v["x_range"], [metrics.surface_of(ds, name)] * 2, "-", color=color, lw=0.8)
+        ax.set_aspect("equal")
+        ax.set_xlim(-8, 308)
+        ax.set_ylim(-108, 104)
+        ax.set_xticks([0, 100, 300])
+        ax.tick_params(labelsize=7)
+        if k:
+            ax.set_yticklabels([])
+        ok = abs(r["left"] - p14) <= t14
+        tag = " (kept)" if r["drop"] == kept else ""
+        ax.set_title(f"floor drop {r['drop']:g} cm{tag}\n{r['left']} left ({'within' if ok else 'outside'} "
+                     f"{p14:g} ± {t14:g}); {ds.attrs['status']}", fontsize=8.5,
+                     fontweight="bold" if r["drop"] == kept else "normal")
+    d = np.array([r["drop"] for r in rows])
+    ax_l = fig.add_subplot(gs[1, : n // 2 + n % 2])
+    ax_f = fig.add_subplot(gs[1, n // 2 + n % 2:])
+    left = np.array([r["left"] for r in rows])
+    ax_l.axhspan(p14 - t14, p14 + t14, color="tab:red", alpha=0.12, lw=0,
+                 label=f"the paper's {p14:g} ± {t14:g} (half a floor row): pap-6.4-fourteen passes")
+    ax_l.axhline(p14, color="tab:red", lw=1, ls="--")
+    ax_l.plot(d, left, "o-", color="k", label="particles left in the first vessel at the end of application 4")
+    fx = np.array([r["sum_fx"] for r in rows])
+    ax_f.axhspan(thr, max(fx.max(), thr) * 1.35, color="tab:red", alpha=0.12, lw=0,
+                 label=f"ΣF_x >= {thr:g} N (10 N f_tol, '>> 0'): pap-6.3-sum-fx passes")
+    ax_f.axhline(thr / 10, color="0.4", lw=1, ls=":", label=f"equilibrium bound N f_tol = {thr / 10:g} N")
+    ax_f.plot(d, fx, "o-", color=RESULTANT, label="ΣF_x at the end of application 3 (step 100,000 or an earlier cycle)")
+    for r, y in zip(rows, fx):
+        ax_f.annotate(f"{y:+.0f} N\n(step {r['steps_i']:,})", (r["drop"], y), xytext=(0, 8), textcoords="offset points",
+                      ha="center", fontsize=7)
+    for ax, what in ((ax_l, "particles"), (ax_f, "ΣF_x (N)")):
+        ax.axvline(kept, color="0.5", lw=1, ls="--")
+        ax.text(kept, 1.01, f"kept {kept:g} cm", transform=ax.get_xaxis_transform(), ha="center", va="bottom",
+                fontsize=8, color="0.3")
+        ax.set_xlabel("second vessel's floor below the first (cm), inferred: second_floor_drop")
+        ax.set_ylabel(what)
+        ax.set_xticks(d)
+        ax.legend(loc="upper right" if ax is ax_l else "upper left", fontsize=7.5, frameon=True, framealpha=0.9)
+    for r, y in zip(rows, left):
+        ax_l.annotate(f"{y}", (r["drop"], y), xytext=(6, 4), textcoords="offset points", fontsize=8)
+    ax_l.set_ylim(0, max(left.max(), p14 + t14) * 1.35)
+    ax_f.set_ylim(min(0.0, fx.min() * 1.3), max(fx.max(), thr) * 1.35)
+    fig.suptitle("Figure 10 at every floor drop the claims sweep: the end of the complete flow (paper's update) and "
+                 "the two rows whose verdict flips with the drop", fontsize=10)
+    inferred_note(fig, inferred)
     save(fig, outputs)

@@ -15,7 +15,8 @@ FLOOR = 1e-4  # smallest |error| drawn on the log axes (exact zeros sit on it)
 
 PANELS = [
     ("level_err_paper_cm", "|level - paper's level| (cm)",
-     "(a) free-surface level against the paper\n(k_p calibrated to match this level: config/inferred.yaml)"),
+     "(a) free surface (top centres + half the layer pitch) against the paper\n(k_p calibrated on the top centres: "
+     "config/inferred.yaml)"),
     ("level_err_hydro_cm", "|level - level implied by side loads| (cm)",
      "(b) level against hydrostatic consistency (2 B F_side / W)"),
     ("side_err", "|side-wall total / hydrostatic - 1| (-)", "(c) side-wall loads against hydrostatics"),
@@ -24,11 +25,17 @@ PANELS = [
 ]
 
 
-def error_vs_runtime_figure(inputs, outputs):
-    """Every error measure against solver wall-clock time, log-log: one marker per run;
-    colour = update rule, marker shape = lattice, filled = converged to f_tol, open = not;
-    a black ring marks the paper's configuration of each lattice."""
+X_AXES = {"wall_time_s": ("solver wall-clock time (s)", "Error against run time"),
+          "particle_steps": ("particles x force evaluations", "Error against work (particle-steps, hardware-independent)")}
+
+
+def error_vs_runtime_figure(inputs, outputs, x="wall_time_s"):
+    """Every error measure against solver wall-clock time (x='wall_time_s', a timing figure: it changes from run
+    to run) or against the work, particles x force evaluations (x='particle_steps': the same from run to run),
+    log-log: one marker per run; colour = update rule, marker shape = lattice, filled = converged to f_tol,
+    open = not; a black ring marks the paper's configuration of each lattice."""
     tab = pd.read_csv(inputs[0])
+    tab["particle_steps"] = tab["particles"] * tab["steps"]
     if "residual" not in tab and "residual_N" in tab:
         tab["residual"] = tab["residual_N"]
     fig, axes = plt.subplots(2, 3, figsize=(15, 9))
@@ -44,11 +51,10 @@ def error_vs_runtime_figure(inputs, outputs):
                 y = np.maximum(g[col].abs(), FLOOR)
                 conv = (g["status"] == "converged").values
                 c = variant_style("isa", var)[0]
-                ax.scatter(g["wall_time_s"][conv], y[conv], marker=marker, color=c, s=36, zorder=3)
-                ax.scatter(g["wall_time_s"][~conv], y[~conv], marker=marker, facecolors="none", edgecolors=c, s=36,
-                           zorder=3)
+                ax.scatter(g[x][conv], y[conv], marker=marker, color=c, s=36, zorder=3)
+                ax.scatter(g[x][~conv], y[~conv], marker=marker, facecolors="none", edgecolors=c, s=36, zorder=3)
         paper = tab[tab["paper_config"].astype(bool) & np.isfinite(tab[col])]
-        ax.scatter(paper["wall_time_s"], np.maximum(paper[col].abs(), FLOOR), s=230, facecolors="none",
+        ax.scatter(paper[x], np.maximum(paper[col].abs(), FLOOR), s=230, facecolors="none",
                    edgecolors="k", lw=1.1, zorder=4)
         if col == "residual":
             for ft in sorted(set(tab["f_tol_N"])):
@@ -56,13 +62,13 @@ def error_vs_runtime_figure(inputs, outputs):
             ax.text(0.02, 0.02, "dotted: f_tol of each lattice", transform=ax.transAxes, fontsize=7, color="gray")
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.set_xlabel("solver wall-clock time (s)")
+        ax.set_xlabel(X_AXES[x][0])
         ax.set_ylabel(ylabel)
         ax.set_title(title)
         ax.grid(True, which="major", alpha=0.3)
     _error_legend(axes[-1], tab, variants)
     fig.subplots_adjust(hspace=0.3)
-    fig.suptitle("Error against run time, single 100 cm vessel: paper's update and two variants (not in the paper)")
+    fig.suptitle(f"{X_AXES[x][1]}, single 100 cm vessel: paper's update and two variants (not in the paper)")
     save(fig, outputs)
 
 
