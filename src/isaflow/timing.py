@@ -24,6 +24,7 @@ import time
 from pathlib import Path
 
 JOBS = Path("logs") / "timing" / "jobs.jsonl"
+_JOB = {"threads": 1}  # the cores this job holds (job_start)
 PHASES = ("solve", "compile", "start-up", "other work", "scheduling")
 
 
@@ -33,6 +34,7 @@ def job_start(job):
     runs of the same commit must give byte-identical physics outputs), stderr goes to the rule's log.
     Returns the epoch time the script started (for :func:`record`)."""
     started = time.time()
+    _JOB["threads"] = int(job.threads)
     for var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS", "NUMBA_NUM_THREADS"):
         os.environ[var] = str(job.threads)
     sys.stderr = open(job.log[0], "w", buffering=1)
@@ -56,7 +58,8 @@ def record(rule, job, script_start, imported, solve_s=0.0, runs=0, path=JOBS):
     c = jit.counters() if jit else {"compile_s": 0.0, "load_s": 0.0, "compiled": 0, "gaps": []}
     line = {"rule": rule, "job": job, "process_start": process_start(), "script_start": script_start,
             "imported": imported, "end": time.time(), "solve_s": solve_s, "runs": runs,
-            "compile_s": c["compile_s"], "load_s": c["load_s"], "compiled": c["compiled"], "gaps": len(c["gaps"])}
+            "compile_s": c["compile_s"], "load_s": c["load_s"], "compiled": c["compiled"], "gaps": len(c["gaps"]),
+            "threads": _JOB["threads"]}
     path.parent.mkdir(parents=True, exist_ok=True)
     with open(path, "a") as f:
         f.write(json.dumps(line) + "\n")
@@ -82,15 +85,16 @@ def summary(jobs, start, end, cores):
     'wall', 'jobs', 'runs', 'gaps'."""
     out = dict.fromkeys(PHASES, 0.0)
     busy = 0.0
-    for j in jobs:
+    for j in jobs:  # a job holds its threads' cores from start to end
+        n = j.get("threads", 1)
         total = max(0.0, j["end"] - j["process_start"])
         startup = max(0.0, j["imported"] - j["process_start"]) + j["load_s"]
         solve, comp = j["solve_s"], j["compile_s"]
-        out["solve"] += solve
-        out["compile"] += comp
-        out["start-up"] += startup
-        out["other work"] += max(0.0, total - solve - comp - startup)
-        busy += total
+        out["solve"] += n * solve
+        out["compile"] += n * comp
+        out["start-up"] += n * startup
+        out["other work"] += n * max(0.0, total - solve - comp - startup)
+        busy += n * total
     out["scheduling"] = max(0.0, cores * (end - start) - busy)
     out.update(wall=end - start, jobs=len(jobs), runs=sum(j["runs"] for j in jobs),
                gaps=sum(j["gaps"] for j in jobs), cores=cores)

@@ -68,13 +68,17 @@ TANK_METHODS = [name for name, m in REGISTRY.items() if m.tank]
 # results/report/NN_name.md (assembled in NN order); timing fragments
 # results/timing/NN_name.md (everything that changes from run to run goes there, never into
 # docs/replication.md).
-TARGETS = {"targets": [], "report": [], "timing": []}
+TARGETS = {"targets": [], "report": [], "timing": [], "bench": []}
 
 
-def register(targets=(), report=(), timing=()):
+def register(targets=(), report=(), timing=(), bench=()):
+    """targets: outputs of the full run; report / timing: fragments of docs/replication.md / docs/timing.md;
+    bench: outputs of the benchmarks (target `benchmarks`, docs/benchmarks.md from its .md fragments), which
+    take the whole machine for minutes and are not part of the full run."""
     TARGETS["targets"].extend(targets)
     TARGETS["report"].extend(report)
     TARGETS["timing"].extend(timing)
+    TARGETS["bench"].extend(bench)
 
 
 def code(*modules):

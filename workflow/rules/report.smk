@@ -72,6 +72,34 @@ rule timing_report:
 register(targets=["docs/replication.md", "docs/timing.md"], report=["results/report/90_inferred.md"])
 
 
+# the benchmarks (snakemake -c2 benchmarks): step costs, compile and memory of every method against its peers;
+# each takes the whole machine for minutes, so the full run leaves them out
+rule bench_report:
+    input:
+        parts=lambda wc: sorted(p for p in TARGETS["bench"] if p.endswith(".md")),
+        code=code("report.speed"),
+    output:
+        "docs/benchmarks.md",
+    params:
+        func="report.speed.timing_report",
+        kw={"title": "Benchmarks"},
+    message:
+        JOB
+    resources:
+        **SMALL,
+    log:
+        "logs/report/benchmarks.log",
+    conda:
+        "../envs/isaflow.yaml"
+    script:
+        "../scripts/call.py"
+
+
+rule benchmarks:
+    input:
+        lambda wc: TARGETS["bench"] + ["docs/benchmarks.md"],
+
+
 # The report's copy of a figure, with its own caption (workflow/report/figures.yaml, the verdicts of the claims
 # it bears on from this run's claims registry), category and subcategory.  Only a run of this checkout makes
 # it, so a report never shows a committed figure the run did not make.

@@ -581,7 +581,7 @@ rule isa_timing:
         table1_md="results/isa/table1.md",
         code=code("methods.isa.report.speed"),
     output:
-        "results/timing/10_isa.md",
+        "results/bench/10_isa.md",
     params:
         func="methods.isa.report.speed.timing_fragment",
     message:
@@ -628,4 +628,4 @@ register(targets=PAPER_TARGETS + figure("calibration_free_surface") + figure("co
 register(report=["results/report/10_single.md", "results/report/20_flow.md", "results/report/30_study.md"])
 # the paper's claims are judged by the shared claims rule (claims.smk) from config/claims/papadopoulos2016.yaml
 # and methods.isa.claims: results/claims/registry/papadopoulos2016.csv
-register(timing=["results/timing/10_isa.md"])
+register(bench=["results/bench/10_isa.md"])

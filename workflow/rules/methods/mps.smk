@@ -137,7 +137,6 @@ rule mps_report:
     input:
         summary="results/mps/summary.csv",
         cfg=REGISTRY["mps"].settings,
-        bench="benchmarks/results/mps_step_cost.csv",
         code=code("methods.mps.report"),
     output:
         report="results/report/55_mps.md",
@@ -160,3 +159,26 @@ rule mps_report:
 register(MPS_FILES + ["results/mps/summary.csv"] + figure("mps_wall_loads") + figure("mps_flow") + figure("mps_rest")
          + figure("mps_column"),
          ["results/report/55_mps.md"], timing=["results/timing/55_mps.md"])
+
+
+rule mps_bench_fragment:
+    input:
+        bench="benchmarks/results/mps_step_cost.csv",
+        code=code("methods.mps.report"),
+    output:
+        "results/bench/55_mps.md",
+    params:
+        func="methods.mps.report.bench_fragment",
+    message:
+        JOB
+    resources:
+        **SMALL,
+    log:
+        "logs/mps/bench_fragment.log",
+    conda:
+        "../../envs/isaflow.yaml"
+    script:
+        "../../scripts/call.py"
+
+
+register(bench=["results/bench/55_mps.md"])

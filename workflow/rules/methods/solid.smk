@@ -53,96 +53,56 @@ register(SOLID_RUNS + SOLID_NEW_RUNS + SOLID_CLAIM_RUNS + SOLID_FIGURES, ["resul
          timing=["results/timing/65_solid.md"])
 
 
-# the bar, shear and Hertz cases (SOLID_RUNS, SOLID_CLAIM_RUNS) solve in seconds each: one job, one process
-SOLID_CASE_RUNS = SOLID_RUNS + SOLID_CLAIM_RUNS
+# every solid run without a liquid's loads (the bar, shear and Hertz cases, the pressure vessel, the uniformly
+# loaded floor) solves in seconds: one job, one process, one compile of the solid's kernels
+SOLID_BLOCK = [(os.path.basename(f)[:-3].rsplit("_", 1), f) for f in SOLID_RUNS + SOLID_CLAIM_RUNS] + [
+    (["vessel", v], f"results/solid/vessel_{v}.nc") for v in ("pressure_load", "water_particles")] + [
+    (["floor_uniform", "uniform_load"], "results/solid/floor_uniform_uniform_load.nc")]
 
 
 rule solid_cases:
     input:
         cfg=SOLID_CFG,
-        code=SOLID_CODE,
+        code=SOLID_NEW_CODE,
     output:
-        SOLID_CASE_RUNS,
+        [f for _, f in SOLID_BLOCK],
     params:
         func="methods.solid.outputs.run_cases",
-        kw={"cases": [os.path.basename(f)[:-3].rsplit("_", 1) for f in SOLID_CASE_RUNS]},
+        kw={"cases": [c for c, _ in SOLID_BLOCK]},
     conda:
         "../../envs/isaflow.yaml"
     message:
-        f"solid_cases: {len(SOLID_CASE_RUNS)} runs in one process"
+        f"solid_cases: {len(SOLID_BLOCK)} runs in one process"
     resources:
         mem_mb=SOLID["mem_mb"],
-        runtime=SOLID["runtime"] * 3,
+        runtime=SOLID["runtime"] * 4,
     log:
         "logs/solid/cases.log",
     script:
         "../../scripts/call.py"
 
 
-rule solid_vessel:
+# the elastic floor under each tank method's liquid (its first compared single-vessel run): one job, after the
+# solid cases' job has filled the solid's kernel cache (ancient: their dates do not matter)
+rule solid_floors_oneway:
     input:
         cfg=SOLID_CFG,
+        loads=lambda wc: [first_run(m, "single") for m in SOLID_FLOOR_LOADS],
+        kernels=ancient(SOLID_BLOCK[0][1]),
         code=SOLID_NEW_CODE,
     output:
-        "results/solid/vessel_{variant}.nc",
-    wildcard_constraints:
-        variant="pressure_load|water_particles",
+        [f"results/solid/floor_{src}_oneway.nc" for src in SOLID_FLOOR_LOADS],
     params:
-        func="methods.solid.outputs.run_case",
-        kw=lambda wc: dict(case="vessel", variant=wc.variant),
+        func="methods.solid.outputs.run_cases",
+        kw={"cases": [[f"floor_{src}", "oneway"] for src in SOLID_FLOOR_LOADS]},
     conda:
         "../../envs/isaflow.yaml"
     message:
-        JOB
+        f"solid_floors_oneway: {len(SOLID_FLOOR_LOADS)} runs in one process"
     resources:
         **SOLID,
     log:
-        "logs/solid/vessel_{variant}.log",
-    script:
-        "../../scripts/call.py"
-
-
-rule solid_floor_uniform:
-    input:
-        cfg=SOLID_CFG,
-        code=SOLID_NEW_CODE,
-    output:
-        "results/solid/floor_uniform_uniform_load.nc",
-    params:
-        func="methods.solid.outputs.run_case",
-        kw=dict(case="floor_uniform", variant="uniform_load"),
-    conda:
-        "../../envs/isaflow.yaml"
-    message:
-        JOB
-    resources:
-        **SOLID,
-    log:
-        "logs/solid/floor_uniform_uniform_load.log",
-    script:
-        "../../scripts/call.py"
-
-
-rule solid_floor_oneway:
-    input:
-        cfg=SOLID_CFG,
-        loads=lambda wc: first_run(wc.src, "single"),
-        code=SOLID_NEW_CODE,
-    output:
-        "results/solid/floor_{src}_oneway.nc",
-    wildcard_constraints:
-        src="|".join(SOLID_FLOOR_LOADS),
-    params:
-        func="methods.solid.outputs.run_case",
-        kw=lambda wc: dict(case=f"floor_{wc.src}", variant="oneway"),
-    conda:
-        "../../envs/isaflow.yaml"
-    message:
-        JOB
-    resources:
-        **SOLID,
-    log:
-        "logs/solid/floor_{src}_oneway.log",
+        "logs/solid/floors_oneway.log",
     script:
         "../../scripts/call.py"
 

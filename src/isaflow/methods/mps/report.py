@@ -220,14 +220,20 @@ def cost(bench, target_n=5000, target_ms=50.0):
             f"{big.liquid_particles} particles the fastest is `{big.solver}` ({big.threads} threads), {big.step_ms:.4g} ms per step.")
 
 
-def timing(df, cfg, bench):
-    """Markdown for docs/timing.md: ms per step of every MPS run and the step-cost benchmark."""
+def timing(df, cfg):
+    """Markdown for docs/timing.md: ms per step of every MPS run."""
     g = lambda x: _fmt(x)  # noqa: E731
-    lines = ["## MPS: cost per step (results/mps/summary.csv, benchmarks/results/mps_step_cost.csv)", "",
+    lines = ["## MPS: cost per step (results/mps/summary.csv)", "",
              f"Pressure solver `{cfg['pressure.solver']}`.", ""]
     lines += _table(df.sort_values(["case", "run"]), [("run", None), ("status", None), ("particles", g), ("ms_per_step", g)],
                     ["run", "status", "particles", "ms/step"])
-    return "\n".join(lines + ["", cost(bench), ""])
+    return "\n".join(lines + [""])
+
+
+def bench_fragment(bench, outputs):
+    """outputs = [the benchmarks page's MPS fragment] from the step-cost benchmark."""
+    Path(outputs[0]).parent.mkdir(parents=True, exist_ok=True)
+    Path(outputs[0]).write_text(f"## MPS: step-cost benchmark (benchmarks/results/mps_step_cost.csv)\n\n{cost(bench)}\n")
 
 
 SINGLE_TABLE = "mps_single.csv"  # every single-vessel run, next to the report
@@ -238,13 +244,13 @@ SINGLE_COLUMNS = ["run", "source_term", "spacing_cm", "particles", "status", "si
                   "deepest_graze_cm"]
 
 
-def write(summary, cfg, bench, outputs):
-    """outputs = [report fragment, timing fragment, docs/tables/mps_single.csv] from the summary table, the
-    settings file and the step-cost benchmark."""
+def write(summary, cfg, outputs):
+    """outputs = [report fragment, timing fragment, docs/tables/mps_single.csv] from the summary table and the
+    settings file."""
     df = pd.read_csv(summary, keep_default_na=True)
     cfg_ = settings.load(cfg)
     for p in outputs:
         Path(p).parent.mkdir(parents=True, exist_ok=True)
     Path(outputs[0]).write_text(fragment(df, cfg_) + "\n")
-    Path(outputs[1]).write_text(timing(df, cfg_, bench))
+    Path(outputs[1]).write_text(timing(df, cfg_))
     df[df.case == "single"][SINGLE_COLUMNS].to_csv(outputs[2], index=False, float_format="%.6g")

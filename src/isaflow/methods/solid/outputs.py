@@ -67,12 +67,13 @@ def run_case(cfg, outputs, case, variant, loads=None):
     return write_run(cfg, case, variant, outputs[0], loads=loads)
 
 
-def run_cases(cfg, outputs, cases):
+def run_cases(cfg, outputs, cases, loads=None, kernels=None):
     """Workflow entry point of a block of cases in one process: write_run of each [case, variant] in cases to
-    the output at the same place."""
+    the output at the same place; loads: the rigid-floor run file of each (elastic-floor cases), or None;
+    kernels: an input that only orders the job (its file is not read)."""
     logging.basicConfig(stream=sys.stderr, level=logging.INFO, format="%(asctime)s %(message)s")
-    for (case, variant), out in zip(cases, outputs):
-        write_run(cfg, case, variant, out)
+    for k, ((case, variant), out) in enumerate(zip(cases, outputs)):
+        write_run(cfg, case, variant, out, loads=loads[k] if loads else None)
 
 
 def write_run(config_path, case, variant, out, loads=None):
