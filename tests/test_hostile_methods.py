@@ -23,6 +23,7 @@ from isaflow import cli, preflight, settings, tank as tanks
 from isaflow.inputs import InputError
 
 SINGLE = ROOT / "config" / "tanks" / "single.yaml"
+FLOW = ROOT / "config" / "tanks" / "flow_step50.yaml"
 DEFAULT = {"isa": ("coarse", "paper"), "sph": ("n180", "wcsph"), "mps": ("dx5.56", "standard")}
 
 
@@ -48,8 +49,8 @@ def method_argv(method, *sets, tank=SINGLE, extra=()):
 
 
 # ---- tanks: every tank method refuses the same bad tank ------------------------------------------------
-def _tank(**change):
-    spec = yaml.safe_load(SINGLE.read_text())
+def _tank(base=SINGLE, **change):
+    spec = yaml.safe_load(base.read_text())
     for key, value in change.items():
         spec[key] = value
     return spec
@@ -78,6 +79,11 @@ TANK_CASES = {
     "unknown_key": (_tank(colour="blue"), "(top level)"),
     "no_liquid": ({k: v for k, v in _tank().items() if k != "liquid"}, "'liquid'"),
     "one_wall": (_tank(walls=[W[1]]), "'walls'"),
+    # the depth from the first vessel's own floor (y = 0), not from the second vessel's 50 cm lower
+    "depth_above_own_vessel": (_tank(FLOW, liquid={"weight": 9000.0, "depth": 140.0}), "'liquid.depth'"),
+    # the first vessel's right wall 60 cm high: a 72.5 cm liquid stands over it (the outline's walls are 100 cm)
+    "depth_above_own_side_wall": (_tank(FLOW, walls=[{**w, "to": [100, 60]} if w["name"] == "right1" else w
+                                                     for w in _tank(FLOW)["walls"]]), "'liquid.depth'"),
 }
 
 

@@ -30,6 +30,45 @@ def _segments(spec):
     return [tuple(float(c) for c in w["from"] + w["to"]) for w in spec["walls"]]
 
 
+def vessel_floor(walls, x0, x1):
+    """y [cm] of the floor of a vessel over (x0, x1): the lowest horizontal wall running inside that range (a
+    floor only touching its end belongs to the next vessel); None if there is none.  walls: [(x0, y0, x1, y1)]."""
+    ys = [s[1] for s in walls if abs(s[1] - s[3]) <= TOL and min(max(s[0], s[2]), x1) - max(min(s[0], s[2]), x0) > TOL]
+    return min(ys) if ys else None
+
+
+def side_top(walls, x):
+    """Highest y [cm] of the walls that are not floors where they meet the vertical line at x (a vessel's side);
+    None if no such wall reaches it."""
+    ys = []
+    for x0, y0, x1, y1 in walls:
+        if abs(y0 - y1) <= TOL or not min(x0, x1) - TOL <= x <= max(x0, x1) + TOL:
+            continue
+        ys += [max(y0, y1)] if abs(x1 - x0) <= TOL else [y0 + (y1 - y0) * (x - x0) / (x1 - x0)]
+    return max(ys) if ys else None
+
+
+def bounds(walls):
+    """(xmin, ymin, xmax, ymax) [cm] of the walls' bounding box (pure Python)."""
+    xs = [c for s in walls for c in (s[0], s[2])]
+    ys = [c for s in walls for c in (s[1], s[3])]
+    return min(xs), min(ys), max(xs), max(ys)
+
+
+def check_points(path, field, points, walls):
+    """Refuse points (x, y) [cm] outside the walls' bounding box (NaN counts as outside), naming the first;
+    points: a sequence of pairs, or an (N, 2) array; walls: [(x0, y0, x1, y1)] or a (W, 4) array."""
+    box = bounds([tuple(map(float, w)) for w in walls])
+    out = [(x, y) for x, y in points if not (box[0] <= x <= box[2] and box[1] <= y <= box[3])]
+    if out:
+        _outside(path, field, len(out), box, out[0])
+
+
+def _outside(path, field, count, box, first, what="point(s)"):
+    raise InputError(f"{path}: field '{field}': {count} {what} lie outside the walls' bounding box "
+                     f"[{box[0]:g}, {box[2]:g}] x [{box[1]:g}, {box[3]:g}] cm, e.g. ({first[0]:g}, {first[1]:g})")
+
+
 @dataclass
 class Tank:
     """A validated tank: ``spec`` is the file's mapping, ``text`` its text."""
@@ -74,9 +113,7 @@ class Tank:
 
     def floor_y(self, vessel=0):
         """y [cm] of a vessel's floor: the lowest horizontal wall over its x range."""
-        x0, x1 = self.vessels[vessel][1]
-        return min(s[1] for s in _segments(self.spec) if abs(s[1] - s[3]) <= TOL
-                   and min(max(s[0], s[2]), x1) - max(min(s[0], s[2]), x0) > TOL)
+        return vessel_floor(_segments(self.spec), *self.vessels[vessel][1])
 
     @property
     def rho_g(self):
@@ -89,10 +126,8 @@ class Tank:
         bounding box, open upwards by the tank's own height (a splash may rise above the open top and fall
         back; one rising higher than the tank is tall carries energy no jet of this tank has).  A tuple (pure
         Python: the workflow's checks use it while it is parsed)."""
-        segs = _segments(self.spec)
-        xs = [c for s in segs for c in (s[0], s[2])]
-        ys = [c for s in segs for c in (s[1], s[3])]
-        return (min(xs), min(ys), max(xs), max(ys) + (max(ys) - min(ys)))
+        x0, y0, x1, y1 = bounds(_segments(self.spec))
+        return (x0, y0, x1, y1 + (y1 - y0))
 
     @property
     def digest(self):
@@ -199,25 +234,32 @@ def check_geometry(path, spec, walls):
         if k not in order and (min(s[0], s[2]) < x_lo - TOL or max(s[0], s[2]) > x_hi + TOL):
             raise InputError(f"{where} ({names[k]}): a wall outside the tank's outline [{x_lo:g}, {x_hi:g}] cm")
     vessels = spec.get("vessels") or [{"name": "(whole tank)", "x": [x_lo, x_hi]}]
-    floor_y = None
+    outline = [walls[k] for k in order]
     for v in vessels:
         x0, x1 = v["x"]
         if x0 < x_lo - TOL or x1 > x_hi + TOL:
             raise InputError(f"{path}: field 'vessels' ({v['name']}): [{x0:g}, {x1:g}] cm lies outside the walls "
                              f"[{x_lo:g}, {x_hi:g}] cm")
-        under = [walls[k] for k in order if _horizontal(walls[k]) and min(walls[k][0], walls[k][2]) <= x1
-                 and max(walls[k][0], walls[k][2]) >= x0]
-        if not under:
+        if vessel_floor(outline, x0, x1) is None:
             raise InputError(f"{path}: field 'vessels' ({v['name']}): no floor under [{x0:g}, {x1:g}] cm")
-        if floor_y is None:
-            floor_y = min(s[1] for s in under)
     for a, b in zip(vessels, vessels[1:]):
         if b["x"][0] < a["x"][1] - TOL:
             raise InputError(f"{path}: field 'vessels' ({b['name']}): overlaps '{a['name']}'")
+    check_depth(path, spec, walls, outline, top)
+
+
+def check_depth(path, spec, walls, outline, top):
+    """The liquid's top, its depth above the first vessel's own floor, below that vessel's walls: the outline's
+    wall tops (top, y cm) and the walls on the vessel's two sides."""
+    (x0, x1), name = (spec["vessels"][0]["x"], f"vessel '{spec['vessels'][0]['name']}'") if spec.get("vessels") \
+        else ((outline[0][0], outline[-1][2]), "the tank")
+    floor = vessel_floor(outline, x0, x1)
+    sides = [t for t in (side_top(walls, x0), side_top(walls, x1)) if t is not None]
+    top = min([top, *sides])
     depth = float(spec["liquid"]["depth"])
-    if floor_y + depth > top + TOL:
-        raise InputError(f"{path}: field 'liquid.depth': {depth:g} cm above the first floor (y = {floor_y:g} cm) "
-                         f"reaches over the wall tops (y = {top:g} cm)")
+    if floor + depth > top + TOL:
+        raise InputError(f"{path}: field 'liquid.depth': {depth:g} cm above the floor of {name} (y = {floor:g} cm) "
+                         f"reaches over its walls (y = {top:g} cm)")
 
 
 def check_positions(path, field, pos, walls):
@@ -227,15 +269,10 @@ def check_positions(path, field, pos, walls):
 
     if not np.isfinite(pos).all():
         raise InputError(f"{path}: field '{field}': positions must be finite")
-    ends = np.asarray(walls, float).reshape(-1, 2)
-    lo, hi = ends.min(0), ends.max(0)
-    out = ~((pos >= lo) & (pos <= hi)).all(1)  # NaN counts as outside
+    box = bounds(np.asarray(walls, float).tolist())
+    out = ~((pos >= box[:2]) & (pos <= box[2:])).all(1)  # NaN counts as outside
     if out.any():
-        x, y = pos[np.argmax(out)]
-        raise InputError(
-            f"{path}: field '{field}': {out.sum()} particle(s) lie outside the walls' "
-            f"bounding box [{lo[0]}, {hi[0]}] x [{lo[1]}, {hi[1]}] cm, e.g. ({x:g}, {y:g})"
-        )
+        _outside(path, field, int(out.sum()), box, pos[np.argmax(out)], "particle(s)")
 
 
 def path_of(name):
