@@ -19,7 +19,7 @@ import pytest
 import yaml
 from conftest import ROOT
 
-from isaflow import cli, preflight, settings, tank as tanks
+from isaflow import budget, cli, preflight, settings, tank as tanks
 from isaflow.inputs import InputError
 
 SINGLE = ROOT / "config" / "tanks" / "single.yaml"
@@ -177,6 +177,10 @@ CLI_CASES = {
     "set_newline": (method_argv("sph", "settings.cfl=0.25\nsettings.alpha=9"), "settings.cfl"),
     "tank_is_a_directory": (["--method", "sph", "--tank", str(ROOT / "config"), "--variant", "wcsph",
                              "--resolution", "n180"], "a directory"),
+    "threads_zero": (method_argv("isa", extra=["--threads", "0"]), "--threads"),
+    "threads_negative": (method_argv("sph", extra=["--threads", "-1"]), "--threads"),
+    "threads_beyond_the_machine": (method_argv("mps", extra=["--threads", str(budget.machine_cores() + 1)]),
+                                   "--threads"),
 }
 
 
@@ -185,6 +189,12 @@ def test_bad_command_lines_are_refused(tmp_path, capsys, case):
     argv, field = CLI_CASES[case]
     cli_refuses(capsys, tmp_path, argv, field)
     assert not (tmp_path / "pwned").exists()
+
+
+@pytest.mark.parametrize("value", ["0", "-3", "abc", str(budget.machine_cores() + 1)])
+def test_a_thread_count_numba_cannot_use_is_refused_from_the_environment(tmp_path, capsys, monkeypatch, value):
+    monkeypatch.setenv("NUMBA_NUM_THREADS", value)
+    cli_refuses(capsys, tmp_path, method_argv("isa"), "environment variable NUMBA_NUM_THREADS")
 
 
 def test_a_stability_case_may_leave_the_literature_ranges_but_not_the_budget():
@@ -302,6 +312,17 @@ PARSE_CASES = {
 }
 
 
+def _parse_refuses(proj, field, *args):
+    """snakemake -n in proj: exit 2, one line naming the field, no traceback, no job, nothing under results/."""
+    proc = subprocess.run([sys.executable, "-m", "snakemake", "-n", "--workflow-profile", "none", *args], cwd=proj,
+                          capture_output=True, text=True, timeout=120)
+    errors = [line for line in proc.stderr.splitlines() if line.startswith("error: ")]
+    assert proc.returncode == 2, proc.stderr[-2000:]
+    assert len(errors) == 1 and field in errors[0], proc.stderr[-2000:]
+    assert "Traceback" not in proc.stderr
+    assert not (proj / "results").exists() and not (proj / "pwned").exists()
+
+
 @pytest.mark.parametrize("case", sorted(PARSE_CASES))
 def test_the_workflow_refuses_bad_inputs_while_it_is_parsed(tmp_path, case):
     """snakemake -n on a copy of the project with one bad input: exit 2, one line naming the file and field,
@@ -309,13 +330,25 @@ def test_the_workflow_refuses_bad_inputs_while_it_is_parsed(tmp_path, case):
     rel, old, new, field = PARSE_CASES[case]
     proj = _project(tmp_path)
     _edit(proj / rel, old, new)
-    proc = subprocess.run([sys.executable, "-m", "snakemake", "-n", "-c1", "--workflow-profile", "none"], cwd=proj,
-                          capture_output=True, text=True, timeout=120)
-    errors = [line for line in proc.stderr.splitlines() if line.startswith("error: ")]
-    assert proc.returncode == 2, proc.stderr[-2000:]
-    assert len(errors) == 1 and field in errors[0], proc.stderr[-2000:]
-    assert "Traceback" not in proc.stderr
-    assert not (proj / "results").exists() and not (proj / "pwned").exists()
+    _parse_refuses(proj, field, "-c1")
+
+
+PARSE_ARGS = {
+    "cores_zero": (["-c0"], "'--cores'"),
+    "cores_negative": (["--cores", "-1"], "'--cores'"),
+    "cores_beyond_the_machine": (["-c", str(budget.machine_cores() + 1)], "'--cores'"),
+    **{f"undeclared_{m}_run": (["-c1", f"results/runs/{m}/no_such_run.nc"], f"config/methods/{m}.yaml: field 'runs'")
+       for m in DEFAULT},
+    "run_of_another_method": (["-c1", "results/runs/mps/single_coarse.nc"], "no mps run 'single_coarse'"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(PARSE_ARGS))
+def test_the_workflow_refuses_bad_command_lines_before_any_job(tmp_path, case):
+    """A core count that is no count, or a run file no settings file declares asked for as a target: one line,
+    exit 2, before any job starts (an undeclared target was a KeyError traceback while the DAG was built)."""
+    args, field = PARSE_ARGS[case]
+    _parse_refuses(_project(tmp_path), field, *args)
 
 
 def test_no_shell_line_is_built_from_configuration():

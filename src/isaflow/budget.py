@@ -15,6 +15,7 @@ import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from . import inputs
 from .inputs import InputError
 
 LIMITS = Path("config") / "limits.yaml"
@@ -72,6 +73,32 @@ def memory_limit():
     except OSError:
         pass
     return DEFAULT_MEMORY
+
+
+def machine_cores():
+    """Cores this process may run on (its CPU affinity, as numba counts them)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not Linux
+        return os.cpu_count() or 1
+
+
+def check_threads(where, value, most=None):
+    """Refuse a thread or core count that is not a whole number from 1 to ``most`` (default: the machine's
+    cores); where: what the user wrote, e.g. 'argument --threads'."""
+    cores = machine_cores()
+    most = cores if most is None else most
+    if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= most:
+        raise InputError(f"{where}: {inputs.printable(str(value))} is not a whole number from 1 to {most} (this "
+                         f"machine gives the process {cores} cores)")
+    return value
+
+
+def check_environment():
+    """Refuse a NUMBA_NUM_THREADS in the environment that numba cannot use or this machine cannot give."""
+    env = os.environ.get("NUMBA_NUM_THREADS")
+    if env is not None:
+        check_threads("environment variable NUMBA_NUM_THREADS", int(env) if env.strip().isdigit() else env)
 
 
 def cpu_hours(path=LIMITS):

@@ -21,6 +21,7 @@ WORKFLOW_KEYS = ("meta", "runtime")  # keys the workflow adds to a declaration (
 def check(method, tank, s, accept=("converged",), stability=False, max_hours=None, particles=None):
     """Refuse (InputError) a run whose outcomes, settings or cost are not allowed.  tank: tank.Tank; s: resolved
     settings.Settings; particles: a start file's count (None: the resolution's).  Returns the budget.Cost."""
+    budget.check_environment()
     unstable = [a for a in accept if a in UNSTABLE]
     if unstable and not stability:
         raise InputError(f"accept: outcome '{unstable[0]}' may be accepted only by a declared stability case "

@@ -46,7 +46,7 @@ RUN_RESOURCES = {}  # {(method, run id): {'mem_mb', 'runtime'}}, filled by check
 def run_resources(members):
     """mem_mb and runtime of a job running members [(method, run id)] one after another, from their cost
     estimates (isaflow.budget.job_resources): the largest memory, the sum of the times."""
-    res = [RUN_RESOURCES[m] for m in members]
+    res = [RUN_RESOURCES[m] for m in members if declaration(*m)]
     return {"mem_mb": max(r["mem_mb"] for r in res), "runtime": sum(r["runtime"] for r in res)}
 
 
@@ -129,9 +129,18 @@ def run_file(method, run):
     return f"results/runs/{method}/{run}.nc"
 
 
+def declaration(method, run):
+    """The declaration of a run; a run no settings file declares (a target such as results/runs/<method>/<id>.nc
+    asked for on the command line) is refused with one line while the jobs are planned, before any starts."""
+    if run not in RUNS[method]:
+        refuse(f"{REGISTRY[method].settings}: field 'runs': no {method} run '{_inputs.printable(run)}' is declared, "
+               f"so nothing makes {_inputs.printable(run_file(method, run))}")
+    return RUNS[method][run]
+
+
 def run_job(method, run):
     """(method, run id, declaration + the paths isaflow.run reads: tank_file, settings_file, start_file)."""
-    decl = dict(RUNS[method][run], tank_file=f"config/tanks/{RUNS[method][run]['tank']}.yaml",
+    decl = dict(declaration(method, run), tank_file=f"config/tanks/{RUNS[method][run]['tank']}.yaml",
                 settings_file=REGISTRY[method].settings)
     if decl.get("start"):
         decl["start_file"] = run_file(method, decl["start"])
@@ -146,7 +155,7 @@ def runs_inputs(members):
     out = {"tank": [], "settings": [], "start": [], "compiled": [],
            "code": code("isaflow.run", "isaflow.timing") + ["workflow/scripts/run.py"]}
     for method, run in members:
-        decl = RUNS[method][run]
+        decl = declaration(method, run)
         out["tank"].append(f"config/tanks/{decl['tank']}.yaml")
         out["settings"].append(REGISTRY[method].settings)
         out["code"] += code(REGISTRY[method].entry)
@@ -308,6 +317,7 @@ def check_inputs():
 
     d = _preflight.Declarations()
     try:
+        check_cores(_budget)
         for name in config["compare"]["tanks"]:
             try:
                 d.tank(name)
@@ -321,6 +331,17 @@ def check_inputs():
     except _inputs.InputError as err:
         refuse(err)
     RUN_RESOURCES.update({key: _budget.job_resources(cost) for key, cost in d.costs.items()})
+
+
+def check_cores(budget):
+    """Snakemake's --cores: from 1 to this machine's cores when the jobs run here, at least 1 otherwise (a job's
+    threads are at most the cores, and each sets NUMBA_NUM_THREADS to its threads)."""
+    try:
+        cores = workflow.cores
+    except Exception:  # a cluster run given no --cores: each job's threads are its rule's
+        return
+    budget.check_threads("snakemake command line: field '--cores'", cores,
+                         None if workflow.local_exec else max(cores, 1))
 
 
 def workflow_timing(cores):
