@@ -248,10 +248,17 @@ OTHER_CASES = {
     "solid_water_h_tiny": ("solid", "vessel.water_h_over_dx", 0.1, "'vessel.water_h_over_dx'"),
     "solid_history_1e12_us": ("solid", "vessel.history_us", 1e12, "'vessel.history_us'"),
     "solid_floor_dx_1e-9": ("solid", "floor.dx_cm", 1e-9, "'floor.dx_cm'"),
+    # a case that is no solid under load was written as converged with zero stress
+    "solid_bar_one_particle": ("solid", "bar.particles", [1, 1, 1], "'bar.particles'"),
+    "solid_bar_two_layers": ("solid", "bar.particles", [5, 2, 5], "'bar.particles'"),
+    "solid_shear_no_grip": ("solid", "shear.grip_layers", 0, "'shear.grip_layers'"),
+    "solid_hertz_plate_one_row": ("solid", "hertz.plate", [51, 1], "'hertz.plate'"),
+    "solid_floor_one_column": ("solid", "floor.dx_cm", 200.0, "'floor.dx_cm'"),
+    "solid_long_bar_1e15_steps": ("solid", "bar_long.steps", 10**15, "'bar_long.steps'"),
     "sph1d_n_1e12": ("sph1d", "n", [32, 64, 128, 1000000000000], "'n'"),
     "sph1d_ratio_1e9": ("sph1d", "ratio", {"start": 0.51, "stop": 1e9, "step": 0.01}, "'ratio'"),
     "sph1d_step_tiny": ("sph1d", "ratio", {"start": 0.51, "stop": 3.0, "step": 1e-12}, "'ratio'"),
-    "sph1d_column_overflow": ("sph1d", "column.height", 1e308, "'column'"),
+    "sph1d_column_overflow": ("sph1d", "column.height", 1e308, "'column.height'"),
     "sph1d_n_below_8": ("sph1d", "n", [2, 4, 8, 16], "'n"),
 }
 
@@ -267,7 +274,7 @@ def test_bad_solid_and_sph1d_settings_are_refused(tmp_path, case):
         path = _mutated(tmp_path, f"config/methods/{method}.yaml", dotted, value)
     t0 = time.perf_counter()
     with pytest.raises(InputError) as err:
-        preflight.methods.get(method).checks_module().validate(path)
+        preflight.check_file(method, path)
     assert time.perf_counter() - t0 < 5.0
     msg = str(err.value)
     assert msg.startswith(f"{path}: ") and "\n" not in msg and field in msg, msg
@@ -383,6 +390,6 @@ def test_the_parse_time_checks_need_no_numerics():
             "from isaflow import preflight, methods\n"
             "d = preflight.Declarations()\n"
             "for m in ('isa', 'sph', 'mps'): d.check(m, d.spec(m).get('runs', {}))\n"
-            "for m in ('solid', 'sph1d'): methods.get(m).checks_module().validate(methods.get(m).settings)\n")
+            "for m in ('solid', 'sph1d'): preflight.check_file(m)\n")
     proc = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr[-2000:]

@@ -310,7 +310,7 @@ def check_inputs():
     """Every input checked before any job starts (the Snakefile calls this after every rules file declared
     its runs): the comparison's tanks; every declared run of every tank method (tank, variant, resolution,
     overrides, start run, outcomes, plausibility, cost: isaflow.preflight); the settings of the methods
-    without tanks (their checks' validate).  The first error stops the workflow with one line.  Each run's
+    without tanks (preflight.check_file).  The first error stops the workflow with one line.  Each run's
     estimate then gives its job's mem_mb and runtime (RUN_RESOURCES, isaflow.budget.job_resources)."""
     from isaflow import budget as _budget
     from isaflow import preflight as _preflight
@@ -325,9 +325,9 @@ def check_inputs():
                 raise _inputs.InputError(f"config/config.yaml: field 'compare.tanks': {err}") from None
         for method in TANK_METHODS:
             d.check(method, RUNS[method])
-        for m in REGISTRY.values():
+        for name, m in REGISTRY.items():
             if not m.tank:
-                m.checks_module().validate(m.settings)
+                _preflight.check_file(name)
     except _inputs.InputError as err:
         refuse(err)
     RUN_RESOURCES.update({key: _budget.job_resources(cost) for key, cost in d.costs.items()})

@@ -47,6 +47,6 @@ def cost(tank, s, particles=None):
     nbytes = n * BYTES_PER_PARTICLE + records * BYTES_PER_RECORD + snaps
     big = max((n * BYTES_PER_PARTICLE, "particles"), (records * BYTES_PER_RECORD, "solver.history.every"),
               (snaps, "solver.history.snapshots"))
-    return budget.Cost(n, steps, nbytes, NS_PER_PARTICLE_STEP,
-                       {"particles": "particles", "steps": "solver.max_steps", "bytes": big[1]},
-                       f"max_steps = {steps:.3g}")
+    return [budget.Cost(n, steps, nbytes, NS_PER_PARTICLE_STEP,
+                        {"particles": "particles", "steps": "solver.max_steps", "bytes": big[1]},
+                        f"max_steps = {steps:.3g}")]

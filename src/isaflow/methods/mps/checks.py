@@ -98,4 +98,4 @@ def cost(tank, s, particles=None):
     fields = {"particles": "resolution.spacing", "steps": steps_field,
               "bytes": (wide if s[wide] > 2 * RADIUS[1] else "resolution.spacing") if records * 400 <= nbytes / 2 else
               "time.sample_interval" if s["time.sample_interval"] < dt else t_key}
-    return budget.Cost(n, steps, nbytes, NS_PER_PARTICLE_STEP, fields, f"t = {s[t_key]:g} s / dt = {dt:.3g} s")
+    return [budget.Cost(n, steps, nbytes, NS_PER_PARTICLE_STEP, fields, f"t = {s[t_key]:g} s / dt = {dt:.3g} s")]

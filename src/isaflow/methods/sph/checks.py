@@ -121,5 +121,5 @@ def cost(tank, s, particles=None):
     fields = {"particles": _resolution_field(s), "steps": _steps_field(s, n, t_key),
               "bytes": _resolution_field(s) if chunks * 200 <= nbytes / 2 else
               "settings.chunk_time" if s["settings.chunk_time"] < dt else t_key}
-    return budget.Cost(n, steps, nbytes, NS_PER_PARTICLE_STEP, fields,
-                       f"t = {s[t_key]:g} s / dt = {dt:.3g} s")
+    return [budget.Cost(n, steps, nbytes, NS_PER_PARTICLE_STEP, fields,
+                        f"t = {s[t_key]:g} s / dt = {dt:.3g} s")]
