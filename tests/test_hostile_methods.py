@@ -144,6 +144,12 @@ SETTINGS_CASES = {
                        "CPU-hours"),
     "isa_history_of_1e15_steps": ("isa", ["solver.max_steps=1000000000000000"], "'solver.history.every'", "memory"),
     "isa_du_beyond_pair_range": ("isa", ["solver.du=10"], "'solver.du'", "l_pu"),
+    # points and probes far outside the tank's walls (ran, and wrote a run with a probe that never saw liquid)
+    "isa_points_far_outside": ("isa", ["particles.points=[[1e6, 1e6]]"], "'particles.points'", "bounding box"),
+    "isa_lattice_far_outside": ("isa", ["particles.lattice.center_x=1e6"], "'particles.lattice'", "bounding box"),
+    "mps_probe_far_outside": ("mps", ["probes.single=[[50.0, 10.0], [1e6, 1e6]]"], "'probes.single'", "bounding box"),
+    "mps_on_wall_point_far_outside": ("mps", ["start.on_wall_point=[1e6, 1e6]"], "'start.on_wall_point'",
+                                      "bounding box"),
 }
 
 
@@ -314,6 +320,9 @@ PARSE_CASES = {
                   "isa_study.yaml"),
     "tank_depth_above_walls": ("config/tanks/single.yaml", "depth: 72.5", "depth: 150.0", "'liquid.depth'"),
     "solid_tol": ("config/methods/solid.yaml", "tol: {value: 1.0e-6,", "tol: {value: 1.0e-300,", "'solver.tol'"),
+    # the default flow probes lie below the same-floor tank's floor: the run declares its own
+    "probes_below_the_floor": ("config/methods/mps.yaml", "[200.0, 5.0], [250.0, 10.0]]", "[200.0, -45.0], [250.0, -40.0]]",
+                               "'probes.flow'"),
     "sph1d_huge_n": ("config/methods/sph1d.yaml", "[32, 64, 128, 256, 512, 1024, 2048]",
                      "[32, 64, 128, 256, 512, 1024, 1000000000000]", "memory"),
 }

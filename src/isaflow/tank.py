@@ -55,13 +55,13 @@ def bounds(walls):
     return min(xs), min(ys), max(xs), max(ys)
 
 
-def check_points(path, field, points, walls):
+def check_points(path, field, points, walls, what="point(s)"):
     """Refuse points (x, y) [cm] outside the walls' bounding box (NaN counts as outside), naming the first;
-    points: a sequence of pairs, or an (N, 2) array; walls: [(x0, y0, x1, y1)] or a (W, 4) array."""
-    box = bounds([tuple(map(float, w)) for w in walls])
+    points: a sequence of pairs; walls: [(x0, y0, x1, y1)]."""
+    box = bounds(walls)
     out = [(x, y) for x, y in points if not (box[0] <= x <= box[2] and box[1] <= y <= box[3])]
     if out:
-        _outside(path, field, len(out), box, out[0])
+        _outside(path, field, len(out), box, out[0], what)
 
 
 def _outside(path, field, count, box, first, what="point(s)"):
@@ -87,6 +87,10 @@ class Tank:
         import numpy as np
 
         return np.array(_segments(self.spec), float)
+
+    def walls_list(self):
+        """[(x0, y0, x1, y1)] wall segments [cm] (pure Python)."""
+        return _segments(self.spec)
 
     @property
     def wall_names(self):

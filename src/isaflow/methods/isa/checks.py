@@ -10,6 +10,7 @@ its neighbour's whole repulsion); :func:`cost` estimates particles, steps
 
 from ... import budget
 from ...plausible import require, within
+from ...tank import check_points
 
 NS_PER_PARTICLE_STEP = 20.0  # fastest measured relax step (benchmarks/), rounded down
 BYTES_PER_PARTICLE = 640  # solver + compiled loop + contacts + the run file's copy (measured order, rounded up)
@@ -28,8 +29,23 @@ def particle_count(part):
     return full * sum(lengths) + sum(lengths[:rest])
 
 
+def lattice_corners(lat):
+    """(x, y) [cm] of the corners of the lattice's bounding box, its jitter aside (scene.rhombic_lattice,
+    square_lattice: the widest row's ends, the bottom and top rows)."""
+    pitch = lat["a"] if lat.get("kind", "rhombic") == "square" else lat["a"] / 2
+    half = (max(lat["row_lengths"][:lat["rows"]]) - 1) / 2 * lat["a"]
+    top = lat["bottom_y"] + (lat["rows"] - 1) * pitch
+    return [(lat["center_x"] + dx, y) for dx in (-half, half) for y in (lat["bottom_y"], top)]
+
+
 def plausible(tank, s, stability=False):
     """Refuse implausible settings (InputError naming the file and the setting, with the reason)."""
+    part = s.tree("particles")
+    if part.get("points") is not None:
+        check_points(s.path, "particles.points", part["points"], tank.walls_list())
+    else:
+        check_points(s.path, "particles.lattice", lattice_corners(part["lattice"]), tank.walls_list(),
+                     "lattice corner(s)")
     within(s.path, "solver.du", s["solver.du"], None, s["forces.pair.l_u"] / 2, DU, stability=stability)
     if s.variant == "newton_lm":  # its energy and Hessian are the linear laws' (methods/isa/newton.py)
         for side in ("wall", "pair"):

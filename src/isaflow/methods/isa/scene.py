@@ -120,7 +120,7 @@ def _check_geometry(scene):
         return
     budget.check_count(scene, budget.particle_count(part), "particles")
     pos = scene.pos0 = initial_positions(scene)
-    check_positions(path, "particles", pos, walls)
+    check_positions(path, "particles.points" if "points" in part else "particles.lattice", pos, walls)
     budget.check_memory(scene, pos)
 
 

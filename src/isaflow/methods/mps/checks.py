@@ -13,6 +13,7 @@ import math
 from ... import budget
 from ...core.units import G
 from ...plausible import finite, require, within
+from ...tank import check_points
 
 NS_PER_PARTICLE_STEP = 2000.0  # measured 26 ms per step at about 5,000 particles (5.2 us), rounded down
 BYTES_PER_PARTICLE = 2000  # state, number densities, the pressure system's vectors (order, rounded up)
@@ -72,6 +73,10 @@ def plausible(tank, s, stability=False):
             "model.re_gradient", f"the variational gradient is the derivative of the number density, so its radius is "
             f"the number density's: re_gradient {s['model.re_gradient']:g} l0 against re_density "
             f"{s['model.re_density']:g} l0")
+    probes = "probes.flow" if _flow(tank) else "probes.single"
+    check_points(path, probes, s[probes], tank.walls_list())
+    if s["start.on_wall_point"] is not None:
+        check_points(path, "start.on_wall_point", [s["start.on_wall_point"]], tank.walls_list())
     t_key = "time.flow_time" if _flow(tank) else "time.single_time"
     require(s["time.average_window"] <= s[t_key], path, "time.average_window",
             f"{s['time.average_window']:g} s is longer than the run ({t_key} = {s[t_key]:g} s)")
