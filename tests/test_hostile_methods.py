@@ -134,7 +134,7 @@ SETTINGS_CASES = {
     "mps_beta_half": ("mps", ["model.beta=0.5"], "'model.beta'", "free-surface"),
     "mps_viscosity_huge": ("mps", ["model.kinematic_viscosity=1e9"], "'model.kinematic_viscosity'", "viscous"),
     "mps_spacing_1e-4": ("mps", ["resolution.spacing=1e-4"], "'resolution.spacing'", "memory"),
-    "mps_spacing_1e-9": ("mps", ["resolution.spacing=1e-9"], "'model.kinematic_viscosity'", "viscous"),
+    "mps_spacing_1e-9": ("mps", ["resolution.spacing=1e-9"], "'resolution.spacing'", "viscous"),
     "mps_spacing_above_tank": ("mps", ["resolution.spacing=1000"], "'resolution.spacing'", "at least 2"),
     "mps_sampling_tiny": ("mps", ["time.sample_interval=1e-300"], "'time.sample_interval'", "memory"),
     "mps_window_too_long": ("mps", ["time.average_window=100"], "'time.average_window'", "longer than the run"),
@@ -144,6 +144,19 @@ SETTINGS_CASES = {
                        "CPU-hours"),
     "isa_history_of_1e15_steps": ("isa", ["solver.max_steps=1000000000000000"], "'solver.history.every'", "memory"),
     "isa_du_beyond_pair_range": ("isa", ["solver.du=10"], "'solver.du'", "l_pu"),
+    # a derived size refused only by its allocation (MPS: a 22-78 GB dense load map; SPH: its panel records)
+    "mps_panels_of_4e-5_cm": ("mps", ["walls.panel_length=4e-5"], "'walls.panel_length'", "memory"),
+    "mps_panels_of_1e-320_cm": ("mps", ["walls.panel_length=1e-320"], "'walls.panel_length'", "not a finite"),
+    "sph_panels_of_5e-5_cm": ("sph", ["settings.panel_length=5e-5"], "'settings.panel_length'", "memory"),
+    # a spacing whose particle count overflows (an internal error, exit 70, before)
+    "mps_spacing_1e-320": ("mps", ["resolution.spacing=1e-320"], "'resolution.spacing'", "particle count"),
+    "sph_spacing_1e-320": ("sph", ["resolution.particles=null", "resolution.spacing=1e-320"], "'resolution.spacing'",
+                           "particle count"),
+    # a periodic block it cannot run (an internal error, exit 70, after the warm-up before)
+    "sph_block_summation": ("sph", ["settings.domain=periodic_block", "settings.density=summation"],
+                            "'settings.density'", "periodic block"),
+    "sph_block_h_wide": ("sph", ["settings.domain=periodic_block", "settings.h_factor=5"], "'settings.h_factor'",
+                         "minimum image", ["--stability-case"]),
     # points and probes far outside the tank's walls (ran, and wrote a run with a probe that never saw liquid)
     "isa_points_far_outside": ("isa", ["particles.points=[[1e6, 1e6]]"], "'particles.points'", "bounding box"),
     "isa_lattice_far_outside": ("isa", ["particles.lattice.center_x=1e6"], "'particles.lattice'", "bounding box"),
@@ -160,6 +173,33 @@ def test_bad_method_settings_are_refused_with_their_reason(tmp_path, capsys, cas
                        field.rstrip("'"))
     assert reason in line, line
     assert f"config/methods/{method}.yaml" in line
+
+
+# ---- a derived number names the input it follows: the tank's field when the tank's liquid or walls are its cause
+BIG = [{"name": "left", "from": [0, 7e5], "to": [0, 0]}, {"name": "floor", "from": [0, 0], "to": [7e5, 0]},
+       {"name": "right", "from": [7e5, 0], "to": [7e5, 7e5]}]
+TALL = [{"name": "left", "from": [0, 2e6], "to": [0, 0]}, {"name": "floor", "from": [0, 0], "to": [100, 0]},
+        {"name": "right", "from": [100, 0], "to": [100, 2e6]}]
+BLAME_CASES = {
+    # a 1e-9 cm liquid was reported as the method's resolution.particles / resolution.spacing
+    "depth_1e-9_sph": ("sph", _tank(liquid={"weight": 9000.0, "depth": 1e-9}), "'liquid.depth'"),
+    "depth_1e-9_mps": ("mps", _tank(liquid={"weight": 9000.0, "depth": 1e-9}), "'liquid.depth'"),
+    # a 1e6 cm deep liquid 100 cm wide: 2.4e7 particles at dx = 2.5 cm (was blamed on resolution.spacing)
+    "depth_1e6_sph": ("sph", _tank(walls=TALL, liquid={"weight": 9000.0, "depth": 1e6}), "'liquid.depth'",
+                      ["resolution.particles=null", "resolution.spacing=2.5"]),
+    # 700 km walls round a 100 cm vessel: wall particles, cell lists and the MPS load map (was a MemoryError)
+    "walls_7e5_sph": ("sph", _tank(walls=BIG, vessels=[{"name": "first", "x": [0.0, 100.0]}]), "'walls'"),
+    "walls_7e5_mps": ("mps", _tank(walls=BIG, vessels=[{"name": "first", "x": [0.0, 100.0]}]), "'walls'"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BLAME_CASES))
+def test_a_derived_number_names_the_tank_field_it_follows(tmp_path, capsys, case):
+    method, spec, field, *sets = BLAME_CASES[case]
+    path = tmp_path / "tank.yaml"
+    path.write_text(yaml.safe_dump(spec))
+    line = cli_refuses(capsys, tmp_path, method_argv(method, *(sets[0] if sets else ()), tank=path), field)
+    assert line.startswith(f"error: {path}: field {field}"), line
 
 
 # ---- the command line ------------------------------------------------------------------------------------

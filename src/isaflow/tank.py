@@ -92,6 +92,15 @@ class Tank:
         """[(x0, y0, x1, y1)] wall segments [cm] (pure Python)."""
         return _segments(self.spec)
 
+    def perimeter(self):
+        """Total length [cm] of the walls."""
+        return sum(math.hypot(s[2] - s[0], s[3] - s[1]) for s in _segments(self.spec))
+
+    def panel_count(self, length):
+        """Wall panels of about ``length`` cm (core.panels: at least one per wall), a float that cannot
+        overflow an integer."""
+        return sum(max(1.0, math.hypot(s[2] - s[0], s[3] - s[1]) / length) for s in _segments(self.spec))
+
     @property
     def wall_names(self):
         return [w["name"] for w in self.spec["walls"]]

@@ -15,7 +15,7 @@ import math
 
 from ... import budget
 from ...core.units import KG, PA
-from ...plausible import finite, require
+from ...plausible import extreme, finite, require
 
 NS_PER_PARTICLE_STEP = 10.0  # a lower bound of the dynamic-relaxation step (3-D links, numba)
 BYTES_PER_PARTICLE = 3000  # state, links (26 neighbours in 3-D) and their forces (order, rounded up)
@@ -44,7 +44,7 @@ def plausible(tank, settings, stability=False):
     require(RHO_RANGE[0] <= mat["rho_kg_m3"] <= RHO_RANGE[1], path, "material.rho_kg_m3",
             f"{mat['rho_kg_m3']:g} kg/m^3 is outside {RHO_RANGE[0]:g}-{RHO_RANGE[1]:g} kg/m^3 (aerogels to "
             f"osmium, the densest element)")
-    finite(path, "material", wave_speed(mat), "wave speed sqrt(E / rho) [cm/s]")
+    finite(path, f"material.{extreme(mat, 'E_GPa', 'rho_kg_m3')}", wave_speed(mat), "wave speed sqrt(E / rho) [cm/s]")
     require(s["solver"]["tol"] >= TOL_MIN, path, "solver.tol",
             f"{s['solver']['tol']:g} is below {TOL_MIN:g}, the round-off of the forces in double precision; the "
             f"relaxation could never reach it")
