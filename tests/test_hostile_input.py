@@ -182,8 +182,11 @@ FIELD_CASES = {
     "vessel_x_nan": ([("vessels", [{"name": "v", "x": [0.0, NAN]}])], "'vessels.0.x.1'", "tank"),
     "vessel_x_reversed": ([("vessels", [{"name": "v", "x": [20.0, 0.0]}])], "'vessels' (v)", "tank"),
     "outside_the_walls": ([("particles.lattice.center_x", 50.0)], "outside the walls' bounding box", "settings"),
-    "stiffness_overflows": ([("forces.wall.l_u", 1e-300), ("forces.wall.r_u", 1e300)], "'forces.wall'", "settings"),
-    "stiffness_underflows": ([("forces.pair.l_u", 1e300), ("forces.pair.r_u", 1e-300)], "'forces.pair'", "settings"),
+    "stiffness_overflows": ([("forces.wall.l_u", 1e-300), ("forces.wall.r_u", 1e301)], "'forces.wall.r_u'", "settings"),
+    "stiffness_underflows": ([("forces.pair.l_u", 1e300), ("forces.pair.r_u", 1e-300)], "'forces.pair.r_u'", "settings"),
+    "stiffness_underflows_by_its_range": ([("forces.pair.l_u", 1e300), ("forces.pair.r_u", 1e-30)],
+                                          "'forces.pair.l_u'", "settings"),
+    "du_below_round_off": ([("solver.du", 1e-320)], "'solver.du'", "settings"),
 }
 
 

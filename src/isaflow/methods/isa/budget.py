@@ -15,6 +15,7 @@ import numpy as np
 from ...budget import gb as _gb
 from ...budget import memory_limit
 from ...inputs import InputError
+from ...plausible import extreme
 from .checks import BYTES_PER_PARTICLE, BYTES_PER_RECORD, particle_count  # noqa: F401 (particle_count: scene)
 from .settings import settings
 
@@ -23,10 +24,22 @@ MAX_GRID_CELLS = 10**9  # cells of the neighbour grid (int32 cell starts)
 
 
 def check_settings(scene):
-    """Refuse derived solver numbers that are not finite and positive (naming the field they come from)."""
+    """Refuse derived solver numbers that are not finite and positive, naming the input each follows: the
+    stiffness r_u / l_u its farther-from-1 factor, f_ref, dt_max and the skin their own field if set, else what
+    their defaults follow (du, the stiffness, the pair range), the overdamped step its own field or the weight."""
     s = settings(scene)
-    checks = [("forces.wall", s["wall_r_u"] / s["wall_l_u"]), ("forces.pair", s["pair_r_u"] / s["pair_l_u"]),
-              ("solver.f_ref", s["f_ref"]), ("solver.dt_max", s["dt_max"]), ("solver.skin", s["skin"])]
+    given = scene.spec["solver"]
+    v = {f"forces.{side}.{k}": scene.spec["forces"][side][k] for side in ("wall", "pair") for k in ("l_u", "r_u")}
+    laws = list(v)
+    v.update({"solver.du": s["du"], "particles.weight": scene.spec["particles"]["weight"], "solver.zeta": s["zeta"]})
+    checks = [(extreme(v, "forces.wall.r_u", "forces.wall.l_u"), s["wall_r_u"] / s["wall_l_u"]),
+              (extreme(v, "forces.pair.r_u", "forces.pair.l_u"), s["pair_r_u"] / s["pair_l_u"]),
+              ("solver.f_ref" if "f_ref" in given else extreme(v, "solver.du", *laws), s["f_ref"]),
+              ("solver.dt_max" if "dt_max" in given else extreme(v, *laws), s["dt_max"]),
+              ("solver.skin" if "skin" in given else "forces.pair.l_u", s["skin"])]
+    if s["variant"] == "overdamped":
+        checks.append(("solver.dt" if "dt" in given else extreme(v, "particles.weight", "solver.zeta", *laws),
+                       s["dt"]))
     for field, value in checks:
         if not (math.isfinite(value) and value > 0):
             raise InputError(f"{scene.path}: field '{field}': the derived value {value!r} is not a finite positive "

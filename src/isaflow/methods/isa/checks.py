@@ -8,6 +8,8 @@ its neighbour's whole repulsion); :func:`cost` estimates particles, steps
 (max_steps) and memory for isaflow.budget.  Units: cm, N, bytes.
 """
 
+import math
+
 from ... import budget
 from ...plausible import require, within
 from ...tank import check_points
@@ -47,6 +49,10 @@ def plausible(tank, s, stability=False):
         check_points(s.path, "particles.lattice", lattice_corners(part["lattice"]), tank.walls_list(),
                      "lattice corner(s)")
     within(s.path, "solver.du", s["solver.du"], None, s["forces.pair.l_u"] / 2, DU, stability=stability)
+    reach = max(abs(c) for w in tank.walls_list() for c in w)
+    require(s["solver.du"] > math.ulp(reach), s.path, "solver.du",
+            f"{s['solver.du']:g} cm is below the round-off of a position in this tank ({math.ulp(reach):g} cm at "
+            f"{reach:g} cm): no particle could move")
     if s.variant == "newton_lm":  # its energy and Hessian are the linear laws' (methods/isa/newton.py)
         for side in ("wall", "pair"):
             require(s[f"forces.{side}.law"] == "linear", s.path, f"forces.{side}.law",
