@@ -92,7 +92,7 @@ def prepare(method, tank, variant, resolution, out, settings_path=None, override
     preflight.check(method, t, s, accept, stability, max_hours,
                     _start_particles(start) if start is not None else None)
     entry = m.entry_module()
-    entry.check(t, s, variant, resolution, start)
+    entry.check(t, s, start)
     return Prepared(method, entry, t, s, variant, resolution, start, str(out), tuple(accept), threads,
                     run_id or Path(out).stem, label, stability)
 

@@ -1,8 +1,10 @@
 """Tanks (config/tanks/*.yaml): the walls, vessels and liquid every method shares.
 
-A tank file is validated against ``tank.schema.json`` and its geometry is
-checked (:func:`check_walls`, :func:`check_geometry`); errors name the file
-and the field.  The tank's liquid (weight W per unit thickness and depth h in
+A tank file is validated against ``tank.schema.json`` and checked by functions
+of one signature, ``check_*(path, spec)`` (:func:`check_walls`,
+:func:`check_geometry`, :func:`check_depth`); positions of another file (a
+method's points and probes) by :func:`check_points` / :func:`check_positions`
+``(path, field, points, walls)``; errors name the file and the field.  The tank's liquid (weight W per unit thickness and depth h in
 the first vessel) fixes the hydrostatic theory every method is judged against
 (theory.py): rho g = W / (B h), B the first vessel's width.  Units: cm, N.
 The checks are pure Python (the workflow checks tanks while it is parsed);
@@ -219,11 +221,11 @@ def _cross(a, b):
     return inside and not ends
 
 
-def check_geometry(path, spec, walls):
+def check_geometry(path, spec):
     """A tank that can hold its liquid: one outline of joined walls (down the left side, along the floors, up
     the right side: the liquid on every wall's left), no crossing walls, every vessel inside the outline on a
-    floor, the liquid's top below the outline's wall tops.  InputError naming the file and field otherwise."""
-    names = [w["name"] for w in spec["walls"]]
+    floor.  InputError naming the file and field otherwise."""
+    walls, names = _segments(spec), [w["name"] for w in spec["walls"]]
     where = f"{path}: field 'walls'"
     order = _chain(walls)
     if order is None:
@@ -241,7 +243,6 @@ def check_geometry(path, spec, walls):
             if _cross(walls[i], walls[j]):
                 raise InputError(f"{where}: walls '{names[i]}' and '{names[j]}' cross")
     x_lo, x_hi = first[0], last[2]
-    top = min(first[1], last[3])
     for k in range(len(walls)):
         s = walls[k]
         if k not in order and (min(s[0], s[2]) < x_lo - TOL or max(s[0], s[2]) > x_hi + TOL):
@@ -258,12 +259,14 @@ def check_geometry(path, spec, walls):
     for a, b in zip(vessels, vessels[1:]):
         if b["x"][0] < a["x"][1] - TOL:
             raise InputError(f"{path}: field 'vessels' ({b['name']}): overlaps '{a['name']}'")
-    check_depth(path, spec, walls, outline, top)
 
 
-def check_depth(path, spec, walls, outline, top):
-    """The liquid's top, its depth above the first vessel's own floor, below that vessel's walls: the outline's
-    wall tops (top, y cm) and the walls on the vessel's two sides."""
+def check_depth(path, spec):
+    """The liquid's top, its depth above the first vessel's own floor, below that vessel's walls: the tops of the
+    outline's end walls and of the walls on the vessel's two sides (a tank that passed check_geometry)."""
+    walls = _segments(spec)
+    outline = [walls[k] for k in _chain(walls)]
+    top = min(outline[0][1], outline[-1][3])
     (x0, x1), name = (spec["vessels"][0]["x"], f"vessel '{spec['vessels'][0]['name']}'") if spec.get("vessels") \
         else ((outline[0][0], outline[-1][2]), "the tank")
     floor = vessel_floor(outline, x0, x1)
@@ -297,6 +300,6 @@ def load(path):
     """Read and validate a tank file; InputError naming the file and the field."""
     path = str(path)
     text, spec = inputs.load(path, SCHEMA, "tank")
-    walls = check_walls(path, spec)
-    check_geometry(path, spec, walls)
+    for check in (check_walls, check_geometry, check_depth):  # in this order: each relies on the ones before
+        check(path, spec)
     return Tank(path, spec, text)

@@ -8,7 +8,7 @@ a variant: labels, colours, markers, papers, settings files, claims modules and
 report fragments all come from here.
 
 A *tank method* (``tank=True``) runs on the shared tanks: its ``entry``
-module provides ``check(tank, settings, variant, resolution, start)``,
+module provides ``check(tank, settings, start)``,
 ``solve(tank, settings, variant, resolution, start=None, progress=None,
 threads=None) -> contract.Result``, ``warm_up(threads)`` and
 ``REFERENCES``; its ``values`` (``module:attribute``) is the schema of its
