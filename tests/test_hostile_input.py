@@ -237,7 +237,7 @@ RESOURCE_CASES = {
                         ("walls", [{"name": "left", "from": [0, 6e5], "to": [0, 0]},
                                    {"name": "floor", "from": [0, 0], "to": [1.1e6, 0]},
                                    {"name": "right", "from": [1.1e6, 0], "to": [1.1e6, 6e5]}]),
-                        ("particles.lattice.center_x", 5.5e5)], "'particles'"),
+                        ("particles.lattice.center_x", 5.5e5)], "'particles.lattice'"),
     "chunk_1e12": ([("solver.chunk", 10**12), ("solver.max_steps", 10**12)], "'solver.chunk'"),
     "records_every_step": ([("solver.max_steps", 10**15), ("solver.history", {"every": 1})],
                            "'solver.history.every'"),

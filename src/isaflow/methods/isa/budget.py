@@ -16,7 +16,7 @@ from ...budget import gb as _gb
 from ...budget import memory_limit
 from ...inputs import InputError
 from ...plausible import extreme
-from .checks import BYTES_PER_PARTICLE, BYTES_PER_RECORD, particle_count  # noqa: F401 (particle_count: scene)
+from .checks import BYTES_PER_PARTICLE, BYTES_PER_RECORD, particle_count, particles_field  # noqa: F401
 from .settings import settings
 
 BYTES_PER_PAIR = 12  # int32 neighbour entry with its doubling growth
@@ -112,8 +112,9 @@ def check_memory(scene, pos):
                          f"too far apart for this pair range")
     n = len(pos)
     pairs = pair_bound(pos, np.array([lo[0], lo[1], hi[0], hi[1]]), rc)
-    parts = [(n * BYTES_PER_PARTICLE, "particles", f"{n} particles"),
-             (pairs * BYTES_PER_PAIR, "particles", f"up to {pairs:.3g} neighbour pairs"),
+    field = particles_field(scene.spec["particles"])
+    parts = [(n * BYTES_PER_PARTICLE, field, f"{n} particles"),
+             (pairs * BYTES_PER_PAIR, field, f"up to {pairs:.3g} neighbour pairs"),
              (cells * 4, "forces.pair.l_u", f"{cells:.3g} grid cells")] + _fixed_bytes(scene, n)
     need = sum(p[0] for p in parts)
     limit = memory_limit()

@@ -21,6 +21,11 @@ DU = "a step moves a particle by du; longer than half the pair range l_pu it can
      "neighbour's whole repulsion (the paper: du = 0.01 cm against l_pu = 7.07 cm)"
 
 
+def particles_field(part):
+    """The settings field a particle count comes from: particles.points or particles.lattice."""
+    return "particles.points" if part.get("points") is not None else "particles.lattice"
+
+
 def particle_count(part):
     """Particles a lattice or points block will create, without creating them."""
     if part.get("points"):
@@ -61,14 +66,15 @@ def plausible(tank, s, stability=False):
 
 def cost(tank, s, particles=None):
     """budget.Cost of a run: the lattice or points (or a start file's `particles`), max_steps steps."""
-    n = particle_count(s.tree("particles")) if particles is None else particles
+    part = s.tree("particles")
+    n = particle_count(part) if particles is None else particles
     steps = s["solver.max_steps"]
     hist = s["solver.history"] or {}
     records = steps / hist["every"] if hist.get("every") else 0
     snaps = hist.get("snapshots", 0) * n * 32
     nbytes = n * BYTES_PER_PARTICLE + records * BYTES_PER_RECORD + snaps
-    big = max((n * BYTES_PER_PARTICLE, "particles"), (records * BYTES_PER_RECORD, "solver.history.every"),
+    big = max((n * BYTES_PER_PARTICLE, particles_field(part)), (records * BYTES_PER_RECORD, "solver.history.every"),
               (snaps, "solver.history.snapshots"))
     return [budget.Cost(n, steps, nbytes, NS_PER_PARTICLE_STEP,
-                        {"particles": "particles", "steps": "solver.max_steps", "bytes": big[1]},
+                        {"particles": particles_field(part), "steps": "solver.max_steps", "bytes": big[1]},
                         f"max_steps = {steps:.3g}")]
