@@ -360,6 +360,9 @@ PARSE_CASES = {
                   "isa_study.yaml"),
     "tank_depth_above_walls": ("config/tanks/single.yaml", "depth: 72.5", "depth: 150.0", "'liquid.depth'"),
     "solid_tol": ("config/methods/solid.yaml", "tol: {value: 1.0e-6,", "tol: {value: 1.0e-300,", "'solver.tol'"),
+    # a one-particle bar was written as converged with zero stress
+    "solid_one_particle": ("config/methods/solid.yaml", "particles: {value: [5, 11, 5],", "particles: {value: [1, 1, 1],",
+                           "'bar.particles'"),
     # the default flow probes lie below the same-floor tank's floor: the run declares its own
     "probes_below_the_floor": ("config/methods/mps.yaml", "[200.0, 5.0], [250.0, 10.0]]", "[200.0, -45.0], [250.0, -40.0]]",
                                "'probes.flow'"),
