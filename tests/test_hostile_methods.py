@@ -148,6 +148,9 @@ SETTINGS_CASES = {
     "mps_panels_of_4e-5_cm": ("mps", ["walls.panel_length=4e-5"], "'walls.panel_length'", "memory"),
     "mps_panels_of_1e-320_cm": ("mps", ["walls.panel_length=1e-320"], "'walls.panel_length'", "not a finite"),
     "sph_panels_of_5e-5_cm": ("sph", ["settings.panel_length=5e-5"], "'settings.panel_length'", "memory"),
+    "sph_30000_snapshots_of_1e6_particles": ("sph", ["resolution.particles=1000000", "settings.t_max_single=0.5",
+                                                     "settings.snapshot_times=[" + "0, " * 29999 + "0]"],
+                                             "'settings.snapshot_times'", "memory", ["--max-hours", "1000"]),
     # a spacing whose particle count overflows (an internal error, exit 70, before)
     "mps_spacing_1e-320": ("mps", ["resolution.spacing=1e-320"], "'resolution.spacing'", "particle count"),
     "sph_spacing_1e-320": ("sph", ["resolution.particles=null", "resolution.spacing=1e-320"], "'resolution.spacing'",

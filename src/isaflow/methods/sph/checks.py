@@ -36,7 +36,8 @@ FRACTION = (0.0, 1.0, "a fraction of the cell spacing or of h")
 
 BLOCK_CELLS = 3  # cells of 2h across a periodic block (sph.block: the minimum image)
 BYTES_PER_CELL = 8  # int64 cell start of a cell list
-BYTES_PER_PANEL = 16  # a panel's force (x, y) in every chunk's record of the rest window
+BYTES_PER_PANEL = 16  # a panel's force (x, y) in the rest window's records (bounded here by one per chunk)
+BYTES_PER_SNAPSHOT_PARTICLE = 16  # a liquid particle's position (x, y) in a position snapshot
 
 
 def sound_speed(s):
@@ -139,7 +140,7 @@ def _t_key(s, tank):
 def cost(tank, s, particles=None):
     """[budget.Cost] of a run: the liquid lattice (or a start file's `particles`), wall particles 2h deep,
     t_max / dt steps; memory: particles and pairs, the finest cell list (the wall particles' de-duplication
-    grid, half a spacing over the walls' bounding box) and the panels' rest-window records."""
+    grid, half a spacing over the walls' bounding box), the panels' rest-window records and the snapshots."""
     nx, ny, dx, dy = lattice(tank, s)
     h = s["settings.h_factor"] * math.sqrt(dx * dy)
     liquid = nx * ny if particles is None else particles
@@ -158,7 +159,8 @@ def cost(tank, s, particles=None):
     by_chunks = "settings.chunk_time" if s["settings.chunk_time"] < dt else t_key
     parts = [(n * (BYTES_PER_PARTICLE + BYTES_PER_PAIR * neighbours), by_liquid), (chunks * 200, by_chunks),
              (grid * BYTES_PER_CELL, tank_field(tank, "walls")),
-             (panels * BYTES_PER_PANEL * (chunks + 4), "settings.panel_length" if panels > chunks else by_chunks)]
+             (panels * BYTES_PER_PANEL * (chunks + 4), "settings.panel_length" if panels > chunks else by_chunks),
+             (len(s["settings.snapshot_times"]) * liquid * BYTES_PER_SNAPSHOT_PARTICLE, "settings.snapshot_times")]
     fields = {"particles": by_liquid, "steps": _steps_field(s, n, by_liquid), "bytes": max(parts, key=lambda p: p[0])[1]}
     return [budget.Cost(n, steps, sum(p[0] for p in parts), NS_PER_PARTICLE_STEP, fields,
                         f"t = {s[t_key]:g} s / dt = {dt:.3g} s")]
