@@ -234,10 +234,10 @@ def test_unknown_variant_resolution_and_outcome_are_refused(tmp_path, capsys):
 # ---- resources: refused with the estimate, before anything is allocated ------------------------
 RESOURCE_CASES = {
     "1e10_particles": ([("particles.lattice.rows", 100_000), ("particles.lattice.row_lengths", [100_000]),
-                        ("walls", [{"name": "left", "from": [0, 6e5], "to": [0, 0]},
-                                   {"name": "floor", "from": [0, 0], "to": [1.1e6, 0]},
-                                   {"name": "right", "from": [1.1e6, 0], "to": [1.1e6, 6e5]}]),
-                        ("particles.lattice.center_x", 5.5e5)], "'particles.lattice'"),
+                        ("particles.lattice.a", 0.5), ("particles.lattice.center_x", 2.75e4),
+                        ("walls", [{"name": "left", "from": [0, 3e4], "to": [0, 0]},
+                                   {"name": "floor", "from": [0, 0], "to": [5.5e4, 0]},
+                                   {"name": "right", "from": [5.5e4, 0], "to": [5.5e4, 3e4]}])], "'particles.lattice'"),
     "chunk_1e12": ([("solver.chunk", 10**12), ("solver.max_steps", 10**12)], "'solver.chunk'"),
     "records_every_step": ([("solver.max_steps", 10**15), ("solver.history", {"every": 1})],
                            "'solver.history.every'"),

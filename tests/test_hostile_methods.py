@@ -193,6 +193,7 @@ BLAME_CASES = {
     # 700 km walls round a 100 cm vessel: wall particles, cell lists and the MPS load map (was a MemoryError)
     "walls_7e5_sph": ("sph", _tank(walls=BIG, vessels=[{"name": "first", "x": [0.0, 100.0]}]), "'walls'"),
     "walls_7e5_mps": ("mps", _tank(walls=BIG, vessels=[{"name": "first", "x": [0.0, 100.0]}]), "'walls'"),
+    "walls_7e5_isa": ("isa", _tank(walls=BIG, vessels=[{"name": "first", "x": [0.0, 100.0]}]), "'walls'"),
 }
 
 

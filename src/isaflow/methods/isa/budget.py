@@ -16,11 +16,10 @@ from ...budget import gb as _gb
 from ...budget import memory_limit
 from ...inputs import InputError
 from ...plausible import extreme
-from .checks import BYTES_PER_PARTICLE, BYTES_PER_RECORD, particle_count, particles_field  # noqa: F401
+from .checks import BYTES_PER_PARTICLE, BYTES_PER_RECORD, check_grid, particle_count, particles_field  # noqa: F401
 from .settings import settings
 
 BYTES_PER_PAIR = 12  # int32 neighbour entry with its doubling growth
-MAX_GRID_CELLS = 10**9  # cells of the neighbour grid (int32 cell starts)
 
 
 def check_settings(scene):
@@ -105,11 +104,7 @@ def check_memory(scene, pos):
     walls = scene.walls
     lo, hi = walls.reshape(-1, 2).min(0), walls.reshape(-1, 2).max(0)
     rc = s["pair_l_u"] + s["skin"]
-    cells = max(1.0, (hi[0] - lo[0]) / rc) * max(1.0, (hi[1] - lo[1]) / rc)
-    if not cells <= MAX_GRID_CELLS:
-        raise InputError(f"{scene.path}: field 'forces.pair.l_u': the neighbour grid over the walls' bounding box "
-                         f"would have {cells:.3g} cells of {rc:.3g} cm (limit {MAX_GRID_CELLS:.0e}); the walls are "
-                         f"too far apart for this pair range")
+    cells = check_grid(scene.path, walls.tolist(), rc, "walls")  # the scene's walls: its settings file's copy
     n = len(pos)
     pairs = pair_bound(pos, np.array([lo[0], lo[1], hi[0], hi[1]]), rc)
     field = particles_field(scene.spec["particles"])

@@ -11,11 +11,13 @@ its neighbour's whole repulsion); :func:`cost` estimates particles, steps
 import math
 
 from ... import budget
-from ...plausible import require, within
-from ...tank import check_points
+from ...plausible import require, tank_field, within
+from ...tank import bounds, check_points
+from .settings import SKIN_FRACTION
 
 NS_PER_PARTICLE_STEP = 20.0  # fastest measured relax step (benchmarks/), rounded down
 BYTES_PER_PARTICLE = 640  # solver + compiled loop + contacts + the run file's copy (measured order, rounded up)
+MAX_GRID_CELLS = 10**9  # cells of the neighbour grid (int32 cell starts)
 BYTES_PER_RECORD = 4 * 56  # hist_fmax/lo/hi/step records held as Python lists, then arrays
 DU = "a step moves a particle by du; longer than half the pair range l_pu it can carry a particle through its " \
      "neighbour's whole repulsion (the paper: du = 0.01 cm against l_pu = 7.07 cm)"
@@ -45,6 +47,19 @@ def lattice_corners(lat):
     return [(lat["center_x"] + dx, y) for dx in (-half, half) for y in (lat["bottom_y"], top)]
 
 
+def check_grid(path, walls, rc, walls_field):
+    """Refuse a neighbour grid over the walls' bounding box of more than MAX_GRID_CELLS cells of rc [cm] (the
+    pair range plus skin), naming what makes it large, the walls (walls_field) or forces.pair.l_u: the one
+    farther from 1 cm.  Returns the cells."""
+    x0, y0, x1, y1 = bounds(walls)
+    cells = max(1.0, (x1 - x0) / rc) * max(1.0, (y1 - y0) / rc)
+    big = abs(math.log10(max(x1 - x0, y1 - y0))) > abs(math.log10(rc))
+    require(cells <= MAX_GRID_CELLS, path, walls_field if big else "forces.pair.l_u",
+            f"the neighbour grid over the walls' bounding box ({x1 - x0:g} x {y1 - y0:g} cm) would have {cells:.3g} "
+            f"cells of {rc:.3g} cm, the pair range plus skin (limit {MAX_GRID_CELLS:.0e})")
+    return cells
+
+
 def plausible(tank, s, stability=False):
     """Refuse implausible settings (InputError naming the file and the setting, with the reason)."""
     part = s.tree("particles")
@@ -54,6 +69,8 @@ def plausible(tank, s, stability=False):
         check_points(s.path, "particles.lattice", lattice_corners(part["lattice"]), tank.walls_list(),
                      "lattice corner(s)")
     within(s.path, "solver.du", s["solver.du"], None, s["forces.pair.l_u"] / 2, DU, stability=stability)
+    check_grid(s.path, tank.walls_list(), s["forces.pair.l_u"] + (s["solver.skin"] or SKIN_FRACTION * s["forces.pair.l_u"]),
+               tank_field(tank, "walls"))
     reach = max(abs(c) for w in tank.walls_list() for c in w)
     require(s["solver.du"] > math.ulp(reach), s.path, "solver.du",
             f"{s['solver.du']:g} cm is below the round-off of a position in this tank ({math.ulp(reach):g} cm at "
