@@ -308,6 +308,9 @@ OTHER_CASES = {
     "sph1d_n_1e12": ("sph1d", "n", [32, 64, 128, 1000000000000], "'n'"),
     "sph1d_ratio_1e9": ("sph1d", "ratio", {"start": 0.51, "stop": 1e9, "step": 0.01}, "'ratio'"),
     "sph1d_step_tiny": ("sph1d", "ratio", {"start": 0.51, "stop": 3.0, "step": 1e-12}, "'ratio'"),
+    # counts that overflow an integer (OverflowError tracebacks while the workflow was parsed before)
+    "sph1d_step_1e-320": ("sph1d", "ratio", {"start": 0.51, "stop": 3.0, "step": 1e-320}, "'ratio'"),
+    "solid_floor_dx_1e-320": ("solid", "floor.dx_cm", 1e-320, "'floor.dx_cm'"),
     "sph1d_column_overflow": ("sph1d", "column.height", 1e308, "'column.height'"),
     "sph1d_n_below_8": ("sph1d", "n", [2, 4, 8, 16], "'n"),
 }

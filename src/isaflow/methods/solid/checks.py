@@ -79,9 +79,10 @@ def solids(s, path):
             f"{rows} row(s): the plate's bottom row is held, so it needs at least {PLATE_ROWS} (a free row under the "
             f"disk)")
     f = s["floor"]
-    columns = int(round(f["span_cm"] / f["dx_cm"])) + 1
+    ratio = f["span_cm"] / f["dx_cm"]
+    columns = round(ratio) + 1 if math.isfinite(ratio) else ratio
     require(columns >= FLOOR_COLUMNS, path, "floor.dx_cm",
-            f"{f['dx_cm']:g} cm over the {f['span_cm']:g} cm span gives {columns} column(s); the two end columns are "
+            f"{f['dx_cm']:g} cm over the {f['span_cm']:g} cm span gives {columns:g} column(s); the two end columns are "
             f"supported, so the plate needs at least {FLOOR_COLUMNS} (a free one between the supports)")
 
 

@@ -110,7 +110,7 @@ def block(tank, s, nx, ny, dx, dy, h):
             f"a periodic block (settings.domain) implements no density diffusion, not delta = {s['settings.delta']:g}")
     cells = min(nx * dx, ny * dy) * (1 + s["settings.stretch"]) / (2 * h)
     require(cells >= BLOCK_CELLS, path, _resolution_field(s) if min(nx, ny) < 2 * BLOCK_CELLS else "settings.h_factor",
-            f"the periodic block holds {math.floor(cells)} cells of 2h = {2 * h:.4g} cm across ({nx} x {ny} particles); "
+            f"the periodic block holds {cells:.3g} cells of 2h = {2 * h:.4g} cm across ({nx} x {ny} particles); "
             f"its minimum image needs {BLOCK_CELLS}")
 
 
