@@ -182,8 +182,11 @@ FIELD_CASES = {
     "vessel_x_nan": ([("vessels", [{"name": "v", "x": [0.0, NAN]}])], "'vessels.0.x.1'", "tank"),
     "vessel_x_reversed": ([("vessels", [{"name": "v", "x": [20.0, 0.0]}])], "'vessels' (v)", "tank"),
     "outside_the_walls": ([("particles.lattice.center_x", 50.0)], "outside the walls' bounding box", "settings"),
-    "stiffness_overflows": ([("forces.wall.l_u", 1e-300), ("forces.wall.r_u", 1e300)], "'forces.wall'", "settings"),
-    "stiffness_underflows": ([("forces.pair.l_u", 1e300), ("forces.pair.r_u", 1e-300)], "'forces.pair'", "settings"),
+    "stiffness_overflows": ([("forces.wall.l_u", 1e-300), ("forces.wall.r_u", 1e301)], "'forces.wall.r_u'", "settings"),
+    "stiffness_underflows": ([("forces.pair.l_u", 1e300), ("forces.pair.r_u", 1e-300)], "'forces.pair.r_u'", "settings"),
+    "stiffness_underflows_by_its_range": ([("forces.pair.l_u", 1e300), ("forces.pair.r_u", 1e-30)],
+                                          "'forces.pair.l_u'", "settings"),
+    "du_below_round_off": ([("solver.du", 1e-320)], "'solver.du'", "settings"),
 }
 
 
@@ -230,8 +233,11 @@ def test_unknown_variant_resolution_and_outcome_are_refused(tmp_path, capsys):
 
 # ---- resources: refused with the estimate, before anything is allocated ------------------------
 RESOURCE_CASES = {
-    "1e10_particles": ([("particles.lattice.rows", 100_000), ("particles.lattice.row_lengths", [100_000])],
-                       "'particles'"),
+    "1e10_particles": ([("particles.lattice.rows", 100_000), ("particles.lattice.row_lengths", [100_000]),
+                        ("particles.lattice.a", 0.5), ("particles.lattice.center_x", 2.75e4),
+                        ("walls", [{"name": "left", "from": [0, 3e4], "to": [0, 0]},
+                                   {"name": "floor", "from": [0, 0], "to": [5.5e4, 0]},
+                                   {"name": "right", "from": [5.5e4, 0], "to": [5.5e4, 3e4]}])], "'particles.lattice'"),
     "chunk_1e12": ([("solver.chunk", 10**12), ("solver.max_steps", 10**12)], "'solver.chunk'"),
     "records_every_step": ([("solver.max_steps", 10**15), ("solver.history", {"every": 1})],
                            "'solver.history.every'"),

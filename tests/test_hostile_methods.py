@@ -19,10 +19,11 @@ import pytest
 import yaml
 from conftest import ROOT
 
-from isaflow import cli, preflight, settings, tank as tanks
+from isaflow import budget, cli, preflight, settings, tank as tanks
 from isaflow.inputs import InputError
 
 SINGLE = ROOT / "config" / "tanks" / "single.yaml"
+FLOW = ROOT / "config" / "tanks" / "flow_step50.yaml"
 DEFAULT = {"isa": ("coarse", "paper"), "sph": ("n180", "wcsph"), "mps": ("dx5.56", "standard")}
 
 
@@ -48,8 +49,8 @@ def method_argv(method, *sets, tank=SINGLE, extra=()):
 
 
 # ---- tanks: every tank method refuses the same bad tank ------------------------------------------------
-def _tank(**change):
-    spec = yaml.safe_load(SINGLE.read_text())
+def _tank(base=SINGLE, **change):
+    spec = yaml.safe_load(base.read_text())
     for key, value in change.items():
         spec[key] = value
     return spec
@@ -78,6 +79,11 @@ TANK_CASES = {
     "unknown_key": (_tank(colour="blue"), "(top level)"),
     "no_liquid": ({k: v for k, v in _tank().items() if k != "liquid"}, "'liquid'"),
     "one_wall": (_tank(walls=[W[1]]), "'walls'"),
+    # the depth from the first vessel's own floor (y = 0), not from the second vessel's 50 cm lower
+    "depth_above_own_vessel": (_tank(FLOW, liquid={"weight": 9000.0, "depth": 140.0}), "'liquid.depth'"),
+    # the first vessel's right wall 60 cm high: a 72.5 cm liquid stands over it (the outline's walls are 100 cm)
+    "depth_above_own_side_wall": (_tank(FLOW, walls=[{**w, "to": [100, 60]} if w["name"] == "right1" else w
+                                                     for w in _tank(FLOW)["walls"]]), "'liquid.depth'"),
 }
 
 
@@ -128,7 +134,7 @@ SETTINGS_CASES = {
     "mps_beta_half": ("mps", ["model.beta=0.5"], "'model.beta'", "free-surface"),
     "mps_viscosity_huge": ("mps", ["model.kinematic_viscosity=1e9"], "'model.kinematic_viscosity'", "viscous"),
     "mps_spacing_1e-4": ("mps", ["resolution.spacing=1e-4"], "'resolution.spacing'", "memory"),
-    "mps_spacing_1e-9": ("mps", ["resolution.spacing=1e-9"], "'model.kinematic_viscosity'", "viscous"),
+    "mps_spacing_1e-9": ("mps", ["resolution.spacing=1e-9"], "'resolution.spacing'", "viscous"),
     "mps_spacing_above_tank": ("mps", ["resolution.spacing=1000"], "'resolution.spacing'", "at least 2"),
     "mps_sampling_tiny": ("mps", ["time.sample_interval=1e-300"], "'time.sample_interval'", "memory"),
     "mps_window_too_long": ("mps", ["time.average_window=100"], "'time.average_window'", "longer than the run"),
@@ -138,6 +144,28 @@ SETTINGS_CASES = {
                        "CPU-hours"),
     "isa_history_of_1e15_steps": ("isa", ["solver.max_steps=1000000000000000"], "'solver.history.every'", "memory"),
     "isa_du_beyond_pair_range": ("isa", ["solver.du=10"], "'solver.du'", "l_pu"),
+    # a derived size refused only by its allocation (MPS: a 22-78 GB dense load map; SPH: its panel records)
+    "mps_panels_of_4e-5_cm": ("mps", ["walls.panel_length=4e-5"], "'walls.panel_length'", "memory"),
+    "mps_panels_of_1e-320_cm": ("mps", ["walls.panel_length=1e-320"], "'walls.panel_length'", "not a finite"),
+    "sph_panels_of_5e-5_cm": ("sph", ["settings.panel_length=5e-5"], "'settings.panel_length'", "memory"),
+    "sph_30000_snapshots_of_1e6_particles": ("sph", ["resolution.particles=1000000", "settings.t_max_single=0.5",
+                                                     "settings.snapshot_times=[" + "0, " * 29999 + "0]"],
+                                             "'settings.snapshot_times'", "memory", ["--max-hours", "1000"]),
+    # a spacing whose particle count overflows (an internal error, exit 70, before)
+    "mps_spacing_1e-320": ("mps", ["resolution.spacing=1e-320"], "'resolution.spacing'", "particle count"),
+    "sph_spacing_1e-320": ("sph", ["resolution.particles=null", "resolution.spacing=1e-320"], "'resolution.spacing'",
+                           "particle count"),
+    # a periodic block it cannot run (an internal error, exit 70, after the warm-up before)
+    "sph_block_summation": ("sph", ["settings.domain=periodic_block", "settings.density=summation"],
+                            "'settings.density'", "periodic block"),
+    "sph_block_h_wide": ("sph", ["settings.domain=periodic_block", "settings.h_factor=5"], "'settings.h_factor'",
+                         "minimum image", ["--stability-case"]),
+    # points and probes far outside the tank's walls (ran, and wrote a run with a probe that never saw liquid)
+    "isa_points_far_outside": ("isa", ["particles.points=[[1e6, 1e6]]"], "'particles.points'", "bounding box"),
+    "isa_lattice_far_outside": ("isa", ["particles.lattice.center_x=1e6"], "'particles.lattice'", "bounding box"),
+    "mps_probe_far_outside": ("mps", ["probes.single=[[50.0, 10.0], [1e6, 1e6]]"], "'probes.single'", "bounding box"),
+    "mps_on_wall_point_far_outside": ("mps", ["start.on_wall_point=[1e6, 1e6]"], "'start.on_wall_point'",
+                                      "bounding box"),
 }
 
 
@@ -148,6 +176,34 @@ def test_bad_method_settings_are_refused_with_their_reason(tmp_path, capsys, cas
                        field.rstrip("'"))
     assert reason in line, line
     assert f"config/methods/{method}.yaml" in line
+
+
+# ---- a derived number names the input it follows: the tank's field when the tank's liquid or walls are its cause
+BIG = [{"name": "left", "from": [0, 7e5], "to": [0, 0]}, {"name": "floor", "from": [0, 0], "to": [7e5, 0]},
+       {"name": "right", "from": [7e5, 0], "to": [7e5, 7e5]}]
+TALL = [{"name": "left", "from": [0, 2e6], "to": [0, 0]}, {"name": "floor", "from": [0, 0], "to": [100, 0]},
+        {"name": "right", "from": [100, 0], "to": [100, 2e6]}]
+BLAME_CASES = {
+    # a 1e-9 cm liquid was reported as the method's resolution.particles / resolution.spacing
+    "depth_1e-9_sph": ("sph", _tank(liquid={"weight": 9000.0, "depth": 1e-9}), "'liquid.depth'"),
+    "depth_1e-9_mps": ("mps", _tank(liquid={"weight": 9000.0, "depth": 1e-9}), "'liquid.depth'"),
+    # a 1e6 cm deep liquid 100 cm wide: 2.4e7 particles at dx = 2.5 cm (was blamed on resolution.spacing)
+    "depth_1e6_sph": ("sph", _tank(walls=TALL, liquid={"weight": 9000.0, "depth": 1e6}), "'liquid.depth'",
+                      ["resolution.particles=null", "resolution.spacing=2.5"]),
+    # 700 km walls round a 100 cm vessel: wall particles, cell lists and the MPS load map (was a MemoryError)
+    "walls_7e5_sph": ("sph", _tank(walls=BIG, vessels=[{"name": "first", "x": [0.0, 100.0]}]), "'walls'"),
+    "walls_7e5_mps": ("mps", _tank(walls=BIG, vessels=[{"name": "first", "x": [0.0, 100.0]}]), "'walls'"),
+    "walls_7e5_isa": ("isa", _tank(walls=BIG, vessels=[{"name": "first", "x": [0.0, 100.0]}]), "'walls'"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BLAME_CASES))
+def test_a_derived_number_names_the_tank_field_it_follows(tmp_path, capsys, case):
+    method, spec, field, *sets = BLAME_CASES[case]
+    path = tmp_path / "tank.yaml"
+    path.write_text(yaml.safe_dump(spec))
+    line = cli_refuses(capsys, tmp_path, method_argv(method, *(sets[0] if sets else ()), tank=path), field)
+    assert line.startswith(f"error: {path}: field {field}"), line
 
 
 # ---- the command line ------------------------------------------------------------------------------------
@@ -171,6 +227,10 @@ CLI_CASES = {
     "set_newline": (method_argv("sph", "settings.cfl=0.25\nsettings.alpha=9"), "settings.cfl"),
     "tank_is_a_directory": (["--method", "sph", "--tank", str(ROOT / "config"), "--variant", "wcsph",
                              "--resolution", "n180"], "a directory"),
+    "threads_zero": (method_argv("isa", extra=["--threads", "0"]), "--threads"),
+    "threads_negative": (method_argv("sph", extra=["--threads", "-1"]), "--threads"),
+    "threads_beyond_the_machine": (method_argv("mps", extra=["--threads", str(budget.machine_cores() + 1)]),
+                                   "--threads"),
 }
 
 
@@ -179,6 +239,12 @@ def test_bad_command_lines_are_refused(tmp_path, capsys, case):
     argv, field = CLI_CASES[case]
     cli_refuses(capsys, tmp_path, argv, field)
     assert not (tmp_path / "pwned").exists()
+
+
+@pytest.mark.parametrize("value", ["0", "-3", "abc", str(budget.machine_cores() + 1)])
+def test_a_thread_count_numba_cannot_use_is_refused_from_the_environment(tmp_path, capsys, monkeypatch, value):
+    monkeypatch.setenv("NUMBA_NUM_THREADS", value)
+    cli_refuses(capsys, tmp_path, method_argv("isa"), "environment variable NUMBA_NUM_THREADS")
 
 
 def test_a_stability_case_may_leave_the_literature_ranges_but_not_the_budget():
@@ -232,10 +298,20 @@ OTHER_CASES = {
     "solid_water_h_tiny": ("solid", "vessel.water_h_over_dx", 0.1, "'vessel.water_h_over_dx'"),
     "solid_history_1e12_us": ("solid", "vessel.history_us", 1e12, "'vessel.history_us'"),
     "solid_floor_dx_1e-9": ("solid", "floor.dx_cm", 1e-9, "'floor.dx_cm'"),
+    # a case that is no solid under load was written as converged with zero stress
+    "solid_bar_one_particle": ("solid", "bar.particles", [1, 1, 1], "'bar.particles'"),
+    "solid_bar_two_layers": ("solid", "bar.particles", [5, 2, 5], "'bar.particles'"),
+    "solid_shear_no_grip": ("solid", "shear.grip_layers", 0, "'shear.grip_layers'"),
+    "solid_hertz_plate_one_row": ("solid", "hertz.plate", [51, 1], "'hertz.plate'"),
+    "solid_floor_one_column": ("solid", "floor.dx_cm", 200.0, "'floor.dx_cm'"),
+    "solid_long_bar_1e15_steps": ("solid", "bar_long.steps", 10**15, "'bar_long.steps'"),
     "sph1d_n_1e12": ("sph1d", "n", [32, 64, 128, 1000000000000], "'n'"),
     "sph1d_ratio_1e9": ("sph1d", "ratio", {"start": 0.51, "stop": 1e9, "step": 0.01}, "'ratio'"),
     "sph1d_step_tiny": ("sph1d", "ratio", {"start": 0.51, "stop": 3.0, "step": 1e-12}, "'ratio'"),
-    "sph1d_column_overflow": ("sph1d", "column.height", 1e308, "'column'"),
+    # counts that overflow an integer (OverflowError tracebacks while the workflow was parsed before)
+    "sph1d_step_1e-320": ("sph1d", "ratio", {"start": 0.51, "stop": 3.0, "step": 1e-320}, "'ratio'"),
+    "solid_floor_dx_1e-320": ("solid", "floor.dx_cm", 1e-320, "'floor.dx_cm'"),
+    "sph1d_column_overflow": ("sph1d", "column.height", 1e308, "'column.height'"),
     "sph1d_n_below_8": ("sph1d", "n", [2, 4, 8, 16], "'n"),
 }
 
@@ -251,7 +327,7 @@ def test_bad_solid_and_sph1d_settings_are_refused(tmp_path, case):
         path = _mutated(tmp_path, f"config/methods/{method}.yaml", dotted, value)
     t0 = time.perf_counter()
     with pytest.raises(InputError) as err:
-        preflight.methods.get(method).checks_module().validate(path)
+        preflight.check_file(method, path)
     assert time.perf_counter() - t0 < 5.0
     msg = str(err.value)
     assert msg.startswith(f"{path}: ") and "\n" not in msg and field in msg, msg
@@ -291,9 +367,26 @@ PARSE_CASES = {
                   "isa_study.yaml"),
     "tank_depth_above_walls": ("config/tanks/single.yaml", "depth: 72.5", "depth: 150.0", "'liquid.depth'"),
     "solid_tol": ("config/methods/solid.yaml", "tol: {value: 1.0e-6,", "tol: {value: 1.0e-300,", "'solver.tol'"),
+    # a one-particle bar was written as converged with zero stress
+    "solid_one_particle": ("config/methods/solid.yaml", "particles: {value: [5, 11, 5],", "particles: {value: [1, 1, 1],",
+                           "'bar.particles'"),
+    # the default flow probes lie below the same-floor tank's floor: the run declares its own
+    "probes_below_the_floor": ("config/methods/mps.yaml", "[200.0, 5.0], [250.0, 10.0]]", "[200.0, -45.0], [250.0, -40.0]]",
+                               "'probes.flow'"),
     "sph1d_huge_n": ("config/methods/sph1d.yaml", "[32, 64, 128, 256, 512, 1024, 2048]",
                      "[32, 64, 128, 256, 512, 1024, 1000000000000]", "memory"),
 }
+
+
+def _parse_refuses(proj, field, *args):
+    """snakemake -n in proj: exit 2, one line naming the field, no traceback, no job, nothing under results/."""
+    proc = subprocess.run([sys.executable, "-m", "snakemake", "-n", "--workflow-profile", "none", *args], cwd=proj,
+                          capture_output=True, text=True, timeout=120)
+    errors = [line for line in proc.stderr.splitlines() if line.startswith("error: ")]
+    assert proc.returncode == 2, proc.stderr[-2000:]
+    assert len(errors) == 1 and field in errors[0], proc.stderr[-2000:]
+    assert "Traceback" not in proc.stderr
+    assert not (proj / "results").exists() and not (proj / "pwned").exists()
 
 
 @pytest.mark.parametrize("case", sorted(PARSE_CASES))
@@ -303,13 +396,25 @@ def test_the_workflow_refuses_bad_inputs_while_it_is_parsed(tmp_path, case):
     rel, old, new, field = PARSE_CASES[case]
     proj = _project(tmp_path)
     _edit(proj / rel, old, new)
-    proc = subprocess.run([sys.executable, "-m", "snakemake", "-n", "-c1", "--workflow-profile", "none"], cwd=proj,
-                          capture_output=True, text=True, timeout=120)
-    errors = [line for line in proc.stderr.splitlines() if line.startswith("error: ")]
-    assert proc.returncode == 2, proc.stderr[-2000:]
-    assert len(errors) == 1 and field in errors[0], proc.stderr[-2000:]
-    assert "Traceback" not in proc.stderr
-    assert not (proj / "results").exists() and not (proj / "pwned").exists()
+    _parse_refuses(proj, field, "-c1")
+
+
+PARSE_ARGS = {
+    "cores_zero": (["-c0"], "'--cores'"),
+    "cores_negative": (["--cores", "-1"], "'--cores'"),
+    "cores_beyond_the_machine": (["-c", str(budget.machine_cores() + 1)], "'--cores'"),
+    **{f"undeclared_{m}_run": (["-c1", f"results/runs/{m}/no_such_run.nc"], f"config/methods/{m}.yaml: field 'runs'")
+       for m in DEFAULT},
+    "run_of_another_method": (["-c1", "results/runs/mps/single_coarse.nc"], "no mps run 'single_coarse'"),
+}
+
+
+@pytest.mark.parametrize("case", sorted(PARSE_ARGS))
+def test_the_workflow_refuses_bad_command_lines_before_any_job(tmp_path, case):
+    """A core count that is no count, or a run file no settings file declares asked for as a target: one line,
+    exit 2, before any job starts (an undeclared target was a KeyError traceback while the DAG was built)."""
+    args, field = PARSE_ARGS[case]
+    _parse_refuses(_project(tmp_path), field, *args)
 
 
 def test_no_shell_line_is_built_from_configuration():
@@ -344,6 +449,6 @@ def test_the_parse_time_checks_need_no_numerics():
             "from isaflow import preflight, methods\n"
             "d = preflight.Declarations()\n"
             "for m in ('isa', 'sph', 'mps'): d.check(m, d.spec(m).get('runs', {}))\n"
-            "for m in ('solid', 'sph1d'): methods.get(m).checks_module().validate(methods.get(m).settings)\n")
+            "for m in ('solid', 'sph1d'): preflight.check_file(m)\n")
     proc = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr[-2000:]

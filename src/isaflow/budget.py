@@ -15,7 +15,9 @@ import os
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from . import inputs
 from .inputs import InputError
+from .plausible import where
 
 LIMITS = Path("config") / "limits.yaml"
 LIMIT_VALUES = {"cpu_hours": {"type": "number", "exclusiveMinimum": 0}}
@@ -38,8 +40,9 @@ JOB_MIN_RUNTIME = 5  # min
 class Cost:
     """A run's estimate.  particles: the most held at once; steps: the steps (or solves) it may take;
     bytes: its peak memory; ns_per_particle_step: the method's measured step cost [ns];
-    fields: {'particles' | 'steps' | 'bytes': the setting the number comes from}; detail: how the
-    steps follow from the settings, e.g. 't = 5 s / dt = 3.1e-4 s'."""
+    fields: {'particles' | 'steps' | 'bytes': the setting the number comes from, a dotted key of the settings
+    file or (file, field) of another (the tank)}; detail: how the steps follow from the settings, e.g.
+    't = 5 s / dt = 3.1e-4 s'."""
 
     particles: float
     steps: float
@@ -74,6 +77,32 @@ def memory_limit():
     return DEFAULT_MEMORY
 
 
+def machine_cores():
+    """Cores this process may run on (its CPU affinity, as numba counts them)."""
+    try:
+        return len(os.sched_getaffinity(0))
+    except AttributeError:  # not Linux
+        return os.cpu_count() or 1
+
+
+def check_threads(where, value, most=None):
+    """Refuse a thread or core count that is not a whole number from 1 to ``most`` (default: the machine's
+    cores); where: what the user wrote, e.g. 'argument --threads'."""
+    cores = machine_cores()
+    most = cores if most is None else most
+    if isinstance(value, bool) or not isinstance(value, int) or not 1 <= value <= most:
+        raise InputError(f"{where}: {inputs.printable(str(value))} is not a whole number from 1 to {most} (this "
+                         f"machine gives the process {cores} cores)")
+    return value
+
+
+def check_environment():
+    """Refuse a NUMBA_NUM_THREADS in the environment that numba cannot use or this machine cannot give."""
+    env = os.environ.get("NUMBA_NUM_THREADS")
+    if env is not None:
+        check_threads("environment variable NUMBA_NUM_THREADS", int(env) if env.strip().isdigit() else env)
+
+
 def cpu_hours(path=LIMITS):
     """The CPU-hour budget of a run (config/limits.yaml, read by the one settings loader)."""
     from . import settings
@@ -99,20 +128,23 @@ def check(path, cost, max_hours=None):
     returns the cost.
 
     max_hours: the run's own CPU-hour limit (a deliberate long run), else config/limits.yaml's."""
-    numbers = (cost.particles, cost.steps, cost.bytes)
-    if not all(math.isfinite(x) and x >= 0 for x in numbers):
-        raise InputError(f"{path}: field '{cost.fields.get('steps', 'resolution')}': the run's size is not a finite "
-                         f"number ({cost.particles:.3g} particles, {cost.steps:.3g} steps); choose less extreme values")
+
+    def blame(kind):
+        return where(path, cost.fields.get(kind, "resolution"))
+
+    numbers = {"particles": cost.particles, "steps": cost.steps, "bytes": cost.bytes}
+    bad = [kind for kind, x in numbers.items() if not (math.isfinite(x) and x >= 0)]
+    if bad:
+        raise InputError(f"{blame(bad[0])}: the run's size is not a finite number ({cost.particles:.3g} particles, "
+                         f"{cost.steps:.3g} steps, {cost.bytes:.3g} bytes); choose less extreme values")
     limit = memory_limit()
     if cost.bytes > limit:
-        raise InputError(f"{path}: field '{cost.fields.get('bytes', 'resolution')}': the run needs about "
-                         f"{gb(cost.bytes)} of memory ({cost.particles:.3g} particles, {cost.steps:.3g} steps, {cost.detail}); "
-                         f"{gb(limit)} available")
+        raise InputError(f"{blame('bytes')}: the run needs about {gb(cost.bytes)} of memory ({cost.particles:.3g} "
+                         f"particles, {cost.steps:.3g} steps, {cost.detail}); {gb(limit)} available")
     budget = cpu_hours() if max_hours is None else float(max_hours)
     if cost.hours > budget:
-        raise InputError(f"{path}: field '{cost.fields.get('steps', 'resolution')}': the run needs about "
-                         f"{cost.particles * cost.steps:.3g} particle-steps ({cost.particles:.3g} particles x "
-                         f"{cost.steps:.3g} steps, {cost.detail}), about {cost.hours:.3g} CPU-hours at "
+        raise InputError(f"{blame('steps')}: the run needs about {cost.particles * cost.steps:.3g} particle-steps "
+                         f"({cost.particles:.3g} particles x {cost.steps:.3g} steps, {cost.detail}), about {cost.hours:.3g} CPU-hours at "
                          f"{cost.ns_per_particle_step:g} ns per particle-step; the budget is {budget:g} h "
                          f"(config/limits.yaml cpu_hours, or the run's max_hours for a deliberate long run)")
     return cost

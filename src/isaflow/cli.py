@@ -107,9 +107,6 @@ def main(argv=None):
         if max_hours is not None and not (math.isfinite(max_hours) and max_hours > 0):
             _error("argument --max-hours: must be a finite positive number of hours")
             return 2
-        if args.threads is not None and not 1 <= args.threads <= 64:
-            _error("argument --threads: must be between 1 and 64")
-            return 2
         return runs.run(args.method, tank, variant, resolution, args.out, args.settings, overrides, start, accept,
                         args.threads, args.run, stability=stability, max_hours=max_hours)
     except inputs.InputError as err:

@@ -1,13 +1,20 @@
 """The checks of a run that need no numerics, made before any work and while the workflow is parsed.
 
-:func:`check` takes a run's tank, resolved settings and outcomes: unstable
-outcomes (escaped, non-finite, solver failure) may be accepted only by a
-declared stability case; the method's ``checks`` module refuses implausible
-settings and estimates the cost that isaflow.budget holds against the
-machine and the CPU-hour budget.  :class:`Declarations` checks every run a
-method's settings file (or a study plan) declares: its tank, variant,
-resolution, overrides, start run and the same checks, each error one line
-naming the file, the run and the setting.  Pure Python (yaml, jsonschema).
+:func:`check` takes a run's tank (None for the methods without tanks), resolved
+settings and outcomes: unstable outcomes (escaped, non-finite, solver failure)
+may be accepted only by a declared stability case; the method's ``checks``
+module refuses implausible settings and estimates the cost that
+isaflow.budget holds against the machine and the CPU-hour budget.  Every
+method's ``checks`` module has the same two functions::
+
+    plausible(tank, settings, stability=False)   # InputError naming the file and the setting
+    cost(tank, settings, particles=None)         # -> [budget.Cost], one per run the settings make
+
+:func:`check_file` checks the settings file of a method without tanks (every
+resolution).  :class:`Declarations` checks every run a method's settings file
+(or a study plan) declares: its tank, variant, resolution, overrides, start run
+and the same checks, each error one line naming the file, the run and the
+setting.  Pure Python (yaml, jsonschema).
 """
 
 from . import budget, inputs, methods, settings
@@ -19,15 +26,29 @@ WORKFLOW_KEYS = ("meta", "runtime")  # keys the workflow adds to a declaration (
 
 
 def check(method, tank, s, accept=("converged",), stability=False, max_hours=None, particles=None):
-    """Refuse (InputError) a run whose outcomes, settings or cost are not allowed.  tank: tank.Tank; s: resolved
-    settings.Settings; particles: a start file's count (None: the resolution's).  Returns the budget.Cost."""
+    """Refuse (InputError) a run whose outcomes, settings, cost or threads are not allowed.  tank: tank.Tank or
+    None; s: resolved settings.Settings; particles: a start file's count (None: the resolution's).  Returns the
+    largest of its costs (budget.Cost)."""
+    budget.check_environment()
     unstable = [a for a in accept if a in UNSTABLE]
     if unstable and not stability:
         raise InputError(f"accept: outcome '{unstable[0]}' may be accepted only by a declared stability case "
                          f"(stability: true / --stability-case); any other run that ends so fails")
     checks = methods.get(method).checks_module()
     checks.plausible(tank, s, stability)  # first: it refuses derived numbers that over- or underflow
-    return budget.check(s.path, checks.cost(tank, s, particles), max_hours)
+    costs = [budget.check(s.path, c, max_hours) for c in checks.cost(tank, s, particles)]
+    return max(costs, key=lambda c: (c.bytes, c.hours))
+
+
+def check_file(method, path=None):
+    """Check the settings file of a method without tanks, its defaults and every resolution (InputError naming
+    the file and the setting); returns the validated file as written."""
+    m = methods.get(method)
+    path, schema = str(path or m.settings), m.values_schema()
+    spec = settings.read(path, schema, f"{method} settings")
+    for resolution in (None, *spec.get("resolutions", {})):
+        check(method, None, settings.load(path, schema, resolution=resolution, spec=spec))
+    return spec
 
 
 class Declarations:

@@ -17,7 +17,7 @@ import time
 from dataclasses import dataclass
 from pathlib import Path
 
-from . import methods, preflight, runfile, settings, tank as tanks
+from . import budget, methods, preflight, runfile, settings, tank as tanks
 from .inputs import InputError, printable
 
 PROGRESS_EVERY = 20.0  # s of wall time between progress lines (a log line at least every 30 s)
@@ -71,6 +71,9 @@ def prepare(method, tank, variant, resolution, out, settings_path=None, override
     if not m.tank:
         raise InputError(f"--method: method '{method}' does not run on tanks (choose from "
                          f"{', '.join(methods.tank_methods())})")
+    if threads is not None:
+        budget.check_threads("argument --threads", threads,
+                             min(budget.machine_cores(), settings.RUN_SCHEMA["properties"]["threads"]["maximum"]))
     if variant not in m.variants:
         raise InputError(f"--variant: method '{method}' has no variant '{printable(str(variant))}' "
                          f"(choose from {', '.join(m.variants)})")
@@ -89,7 +92,7 @@ def prepare(method, tank, variant, resolution, out, settings_path=None, override
     preflight.check(method, t, s, accept, stability, max_hours,
                     _start_particles(start) if start is not None else None)
     entry = m.entry_module()
-    entry.check(t, s, variant, resolution, start)
+    entry.check(t, s, start)
     return Prepared(method, entry, t, s, variant, resolution, start, str(out), tuple(accept), threads,
                     run_id or Path(out).stem, label, stability)
 

@@ -1,8 +1,10 @@
 """Tanks (config/tanks/*.yaml): the walls, vessels and liquid every method shares.
 
-A tank file is validated against ``tank.schema.json`` and its geometry is
-checked (:func:`check_walls`, :func:`check_geometry`); errors name the file
-and the field.  The tank's liquid (weight W per unit thickness and depth h in
+A tank file is validated against ``tank.schema.json`` and checked by functions
+of one signature, ``check_*(path, spec)`` (:func:`check_walls`,
+:func:`check_geometry`, :func:`check_depth`); positions of another file (a
+method's points and probes) by :func:`check_points` / :func:`check_positions`
+``(path, field, points, walls)``; errors name the file and the field.  The tank's liquid (weight W per unit thickness and depth h in
 the first vessel) fixes the hydrostatic theory every method is judged against
 (theory.py): rho g = W / (B h), B the first vessel's width.  Units: cm, N.
 The checks are pure Python (the workflow checks tanks while it is parsed);
@@ -30,6 +32,45 @@ def _segments(spec):
     return [tuple(float(c) for c in w["from"] + w["to"]) for w in spec["walls"]]
 
 
+def vessel_floor(walls, x0, x1):
+    """y [cm] of the floor of a vessel over (x0, x1): the lowest horizontal wall running inside that range (a
+    floor only touching its end belongs to the next vessel); None if there is none.  walls: [(x0, y0, x1, y1)]."""
+    ys = [s[1] for s in walls if abs(s[1] - s[3]) <= TOL and min(max(s[0], s[2]), x1) - max(min(s[0], s[2]), x0) > TOL]
+    return min(ys) if ys else None
+
+
+def side_top(walls, x):
+    """Highest y [cm] of the walls that are not floors where they meet the vertical line at x (a vessel's side);
+    None if no such wall reaches it."""
+    ys = []
+    for x0, y0, x1, y1 in walls:
+        if abs(y0 - y1) <= TOL or not min(x0, x1) - TOL <= x <= max(x0, x1) + TOL:
+            continue
+        ys += [max(y0, y1)] if abs(x1 - x0) <= TOL else [y0 + (y1 - y0) * (x - x0) / (x1 - x0)]
+    return max(ys) if ys else None
+
+
+def bounds(walls):
+    """(xmin, ymin, xmax, ymax) [cm] of the walls' bounding box (pure Python)."""
+    xs = [c for s in walls for c in (s[0], s[2])]
+    ys = [c for s in walls for c in (s[1], s[3])]
+    return min(xs), min(ys), max(xs), max(ys)
+
+
+def check_points(path, field, points, walls, what="point(s)"):
+    """Refuse points (x, y) [cm] outside the walls' bounding box (NaN counts as outside), naming the first;
+    points: a sequence of pairs; walls: [(x0, y0, x1, y1)]."""
+    box = bounds(walls)
+    out = [(x, y) for x, y in points if not (box[0] <= x <= box[2] and box[1] <= y <= box[3])]
+    if out:
+        _outside(path, field, len(out), box, out[0], what)
+
+
+def _outside(path, field, count, box, first, what="point(s)"):
+    raise InputError(f"{path}: field '{field}': {count} {what} lie outside the walls' bounding box "
+                     f"[{box[0]:g}, {box[2]:g}] x [{box[1]:g}, {box[3]:g}] cm, e.g. ({first[0]:g}, {first[1]:g})")
+
+
 @dataclass
 class Tank:
     """A validated tank: ``spec`` is the file's mapping, ``text`` its text."""
@@ -48,6 +89,19 @@ class Tank:
         import numpy as np
 
         return np.array(_segments(self.spec), float)
+
+    def walls_list(self):
+        """[(x0, y0, x1, y1)] wall segments [cm] (pure Python)."""
+        return _segments(self.spec)
+
+    def perimeter(self):
+        """Total length [cm] of the walls."""
+        return sum(math.hypot(s[2] - s[0], s[3] - s[1]) for s in _segments(self.spec))
+
+    def panel_count(self, length):
+        """Wall panels of about ``length`` cm (core.panels: at least one per wall), a float that cannot
+        overflow an integer."""
+        return sum(max(1.0, math.hypot(s[2] - s[0], s[3] - s[1]) / length) for s in _segments(self.spec))
 
     @property
     def wall_names(self):
@@ -74,9 +128,7 @@ class Tank:
 
     def floor_y(self, vessel=0):
         """y [cm] of a vessel's floor: the lowest horizontal wall over its x range."""
-        x0, x1 = self.vessels[vessel][1]
-        return min(s[1] for s in _segments(self.spec) if abs(s[1] - s[3]) <= TOL
-                   and min(max(s[0], s[2]), x1) - max(min(s[0], s[2]), x0) > TOL)
+        return vessel_floor(_segments(self.spec), *self.vessels[vessel][1])
 
     @property
     def rho_g(self):
@@ -89,10 +141,8 @@ class Tank:
         bounding box, open upwards by the tank's own height (a splash may rise above the open top and fall
         back; one rising higher than the tank is tall carries energy no jet of this tank has).  A tuple (pure
         Python: the workflow's checks use it while it is parsed)."""
-        segs = _segments(self.spec)
-        xs = [c for s in segs for c in (s[0], s[2])]
-        ys = [c for s in segs for c in (s[1], s[3])]
-        return (min(xs), min(ys), max(xs), max(ys) + (max(ys) - min(ys)))
+        x0, y0, x1, y1 = bounds(_segments(self.spec))
+        return (x0, y0, x1, y1 + (y1 - y0))
 
     @property
     def digest(self):
@@ -171,11 +221,11 @@ def _cross(a, b):
     return inside and not ends
 
 
-def check_geometry(path, spec, walls):
+def check_geometry(path, spec):
     """A tank that can hold its liquid: one outline of joined walls (down the left side, along the floors, up
     the right side: the liquid on every wall's left), no crossing walls, every vessel inside the outline on a
-    floor, the liquid's top below the outline's wall tops.  InputError naming the file and field otherwise."""
-    names = [w["name"] for w in spec["walls"]]
+    floor.  InputError naming the file and field otherwise."""
+    walls, names = _segments(spec), [w["name"] for w in spec["walls"]]
     where = f"{path}: field 'walls'"
     order = _chain(walls)
     if order is None:
@@ -193,31 +243,39 @@ def check_geometry(path, spec, walls):
             if _cross(walls[i], walls[j]):
                 raise InputError(f"{where}: walls '{names[i]}' and '{names[j]}' cross")
     x_lo, x_hi = first[0], last[2]
-    top = min(first[1], last[3])
     for k in range(len(walls)):
         s = walls[k]
         if k not in order and (min(s[0], s[2]) < x_lo - TOL or max(s[0], s[2]) > x_hi + TOL):
             raise InputError(f"{where} ({names[k]}): a wall outside the tank's outline [{x_lo:g}, {x_hi:g}] cm")
     vessels = spec.get("vessels") or [{"name": "(whole tank)", "x": [x_lo, x_hi]}]
-    floor_y = None
+    outline = [walls[k] for k in order]
     for v in vessels:
         x0, x1 = v["x"]
         if x0 < x_lo - TOL or x1 > x_hi + TOL:
             raise InputError(f"{path}: field 'vessels' ({v['name']}): [{x0:g}, {x1:g}] cm lies outside the walls "
                              f"[{x_lo:g}, {x_hi:g}] cm")
-        under = [walls[k] for k in order if _horizontal(walls[k]) and min(walls[k][0], walls[k][2]) <= x1
-                 and max(walls[k][0], walls[k][2]) >= x0]
-        if not under:
+        if vessel_floor(outline, x0, x1) is None:
             raise InputError(f"{path}: field 'vessels' ({v['name']}): no floor under [{x0:g}, {x1:g}] cm")
-        if floor_y is None:
-            floor_y = min(s[1] for s in under)
     for a, b in zip(vessels, vessels[1:]):
         if b["x"][0] < a["x"][1] - TOL:
             raise InputError(f"{path}: field 'vessels' ({b['name']}): overlaps '{a['name']}'")
+
+
+def check_depth(path, spec):
+    """The liquid's top, its depth above the first vessel's own floor, below that vessel's walls: the tops of the
+    outline's end walls and of the walls on the vessel's two sides (a tank that passed check_geometry)."""
+    walls = _segments(spec)
+    outline = [walls[k] for k in _chain(walls)]
+    top = min(outline[0][1], outline[-1][3])
+    (x0, x1), name = (spec["vessels"][0]["x"], f"vessel '{spec['vessels'][0]['name']}'") if spec.get("vessels") \
+        else ((outline[0][0], outline[-1][2]), "the tank")
+    floor = vessel_floor(outline, x0, x1)
+    sides = [t for t in (side_top(walls, x0), side_top(walls, x1)) if t is not None]
+    top = min([top, *sides])
     depth = float(spec["liquid"]["depth"])
-    if floor_y + depth > top + TOL:
-        raise InputError(f"{path}: field 'liquid.depth': {depth:g} cm above the first floor (y = {floor_y:g} cm) "
-                         f"reaches over the wall tops (y = {top:g} cm)")
+    if floor + depth > top + TOL:
+        raise InputError(f"{path}: field 'liquid.depth': {depth:g} cm above the floor of {name} (y = {floor:g} cm) "
+                         f"reaches over its walls (y = {top:g} cm)")
 
 
 def check_positions(path, field, pos, walls):
@@ -227,15 +285,10 @@ def check_positions(path, field, pos, walls):
 
     if not np.isfinite(pos).all():
         raise InputError(f"{path}: field '{field}': positions must be finite")
-    ends = np.asarray(walls, float).reshape(-1, 2)
-    lo, hi = ends.min(0), ends.max(0)
-    out = ~((pos >= lo) & (pos <= hi)).all(1)  # NaN counts as outside
+    box = bounds(np.asarray(walls, float).tolist())
+    out = ~((pos >= box[:2]) & (pos <= box[2:])).all(1)  # NaN counts as outside
     if out.any():
-        x, y = pos[np.argmax(out)]
-        raise InputError(
-            f"{path}: field '{field}': {out.sum()} particle(s) lie outside the walls' "
-            f"bounding box [{lo[0]}, {hi[0]}] x [{lo[1]}, {hi[1]}] cm, e.g. ({x:g}, {y:g})"
-        )
+        _outside(path, field, int(out.sum()), box, pos[np.argmax(out)], "particle(s)")
 
 
 def path_of(name):
@@ -247,6 +300,6 @@ def load(path):
     """Read and validate a tank file; InputError naming the file and the field."""
     path = str(path)
     text, spec = inputs.load(path, SCHEMA, "tank")
-    walls = check_walls(path, spec)
-    check_geometry(path, spec, walls)
+    for check in (check_walls, check_geometry, check_depth):  # in this order: each relies on the ones before
+        check(path, spec)
     return Tank(path, spec, text)

@@ -46,7 +46,7 @@ RUN_RESOURCES = {}  # {(method, run id): {'mem_mb', 'runtime'}}, filled by check
 def run_resources(members):
     """mem_mb and runtime of a job running members [(method, run id)] one after another, from their cost
     estimates (isaflow.budget.job_resources): the largest memory, the sum of the times."""
-    res = [RUN_RESOURCES[m] for m in members]
+    res = [RUN_RESOURCES[m] for m in members if declaration(*m)]
     return {"mem_mb": max(r["mem_mb"] for r in res), "runtime": sum(r["runtime"] for r in res)}
 
 
@@ -133,9 +133,18 @@ def run_file(method, run):
     return f"results/runs/{method}/{run}.nc"
 
 
+def declaration(method, run):
+    """The declaration of a run; a run no settings file declares (a target such as results/runs/<method>/<id>.nc
+    asked for on the command line) is refused with one line while the jobs are planned, before any starts."""
+    if run not in RUNS[method]:
+        refuse(f"{REGISTRY[method].settings}: field 'runs': no {method} run '{_inputs.printable(run)}' is declared, "
+               f"so nothing makes {_inputs.printable(run_file(method, run))}")
+    return RUNS[method][run]
+
+
 def run_job(method, run):
     """(method, run id, declaration + the paths isaflow.run reads: tank_file, settings_file, start_file)."""
-    decl = dict(RUNS[method][run], tank_file=f"config/tanks/{RUNS[method][run]['tank']}.yaml",
+    decl = dict(declaration(method, run), tank_file=f"config/tanks/{RUNS[method][run]['tank']}.yaml",
                 settings_file=REGISTRY[method].settings)
     if decl.get("start"):
         decl["start_file"] = run_file(method, decl["start"])
@@ -150,7 +159,7 @@ def runs_inputs(members):
     out = {"tank": [], "settings": [], "start": [], "compiled": [],
            "code": code("isaflow.run", "isaflow.timing") + ["workflow/scripts/run.py"]}
     for method, run in members:
-        decl = RUNS[method][run]
+        decl = declaration(method, run)
         out["tank"].append(f"config/tanks/{decl['tank']}.yaml")
         out["settings"].append(REGISTRY[method].settings)
         out["code"] += code(REGISTRY[method].entry)
@@ -305,13 +314,14 @@ def check_inputs():
     """Every input checked before any job starts (the Snakefile calls this after every rules file declared
     its runs): the comparison's tanks; every declared run of every tank method (tank, variant, resolution,
     overrides, start run, outcomes, plausibility, cost: isaflow.preflight); the settings of the methods
-    without tanks (their checks' validate).  The first error stops the workflow with one line.  Each run's
+    without tanks (preflight.check_file).  The first error stops the workflow with one line.  Each run's
     estimate then gives its job's mem_mb and runtime (RUN_RESOURCES, isaflow.budget.job_resources)."""
     from isaflow import budget as _budget
     from isaflow import preflight as _preflight
 
     d = _preflight.Declarations()
     try:
+        check_cores(_budget)
         for name in config["compare"]["tanks"]:
             try:
                 d.tank(name)
@@ -319,12 +329,23 @@ def check_inputs():
                 raise _inputs.InputError(f"config/config.yaml: field 'compare.tanks': {err}") from None
         for method in TANK_METHODS:
             d.check(method, RUNS[method])
-        for m in REGISTRY.values():
+        for name, m in REGISTRY.items():
             if not m.tank:
-                m.checks_module().validate(m.settings)
+                _preflight.check_file(name)
     except _inputs.InputError as err:
         refuse(err)
     RUN_RESOURCES.update({key: _budget.job_resources(cost) for key, cost in d.costs.items()})
+
+
+def check_cores(budget):
+    """Snakemake's --cores: from 1 to this machine's cores when the jobs run here, at least 1 otherwise (a job's
+    threads are at most the cores, and each sets NUMBA_NUM_THREADS to its threads)."""
+    try:
+        cores = workflow.cores
+    except Exception:  # a cluster run given no --cores: each job's threads are its rule's
+        return
+    budget.check_threads("snakemake command line: field '--cores'", cores,
+                         None if workflow.local_exec else max(cores, 1))
 
 
 def workflow_timing(cores):

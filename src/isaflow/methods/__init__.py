@@ -8,13 +8,14 @@ a variant: labels, colours, markers, papers, settings files, claims modules and
 report fragments all come from here.
 
 A *tank method* (``tank=True``) runs on the shared tanks: its ``entry``
-module provides ``check(tank, settings, variant, resolution, start)``,
+module provides ``check(tank, settings, start)``,
 ``solve(tank, settings, variant, resolution, start=None, progress=None,
 threads=None) -> contract.Result``, ``warm_up(threads)`` and
 ``REFERENCES``; its ``values`` (``module:attribute``) is the schema of its
-settings file (isaflow.settings); its ``checks`` module (pure Python, read
-while the workflow is parsed) ``plausible(tank, settings, stability)`` and
-``cost(tank, settings, particles) -> isaflow.budget.Cost``.
+settings file (isaflow.settings).  Every method's ``checks`` module (pure
+Python, read while the workflow is parsed) has ``plausible(tank, settings,
+stability)`` and ``cost(tank, settings, particles) -> [isaflow.budget.Cost]``
+(isaflow.preflight; tank is None for the methods without tanks).
 """
 
 import importlib
@@ -42,9 +43,8 @@ class Method:
     variants: dict = field(default_factory=dict)  # name -> Variant
     tank: bool = False  # runs on the shared tanks through isaflow.run
     entry: str = ""  # module with check / solve / warm_up / REFERENCES (tank methods)
-    checks: str = ""  # pure-Python checks: plausible(tank, settings, stability) and cost(...) (tank methods);
-    # the module whose validate(settings path) checks the settings file (the others)
-    values: str = ""  # "module:attribute" of the settings values schema (tank methods)
+    checks: str = ""  # pure-Python checks: plausible(tank, settings, stability) and cost(tank, settings, particles)
+    values: str = ""  # "module:attribute" of the settings values schema
     settings: str = ""  # default settings file, relative to the project root
     report: str = ""  # the method's report fragment, results/report/NN_name.md
     timing: str = ""  # its timing fragment, results/timing/NN_name.md

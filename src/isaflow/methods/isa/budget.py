@@ -15,18 +15,30 @@ import numpy as np
 from ...budget import gb as _gb
 from ...budget import memory_limit
 from ...inputs import InputError
-from .checks import BYTES_PER_PARTICLE, BYTES_PER_RECORD, particle_count  # noqa: F401 (particle_count: scene)
+from ...plausible import extreme
+from .checks import BYTES_PER_PARTICLE, BYTES_PER_RECORD, check_grid, particle_count, particles_field  # noqa: F401
 from .settings import settings
 
 BYTES_PER_PAIR = 12  # int32 neighbour entry with its doubling growth
-MAX_GRID_CELLS = 10**9  # cells of the neighbour grid (int32 cell starts)
 
 
 def check_settings(scene):
-    """Refuse derived solver numbers that are not finite and positive (naming the field they come from)."""
+    """Refuse derived solver numbers that are not finite and positive, naming the input each follows: the
+    stiffness r_u / l_u its farther-from-1 factor, f_ref, dt_max and the skin their own field if set, else what
+    their defaults follow (du, the stiffness, the pair range), the overdamped step its own field or the weight."""
     s = settings(scene)
-    checks = [("forces.wall", s["wall_r_u"] / s["wall_l_u"]), ("forces.pair", s["pair_r_u"] / s["pair_l_u"]),
-              ("solver.f_ref", s["f_ref"]), ("solver.dt_max", s["dt_max"]), ("solver.skin", s["skin"])]
+    given = scene.spec["solver"]
+    v = {f"forces.{side}.{k}": scene.spec["forces"][side][k] for side in ("wall", "pair") for k in ("l_u", "r_u")}
+    laws = list(v)
+    v.update({"solver.du": s["du"], "particles.weight": scene.spec["particles"]["weight"], "solver.zeta": s["zeta"]})
+    checks = [(extreme(v, "forces.wall.r_u", "forces.wall.l_u"), s["wall_r_u"] / s["wall_l_u"]),
+              (extreme(v, "forces.pair.r_u", "forces.pair.l_u"), s["pair_r_u"] / s["pair_l_u"]),
+              ("solver.f_ref" if "f_ref" in given else extreme(v, "solver.du", *laws), s["f_ref"]),
+              ("solver.dt_max" if "dt_max" in given else extreme(v, *laws), s["dt_max"]),
+              ("solver.skin" if "skin" in given else "forces.pair.l_u", s["skin"])]
+    if s["variant"] == "overdamped":
+        checks.append(("solver.dt" if "dt" in given else extreme(v, "particles.weight", "solver.zeta", *laws),
+                       s["dt"]))
     for field, value in checks:
         if not (math.isfinite(value) and value > 0):
             raise InputError(f"{scene.path}: field '{field}': the derived value {value!r} is not a finite positive "
@@ -92,15 +104,12 @@ def check_memory(scene, pos):
     walls = scene.walls
     lo, hi = walls.reshape(-1, 2).min(0), walls.reshape(-1, 2).max(0)
     rc = s["pair_l_u"] + s["skin"]
-    cells = max(1.0, (hi[0] - lo[0]) / rc) * max(1.0, (hi[1] - lo[1]) / rc)
-    if not cells <= MAX_GRID_CELLS:
-        raise InputError(f"{scene.path}: field 'forces.pair.l_u': the neighbour grid over the walls' bounding box "
-                         f"would have {cells:.3g} cells of {rc:.3g} cm (limit {MAX_GRID_CELLS:.0e}); the walls are "
-                         f"too far apart for this pair range")
+    cells = check_grid(scene.path, walls.tolist(), rc, "walls")  # the scene's walls: its settings file's copy
     n = len(pos)
     pairs = pair_bound(pos, np.array([lo[0], lo[1], hi[0], hi[1]]), rc)
-    parts = [(n * BYTES_PER_PARTICLE, "particles", f"{n} particles"),
-             (pairs * BYTES_PER_PAIR, "particles", f"up to {pairs:.3g} neighbour pairs"),
+    field = particles_field(scene.spec["particles"])
+    parts = [(n * BYTES_PER_PARTICLE, field, f"{n} particles"),
+             (pairs * BYTES_PER_PAIR, field, f"up to {pairs:.3g} neighbour pairs"),
              (cells * 4, "forces.pair.l_u", f"{cells:.3g} grid cells")] + _fixed_bytes(scene, n)
     need = sum(p[0] for p in parts)
     limit = memory_limit()

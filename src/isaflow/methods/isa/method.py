@@ -22,9 +22,9 @@ def _scene(tank, settings, variant, start):
     return scenes.build(tank, settings, variant, start)
 
 
-def check(tank, settings, variant, resolution, start=None):
+def check(tank, settings, start=None):
     """Every check that can refuse the run (scene geometry, memory, start file); InputError naming the field."""
-    scene = _scene(tank, settings, variant, start)
+    scene = _scene(tank, settings, settings.variant, start)
     if start is not None:
         scenes.start_file(scene)
 

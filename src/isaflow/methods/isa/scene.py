@@ -118,9 +118,9 @@ def _check_geometry(scene):
     part = scene.spec["particles"]
     if "from_run" in part:
         return
-    budget.check_count(scene, budget.particle_count(part), "particles")
+    budget.check_count(scene, budget.particle_count(part), budget.particles_field(part))
     pos = scene.pos0 = initial_positions(scene)
-    check_positions(path, "particles", pos, walls)
+    check_positions(path, "particles.points" if "points" in part else "particles.lattice", pos, walls)
     budget.check_memory(scene, pos)
 
 

@@ -24,11 +24,10 @@ def _flow(tank):
     return len(tank.spec.get("vessels", [])) > 1
 
 
-def check(tank, settings, variant, resolution, start=None):
-    """Every check that can refuse the run: a spacing, and a start file that is an MPS run of that spacing."""
+def check(tank, settings, start=None):
+    """Every check that can refuse the run before any work beyond checks.plausible's: a start file that is an MPS
+    run of the run's spacing."""
     l0 = settings["resolution.spacing"]
-    if l0 is None:
-        raise InputError(f"{settings.path}: field 'resolutions.{resolution}': no resolution.spacing")
     if start is not None:
         with runfile.open_run(start) as ds:
             if ds.attrs.get("method") != "mps":

@@ -30,7 +30,8 @@ METHOD = Method(
     marker="D",
     paper_label="Marko et al. (2017), SPH liquid and Hooke's-law solid particles",
     settings="config/methods/solid.yaml",
-    checks="isaflow.methods.solid.settings",
+    checks="isaflow.methods.solid.checks",
+    values="isaflow.methods.solid.settings:VALUES",
     report="results/report/65_solid.md",
     timing="results/timing/65_solid.md",
 )

@@ -1,18 +1,21 @@
 """What makes the solid method's settings plausible, and what its cases will cost (pure Python).
 
-:func:`check` (called by settings.load, so by every run and while the
-workflow is parsed) refuses materials no solid has, a tolerance below
-double-precision round-off, a Hertz disk pressed through its plate, a vessel
-time step over the lattice's step rule (eq. 26, dx / (4 c)), and any case
-whose particles x steps exceed the budget (isaflow.budget).  Units: the
-settings file's (GPa, kg/m^3, mm, um, ns), converted here to cm, N, s.
+The checks of every method (isaflow.preflight.check; settings.load calls it, so
+every run and the workflow while it is parsed): :func:`plausible` refuses
+materials no solid has, a tolerance below double-precision round-off, a Hertz
+disk pressed through its plate, a vessel time step over the lattice's step
+rule (eq. 26, dx / (4 c)), and a case that is no solid under load (no free
+particle between its held ones, nothing holding or moving it); :func:`cost`
+gives every case's particles x steps for isaflow.budget.  The solid has no
+tank (tank is None).  Units: the settings file's (GPa, kg/m^3, mm, um, ns),
+converted here to cm, N, s.
 """
 
 import math
 
 from ... import budget
 from ...core.units import KG, PA
-from ...plausible import finite, require
+from ...plausible import extreme, finite, require
 
 NS_PER_PARTICLE_STEP = 10.0  # a lower bound of the dynamic-relaxation step (3-D links, numba)
 BYTES_PER_PARTICLE = 3000  # state, links (26 neighbours in 3-D) and their forces (order, rounded up)
@@ -27,15 +30,21 @@ def wave_speed(mat):
     return math.sqrt(mat["E_GPa"] * 1e9 * PA / (mat["rho_kg_m3"] * KG / 1e6))
 
 
-def plausible(s, path):
-    """Refuse implausible settings ({section: {key: value}}; InputError naming the file and the setting)."""
+BAR_LAYERS = 3  # the bar's gripped end layers and a free mid-length layer between them, where the stress is read
+PLATE_ROWS = 2  # the Hertz plate's held bottom row and a free row above it
+FLOOR_COLUMNS = 3  # the floor's two supported end columns and a free one between them
+
+
+def plausible(tank, settings, stability=False):
+    """Refuse implausible settings (settings.Settings; InputError naming the file and the setting)."""
+    s, path = settings.tree(), settings.path
     mat = s["material"]
     require(mat["E_GPa"] <= E_MAX_GPA, path, "material.E_GPa",
             f"{mat['E_GPa']:g} GPa is stiffer than diamond ({E_MAX_GPA:g} GPa), the stiffest solid")
     require(RHO_RANGE[0] <= mat["rho_kg_m3"] <= RHO_RANGE[1], path, "material.rho_kg_m3",
             f"{mat['rho_kg_m3']:g} kg/m^3 is outside {RHO_RANGE[0]:g}-{RHO_RANGE[1]:g} kg/m^3 (aerogels to "
             f"osmium, the densest element)")
-    finite(path, "material", wave_speed(mat), "wave speed sqrt(E / rho) [cm/s]")
+    finite(path, f"material.{extreme(mat, 'E_GPa', 'rho_kg_m3')}", wave_speed(mat), "wave speed sqrt(E / rho) [cm/s]")
     require(s["solver"]["tol"] >= TOL_MIN, path, "solver.tol",
             f"{s['solver']['tol']:g} is below {TOL_MIN:g}, the round-off of the forces in double precision; the "
             f"relaxation could never reach it")
@@ -54,10 +63,32 @@ def plausible(s, path):
     require(v["water_h_over_dx"] >= 1.0, path, "vessel.water_h_over_dx",
             f"{v['water_h_over_dx']:g}: below 1 the water's kernel (support 2h) sees too few neighbours "
             f"(Monaghan 1992: h ~ 1.2-1.3 dx)")
+    solids(s, path)
 
 
-def costs(s):
-    """{case: budget.Cost} of every case of the settings."""
+def solids(s, path):
+    """Refuse a case that is no solid under load: its held particles leave none free, or nothing holds it."""
+    layers = s["bar"]["particles"][1]
+    require(layers >= BAR_LAYERS, path, "bar.particles",
+            f"{layers} layer(s) along y: the bar's end layers are gripped and its stress is read at mid-length, so "
+            f"it needs at least {BAR_LAYERS} (a free layer between the grips)")
+    require(s["shear"]["grip_layers"] >= 1, path, "shear.grip_layers",
+            "0: no layer holds the block or moves it, so it carries no load")
+    rows = s["hertz"]["plate"][1]
+    require(rows >= PLATE_ROWS, path, "hertz.plate",
+            f"{rows} row(s): the plate's bottom row is held, so it needs at least {PLATE_ROWS} (a free row under the "
+            f"disk)")
+    f = s["floor"]
+    ratio = f["span_cm"] / f["dx_cm"]
+    columns = round(ratio) + 1 if math.isfinite(ratio) else ratio
+    require(columns >= FLOOR_COLUMNS, path, "floor.dx_cm",
+            f"{f['dx_cm']:g} cm over the {f['span_cm']:g} cm span gives {columns:g} column(s); the two end columns are "
+            f"supported, so the plate needs at least {FLOOR_COLUMNS} (a free one between the supports)")
+
+
+def cost(tank, settings, particles=None):
+    """[budget.Cost] of every case of the settings (settings.Settings)."""
+    s = settings.tree()
     steps_hooke = s["solver"]["max_steps"]
     b, sh, h, v, f = s["bar"], s["shear"], s["hertz"], s["vessel"], s["floor"]
     n_bar = math.prod(b["particles"])
@@ -67,23 +98,17 @@ def costs(s):
     n_floor = (f["span_cm"] / f["dx_cm"] + 1) * f["layers"]
     history = v["history_us"] * 1e-6 / (v["dt_ns"] * NS)
 
-    def cost(n, steps, field_n, field_steps, detail):
+    def case(n, steps, field_n, field_steps, detail):
         return budget.Cost(n, steps, n * BYTES_PER_PARTICLE, NS_PER_PARTICLE_STEP,
                            {"particles": field_n, "steps": field_steps, "bytes": field_n}, detail)
 
-    return {
-        "bar": cost(n_bar, 2 * steps_hooke, "bar.particles", "solver.max_steps", "two loads x max_steps"),
-        "shear": cost(n_shear, steps_hooke, "shear.particles", "solver.max_steps", "max_steps"),
-        "hertz": cost(n_hertz, len(h["depths_um"]) * steps_hooke + len(h["paper_dt_ns"]) * h["dt_check_steps"],
-                      "hertz.plate", "solver.max_steps", "depths x max_steps + the paper's dt checks"),
-        "vessel": cost(n_vessel, steps_hooke + history + v["steps"], "vessel.water_radius_particles",
-                       "vessel.history_us", f"settling + history {v['history_us']:g} us / dt {v['dt_ns']:g} ns"),
-        "floor": cost(n_floor, f["max_steps"], "floor.dx_cm", "floor.max_steps", "max_steps"),
-    }
-
-
-def check(s, path):
-    """plausible() and the cost of every case against the budget."""
-    plausible(s, path)
-    for c in costs(s).values():
-        budget.check(path, c)
+    return [
+        case(n_bar, 2 * steps_hooke, "bar.particles", "solver.max_steps", "two loads x max_steps"),
+        case(n_shear, steps_hooke, "shear.particles", "solver.max_steps", "max_steps"),
+        case(n_hertz, len(h["depths_um"]) * steps_hooke + len(h["paper_dt_ns"]) * h["dt_check_steps"],
+             "hertz.plate", "solver.max_steps", "depths x max_steps + the paper's dt checks"),
+        case(n_vessel, steps_hooke + history + v["steps"], "vessel.water_radius_particles",
+             "vessel.history_us", f"settling + history {v['history_us']:g} us / dt {v['dt_ns']:g} ns"),
+        case(n_bar, s["bar_long"]["steps"], "bar.particles", "bar_long.steps", "one sustained-tension run"),
+        case(n_floor, f["max_steps"], "floor.dx_cm", "floor.max_steps", "max_steps"),
+    ]

@@ -4,6 +4,7 @@ Every value is ``{value: ..., source: "..."}``; unknown keys are rejected and
 a bad file raises isaflow.inputs.InputError naming the file and field.
 """
 
+from isaflow import preflight
 from isaflow import settings as S
 from isaflow.core.units import KG, PA
 
@@ -43,17 +44,10 @@ VALUES = {f"{sec}.{k}": v for sec, fields in SECTIONS.items() for k, v in fields
 
 def load(path):
     """{section: {key: value}} of a settings file, values as written (sources dropped); plausibility and the
-    cost of every case checked (checks.check)."""
-    from .checks import check
-
-    s = S.load(path, VALUES, what="solid settings").tree()
-    check(s, str(path))
-    return s
-
-
-def validate(path):
-    """The workflow's parse-time check of a settings file (load: schema, plausibility, cost)."""
-    load(path)
+    cost of every case checked (isaflow.preflight)."""
+    s = S.load(path, VALUES, what="solid settings")
+    preflight.check("solid", None, s)
+    return s.tree()
 
 
 def load_with_sources(path):

@@ -13,7 +13,8 @@ import math
 
 from ... import budget
 from ...core.units import G
-from ...plausible import finite, require, within
+from ...plausible import extreme, finite, lattice_field, liquid_field, require, tank_field, within
+from ...tank import bounds
 
 NS_PER_PARTICLE_STEP = 70.0  # fastest measured, 2 threads at 2e4-5e4 particles (benchmarks/); 1 thread 127-130
 BYTES_PER_PARTICLE = 900  # state, accelerations, wall contacts, neighbour-list bookkeeping (order, rounded up)
@@ -33,6 +34,12 @@ DELTA = (0.0, 1.0, "delta-SPH density diffusion: 0.1 (Molteni & Colagrossi 2009)
 FRACTION = (0.0, 1.0, "a fraction of the cell spacing or of h")
 
 
+BLOCK_CELLS = 3  # cells of 2h across a periodic block (sph.block: the minimum image)
+BYTES_PER_CELL = 8  # int64 cell start of a cell list
+BYTES_PER_PANEL = 16  # a panel's force (x, y) in the rest window's records (bounded here by one per chunk)
+BYTES_PER_SNAPSHOT_PARTICLE = 16  # a liquid particle's position (x, y) in a position snapshot
+
+
 def sound_speed(s):
     """c0 [cm/s] = sound_speed_factor sqrt(2 g max_drop)."""
     return s["settings.sound_speed_factor"] * math.sqrt(2 * G * s["settings.max_drop"])
@@ -44,14 +51,18 @@ def _first_vessel(tank):
 
 
 def lattice(tank, s):
-    """(nx, ny, dx, dy) [cm] of the liquid lattice a resolution asks for (particles.lattice_shape, in Python)."""
+    """(nx, ny, dx, dy) [cm] of the liquid lattice a resolution asks for (particles.lattice_shape, in Python);
+    counts that overflow are inf, a spacing that is not finite and positive gives 0 x 0 and NaN."""
     width, depth = _first_vessel(tank), tank.depth
     n, spacing = s["resolution.particles"], s["resolution.spacing"]
     if spacing is None:
         spacing = math.sqrt(width * depth / n) if n else float("nan")
     if not (math.isfinite(spacing) and spacing > 0):
         return 0, 0, float("nan"), float("nan")
-    nx, ny = max(1, round(width / spacing)), max(1, round(depth / spacing))
+    nx, ny = width / spacing, depth / spacing
+    if not (math.isfinite(nx) and math.isfinite(ny)):
+        return nx, ny, float("nan"), float("nan")
+    nx, ny = max(1, round(nx)), max(1, round(ny))
     return nx, ny, width / nx, depth / ny
 
 
@@ -64,9 +75,10 @@ def plausible(tank, s, stability=False):
     """Refuse implausible settings (InputError naming the file and the setting, with the reason)."""
     path, field = s.path, _resolution_field(s)
     nx, ny, dx, dy = lattice(tank, s)
-    require(nx >= 2 and ny >= 2, path, field,
-            f"the liquid ({_first_vessel(tank):g} cm wide, {tank.depth:g} cm deep) would be {nx} x {ny} particles; "
-            f"a liquid needs at least 2 across its width and its depth")
+    require(nx >= 2 and ny >= 2, path, lattice_field(tank, nx, ny, field),
+            f"the liquid ({_first_vessel(tank):g} cm wide, {tank.depth:g} cm deep) would be {nx} x {ny} particles "
+            f"({field} = {s[field]:g}); a liquid needs at least 2 across its width and its depth")
+    finite(path, field, float(nx * ny), "particle count of the liquid")
     within(path, "settings.h_factor", s["settings.h_factor"], *H_RANGE, stability=stability)
     within(path, "settings.cfl", s["settings.cfl"], *CFL_MAX, stability=stability)
     within(path, "settings.sound_speed_factor", s["settings.sound_speed_factor"], *MACH, stability=stability)
@@ -83,43 +95,72 @@ def plausible(tank, s, stability=False):
     c0 = sound_speed(s)
     finite(path, "settings.sound_speed_factor", c0, "sound speed c0 [cm/s]")
     h = s["settings.h_factor"] * math.sqrt(dx * dy)
-    finite(path, "settings.cfl", time_step(s, h, c0), "time step dt [s]")
+    finite(path, extreme(s, "settings.cfl", "settings.h_factor"), time_step(s, h, c0), "time step dt [s]")
+    if s["settings.domain"] == "periodic_block":
+        block(tank, s, nx, ny, dx, dy, h)
+
+
+def block(tank, s, nx, ny, dx, dy, h):
+    """Refuse a periodic block (sph.block) it cannot run: a density or diffusion it does not implement, a box of
+    fewer than BLOCK_CELLS x BLOCK_CELLS cells of 2h (its minimum image needs them)."""
+    path = s.path
+    require(s["settings.density"] == "continuity", path, "settings.density",
+            f"a periodic block (settings.domain) implements the continuity density only, not '{s['settings.density']}'")
+    require(s["settings.delta"] == 0, path, "settings.delta",
+            f"a periodic block (settings.domain) implements no density diffusion, not delta = {s['settings.delta']:g}")
+    cells = min(nx * dx, ny * dy) * (1 + s["settings.stretch"]) / (2 * h)
+    require(cells >= BLOCK_CELLS, path, _resolution_field(s) if min(nx, ny) < 2 * BLOCK_CELLS else "settings.h_factor",
+            f"the periodic block holds {cells:.3g} cells of 2h = {2 * h:.4g} cm across ({nx} x {ny} particles); "
+            f"its minimum image needs {BLOCK_CELLS}")
 
 
 def _resolution_field(s):
     return "resolution.spacing" if s["resolution.spacing"] is not None else "resolution.particles"
 
 
-def _steps_field(s, n, t_key):
+def _steps_field(s, n, particles):
     """The setting a too long run is blamed on: a tiny CFL number, a huge sound speed, a fine resolution
-    (dt follows h), else the time limit."""
+    (dt follows h; particles: what the particle count follows), else the time limit."""
     if s["settings.cfl"] < CFL_MAX[1] / 10:
         return "settings.cfl"
     if s["settings.sound_speed_factor"] > 10 * MACH[0]:
         return "settings.sound_speed_factor"
     if n > 1e6:
-        return _resolution_field(s)
-    return t_key
+        return particles
+    return _t_key(s, None)
+
+
+def _t_key(s, tank):
+    if s["settings.domain"] == "periodic_block":
+        return "settings.t_max_block"
+    flow = tank is not None and len(tank.spec.get("vessels", [])) > 1
+    return "settings.t_max_flow" if flow else "settings.t_max_single"
 
 
 def cost(tank, s, particles=None):
-    """budget.Cost of a run: the liquid lattice (or a start file's `particles`), wall particles 2h deep,
-    t_max / dt steps."""
+    """[budget.Cost] of a run: the liquid lattice (or a start file's `particles`), wall particles 2h deep,
+    t_max / dt steps; memory: particles and pairs, the finest cell list (the wall particles' de-duplication
+    grid, half a spacing over the walls' bounding box), the panels' rest-window records and the snapshots."""
     nx, ny, dx, dy = lattice(tank, s)
     h = s["settings.h_factor"] * math.sqrt(dx * dy)
     liquid = nx * ny if particles is None else particles
-    perimeter = sum(math.hypot(w["to"][0] - w["from"][0], w["to"][1] - w["from"][1]) for w in tank.spec["walls"])
-    wall = 2 * perimeter / dx * max(1.0, 2 * h / dy)  # both faces of a thin wall, 2h deep
+    wall = 2 * tank.perimeter() / dx * max(1.0, 2 * h / dy)  # both faces of a thin wall, 2h deep
     n = liquid + wall
-    flow = len(tank.spec.get("vessels", [])) > 1
-    t_key = "settings.t_max_flow" if flow else "settings.t_max_single"
+    t_key = _t_key(s, tank)
     dt = time_step(s, h, sound_speed(s))
     steps = s[t_key] / dt
     neighbours = math.pi * (2 * s["settings.h_factor"] * (1 + s["settings.skin"])) ** 2
     chunks = s[t_key] / s["settings.chunk_time"]
-    nbytes = n * (BYTES_PER_PARTICLE + BYTES_PER_PAIR * neighbours) + chunks * 200
-    fields = {"particles": _resolution_field(s), "steps": _steps_field(s, n, t_key),
-              "bytes": _resolution_field(s) if chunks * 200 <= nbytes / 2 else
-              "settings.chunk_time" if s["settings.chunk_time"] < dt else t_key}
-    return budget.Cost(n, steps, nbytes, NS_PER_PARTICLE_STEP, fields,
-                       f"t = {s[t_key]:g} s / dt = {dt:.3g} s")
+    box = bounds(tank.walls_list())
+    cell = 0.5 * min(dx, dy)
+    grid = ((box[2] - box[0]) / cell + 1) * ((box[3] - box[1]) / cell + 1)
+    panels = tank.panel_count(s["settings.panel_length"])
+    by_liquid = liquid_field(tank, nx, ny, _resolution_field(s)) if liquid >= wall else tank_field(tank, "walls")
+    by_chunks = "settings.chunk_time" if s["settings.chunk_time"] < dt else t_key
+    parts = [(n * (BYTES_PER_PARTICLE + BYTES_PER_PAIR * neighbours), by_liquid), (chunks * 200, by_chunks),
+             (grid * BYTES_PER_CELL, tank_field(tank, "walls")),
+             (panels * BYTES_PER_PANEL * (chunks + 4), "settings.panel_length" if panels > chunks else by_chunks),
+             (len(s["settings.snapshot_times"]) * liquid * BYTES_PER_SNAPSHOT_PARTICLE, "settings.snapshot_times")]
+    fields = {"particles": by_liquid, "steps": _steps_field(s, n, by_liquid), "bytes": max(parts, key=lambda p: p[0])[1]}
+    return [budget.Cost(n, steps, sum(p[0] for p in parts), NS_PER_PARTICLE_STEP, fields,
+                        f"t = {s[t_key]:g} s / dt = {dt:.3g} s")]

@@ -17,7 +17,7 @@ REFERENCES = ("Marko (2017), Computation 5, 33 (section 2); Monaghan (1992), Ann
 START_VARS = ("pos", "velocity", "density", "weight")
 
 
-def check(tank, settings, variant, resolution, start=None):
+def check(tank, settings, start=None):
     """Every check that can refuse the run: one resolution, and a start file that is an SPH run with its state
     (a periodic block starts from its lattice, never from a file)."""
     S.resolution(settings)

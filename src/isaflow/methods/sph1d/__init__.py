@@ -32,7 +32,8 @@ METHOD = Method(
     marker="v",
     paper_label="Merino-Alonso et al. (2020), truncated SPH hydrostatics (abstract only)",
     settings="config/methods/sph1d.yaml",
-    checks="isaflow.methods.sph1d.settings",
+    checks="isaflow.methods.sph1d.checks",
+    values="isaflow.methods.sph1d.settings:VALUES",
     report="results/report/60_sph1d.md",
     timing="results/timing/60_sph1d.md",
 )

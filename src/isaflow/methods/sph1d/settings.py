@@ -4,12 +4,8 @@ Every entry is {value, source}; unknown keys are rejected; a bad file raises
 isaflow.inputs.InputError with one line naming the file and the field.
 """
 
-from pathlib import Path
-
+from isaflow import preflight
 from isaflow import settings as S
-from isaflow.inputs import InputError as SceneError
-
-from .checks import check
 
 KERNELS = ("cubic_spline", "wendland_c2", "wendland_c4", "wendland_c6")  # core.smoothing.NAMES (tested equal)
 GRADIENT_FORMS = ("symmetric", "plain")  # system.GRADIENT_FORMS (tested equal)
@@ -32,28 +28,11 @@ VALUES = {
 
 def load(path, resolution=None):
     """{name: value} of a settings file (with its ``resolutions`` entry ``resolution`` applied, e.g. the longer
-    N range of the sweep to N = 8192); adds 'ratios' (array of h/dx), 'path' and 'resolution'."""
+    N range of the sweep to N = 8192), checked (isaflow.preflight: the defaults and every resolution); adds
+    'variants' ({name: {gradient, floor}}), 'ratios' (array of h/dx), 'path' and 'resolution'."""
     import numpy as np
 
-    s = validate(path, resolution)
-    r = s["ratio"]
-    s["ratios"] = np.round(np.arange(r["start"], r["stop"] + 0.5 * r["step"], r["step"]), 10)
-    s["n"] = sorted(s["n"])
-    s["path"] = str(path)
-    s["resolution"] = resolution or ""
-    return s
-
-
-def validate(path, resolution=None):
-    """{name: value} of a settings file, checked (schema, variants, checks.check); pure Python.  resolution
-    None checks the file's defaults and every entry of its ``resolutions`` (returns the defaults)."""
-    path = Path(path)
-    spec = S.read(path, VALUES, "1D SPH settings")
-    if not spec.get("variants"):
-        raise SceneError(f"{path}: field 'variants': at least one reading to solve")
-    if resolution is None:
-        for name in spec.get("resolutions") or {}:
-            validate(path, name)
+    spec = preflight.check_file("sph1d", path)
     s = S.load(path, VALUES, resolution=resolution, spec=spec).tree()
     s["variants"] = {}
     for name in spec["variants"]:
@@ -61,9 +40,8 @@ def validate(path, resolution=None):
         s["variants"][name] = {"gradient": v["gradient"], "floor": v["floor"]}
     del s["gradient"], s["floor"]
     r = s["ratio"]
-    if r["stop"] < r["start"]:
-        raise SceneError(f"{path}: field 'ratio': stop must be >= start")
-    if len(s["n"]) < s["classify"]["window"]:
-        raise SceneError(f"{path}: field 'n': needs at least classify.window = {s['classify']['window']} values")
-    check(s, str(path))
+    s["ratios"] = np.round(np.arange(r["start"], r["stop"] + 0.5 * r["step"], r["step"]), 10)
+    s["n"] = sorted(s["n"])
+    s["path"] = str(path)
+    s["resolution"] = resolution or ""
     return s
