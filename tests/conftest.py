@@ -6,8 +6,13 @@ import numpy as np
 import pytest
 
 from isaflow import run, runfile
+from isaflow.core import jit
 from isaflow.preflight import UNSTABLE
 from isaflow.methods.isa import scene, solver
+
+# this session's kernels in a generation of their own, sealed at exit: workflow jobs the tests start
+# (default, per-method generations) never meet a test session that writes theirs
+jit.use("tests")
 
 ROOT = Path(__file__).resolve().parents[1]
 TANKS = ROOT / "config" / "tanks"

@@ -402,7 +402,6 @@ def test_the_workflow_refuses_bad_inputs_while_it_is_parsed(tmp_path, case):
 PARSE_ARGS = {
     "cores_zero": (["-c0"], "'--cores'"),
     "cores_negative": (["--cores", "-1"], "'--cores'"),
-    "cores_beyond_the_machine": (["-c", str(budget.machine_cores() + 1)], "'--cores'"),
     **{f"undeclared_{m}_run": (["-c1", f"results/runs/{m}/no_such_run.nc"], f"config/methods/{m}.yaml: field 'runs'")
        for m in DEFAULT},
     "run_of_another_method": (["-c1", "results/runs/mps/single_coarse.nc"], "no mps run 'single_coarse'"),

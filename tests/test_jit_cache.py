@@ -103,3 +103,18 @@ def test_a_process_without_a_fill_compiles_in_memory_while_another_writes(env):
     assert {a["mode"], b["mode"]} <= {"write", "private", "read"} and a["value"] == b["value"] == 12.0
     third, _ = result(start(env, generation="default", sleep=-1))
     assert third["mode"] == "read" and third["compiled"] == 0
+
+
+def test_a_process_without_a_fill_never_waits_for_a_long_lived_writer(env):
+    """A writer without fill (a test session, a script) seals only at its exit: a workflow job that meets it
+    compiles in memory at once instead of waiting for that exit (CI hung 400 s on this)."""
+    holder = subprocess.Popen([sys.executable, "-c", "import time, numpy as np; from isaflow.core import jit; "
+                               "import tiny; jit.use('default'); tiny.outer(np.ones(2)); print('ready', flush=True); "
+                               "time.sleep(60)"], env=env, text=True, stdout=subprocess.PIPE)
+    try:
+        assert holder.stdout.readline().strip() == "ready"
+        other, err = result(start(env, generation="default", sleep=-1))
+        assert other["mode"] == "private" and other["value"] == 12.0 and "being written" in err
+    finally:
+        holder.kill()
+        holder.wait()

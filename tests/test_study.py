@@ -140,6 +140,15 @@ def test_every_planned_run_is_a_valid_scene_with_its_du(plan):
             assert s["dt_max"] == pytest.approx(m.get("dt_factor", STUDY["fire_dt_factor"]) / np.sqrt(k), rel=1e-7)
 
 
+def test_the_float_limit_case_is_refused_at_input_for_the_overdamped_update():
+    """Why isa_study.yaml runs float_limit without overdamped: its derived step is 0 s there."""
+    from isaflow.inputs import InputError
+    case = STUDY["cases"]["list"]["float_limit"]
+    assert "overdamped" not in case["variants"]
+    with pytest.raises(InputError, match="forces.wall.r_u"):
+        settings(scene.of_run("single", case["resolution"], "overdamped", case["set"], ISA_SETTINGS))
+
+
 def test_fire_dt_max_of_the_paper_stiffness():
     # 2 / sqrt(2 x 2000 + 12 x 500) = 2 / 100 s
     assert fire_dt_max(2000.0, 500.0, 2.0) == pytest.approx(0.02)

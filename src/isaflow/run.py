@@ -147,12 +147,13 @@ def _progress(run_id, log, beat=None):
     return progress
 
 
-def compile_method(method, threads=None):
+def compile_method(method, threads=None, entry=None):
     """Bind this process to method's kernel generation (core.jit.use), compiling and sealing it first if no
-    process has, then load (or compile) every kernel its runs time: the warm-up excluded from solver times."""
+    process has, then load (or compile) every kernel its runs time: the warm-up excluded from solver times.
+    entry: the method's entry module (default the registry's)."""
     from .core import jit
 
-    entry = methods.get(method).entry_module()
+    entry = entry or methods.get(method).entry_module()
     jit.use(method, fill=lambda: entry.warm_up(threads))
     entry.warm_up(threads)
 
@@ -163,7 +164,7 @@ def solve(p, log=None):
     log = log or (lambda msg: print(msg, file=sys.stderr, flush=True))
     with _Heartbeat(p.run_id, log) as beat:
         beat.phase = "warming up compiled code"
-        compile_method(p.method, p.threads)
+        compile_method(p.method, p.threads, p.entry)
         beat.phase = "solving"
         started = runfile.now()
         result = p.entry.solve(p.tank, p.settings, p.variant, p.resolution, p.start,

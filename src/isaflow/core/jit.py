@@ -18,9 +18,11 @@ only**, then sealed:
   the first process to get the folder's exclusive lock wipes it and fills it
   (``write``): :func:`use` with a ``fill`` function (a method's warm-up,
   compiling every kernel signature its runs use) fills and seals it at once;
-  a ``default`` writer seals at exit.  A process that can neither read a
-  sealed generation nor write it (another is writing, or the seal is damaged
-  while others read it) compiles in memory only (``private``).  Readers hold
+  a ``default`` writer seals at exit, so a process without ``fill`` never
+  waits for a writer (which may live as long as a test session).  A process
+  that can neither read a sealed generation nor write it (another is writing,
+  or the seal is damaged while others read it) compiles in memory only
+  (``private``).  Readers hold
   a shared lock, so a folder is never wiped under them.
 - A damaged, partial or foreign cache is therefore rebuilt or ignored, never
   loaded; in ``read`` mode a kernel missing from the cache is compiled in
@@ -141,7 +143,12 @@ def use(name, fill=None):
     folder.mkdir(parents=True, exist_ok=True)
     fd = os.open(folder / ".lock", os.O_RDWR | os.O_CREAT, 0o644)
     _STATE.update(name=name, folder=folder, fd=fd)  # the fd stays open: the lock lives with the process
-    fcntl.flock(fd, fcntl.LOCK_SH)  # blocks while a writer fills the folder
+    try:  # waits while a writer fills the folder; a writer without fill seals only at its exit: never wait for it
+        fcntl.flock(fd, fcntl.LOCK_SH if fill is not None else fcntl.LOCK_SH | fcntl.LOCK_NB)
+    except BlockingIOError:
+        _STATE["mode"] = "private"
+        _warn(f"{folder}: being written by another process; compiling in memory")
+        return "private"
     if _sealed(folder):
         _STATE["mode"] = "read"
         return "read"
