@@ -11,6 +11,8 @@ anywhere: NaN and infinite numbers, integers beyond 64 bits, strings with
 control characters or lone surrogates or longer than MAX_STRING.
 """
 
+import copy
+import functools
 import math
 import re
 from pathlib import Path
@@ -75,7 +77,13 @@ def _check_events(text):
 
 
 def parse_yaml(text):
-    """A YAML value from text under the rules above (InputError without the file name)."""
+    """A YAML value from text under the rules above (InputError without the file name); a text parsed before
+    (the settings files, read for every run a process plans) is parsed once and handed out as a fresh copy."""
+    return copy.deepcopy(_parse_yaml(text))
+
+
+@functools.lru_cache(maxsize=64)
+def _parse_yaml(text):
     try:
         _check_events(text)
         return yaml.load(text, Loader=_StrictLoader)
