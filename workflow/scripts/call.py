@@ -1,9 +1,11 @@
 """Snakemake script: call one isaflow function; the one calling convention of every script rule.
 
 params.func names 'module.function' under isaflow (e.g. 'methods.isa.tables.error_table',
-'figures.methods.tanks_figure').  It is called as func(**named inputs except 'code', outputs=[output
-files], **params.kw); single-file inputs are passed as a path, others as a list.  stderr goes to the
-rule's log.  BLAS and OpenMP run on the rule's threads.  An input error (isaflow.inputs.InputError, or a
+'figures.methods.tanks_figure').  It is called as func(**named inputs except 'code' and 'compiled',
+outputs=[output files], **params.kw); single-file inputs are passed as a path, others as a list.
+params.kernels, if given, names the kernel generation (isaflow.core.jit.use) of its kernels, whose
+compile stamp is the input 'compiled'.  stderr goes to the rule's log.  BLAS and OpenMP run on the
+rule's threads.  An input error (isaflow.inputs.InputError, or a
 file that is no run file) ends the job with one line in the log and exit status 2, no traceback.
 """
 import importlib
@@ -20,13 +22,17 @@ _script_start = timing.job_start(snakemake)  # noqa: F821
 # the command run files record: the rule and function, not Snakemake's temporary copy of this script
 sys.argv = ["snakemake", f"rule {snakemake.rule}:", f"isaflow.{snakemake.params.func}", "->", *snakemake.output]  # noqa: F821
 
+if snakemake.params.get("kernels"):  # noqa: F821  the kernel generation (isaflow.core.jit) its calls use
+    from isaflow.core import jit  # noqa: E402
+
+    jit.use(snakemake.params.kernels)  # noqa: F821
 from isaflow.inputs import InputError  # noqa: E402
 from isaflow.runfile import RunFileError  # noqa: E402
 
 mod, name = snakemake.params.func.rsplit(".", 1)  # noqa: F821
 func = getattr(importlib.import_module(f"isaflow.{mod}"), name)
 _imported = time.time()
-inputs = {k: (v if isinstance(v, str) else list(v)) for k, v in snakemake.input.items() if k != "code"}  # noqa: F821
+inputs = {k: (v if isinstance(v, str) else list(v)) for k, v in snakemake.input.items() if k not in ("code", "compiled")}  # noqa: F821
 try:
     func(**inputs, outputs=list(snakemake.output), **dict(snakemake.params.get("kw", {}) or {}))  # noqa: F821
 except (InputError, RunFileError) as err:
