@@ -86,7 +86,8 @@ def snapshots(path, out):
             continue
         ax.scatter(*ds["snap_pos"].values[k].T, s=max(0.5, 1000 / ds.sizes["particle"]), color="tab:blue")
         _walls(ax, ds)
-        ax.set(aspect="equal", xlabel="x (cm)", ylabel="y (cm)", title=f"{t[k]:.2f} s after the opening")
+        ax.set(aspect="equal", ylabel="y (cm)", title=f"{t[k]:.2f} s after the opening",
+               xlabel="x (cm)" if k >= n - 2 else "")  # the bottom panel of each column: no label under a title
         ax.title.set_fontsize(9)
     _method_title(fig, ds, f"flow snapshots, tank {ds.attrs['tank']}, {ds.sizes['particle']} particles")
     save(fig, out)
