@@ -1,9 +1,5 @@
 """Shared fixtures: repository paths and single-vessel runs solved once per session."""
 
-import os
-import signal
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -21,26 +17,6 @@ jit.use("tests")
 ROOT = Path(__file__).resolve().parents[1]
 TANKS = ROOT / "config" / "tanks"
 ISA_SETTINGS = ROOT / "config" / "methods" / "isa.yaml"
-
-# the kernel generations the tests' subprocess runs bind (isaflow.run.compile_method), filled one after the
-# other by one background process on the machine's second core while this one tests; a run started before
-# its generation is sealed waits for the fill (never compiles it twice)
-_FILL = []
-
-
-def pytest_sessionstart(session):
-    code = ("import subprocess, sys\nfor m in ('isa', 'mps', 'sph'):\n    subprocess.run([sys.executable, '-c', "
-            "f'from isaflow import run; run.compile_method({m!r})'], stdout=subprocess.DEVNULL, "
-            "stderr=subprocess.DEVNULL)")
-    _FILL.append(subprocess.Popen([sys.executable, "-c", code], start_new_session=True))
-
-
-def pytest_sessionfinish(session, exitstatus):
-    for p in _FILL:
-        if p.poll() is None:  # an unsealed generation is wiped by its next writer
-            os.killpg(p.pid, signal.SIGTERM)
-        p.wait()
-
 
 # the coarse lattice's force laws (config/methods/isa.yaml, resolution coarse): cm, N
 L_B, R_B = 5.0, 10000.0  # wall: l_bu, R_bu (k_b = 2000 N/cm)
