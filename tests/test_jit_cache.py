@@ -101,7 +101,12 @@ def test_a_process_without_a_fill_compiles_in_memory_while_another_writes(env):
     a, _ = result(writer)
     b, _ = result(other)
     assert {a["mode"], b["mode"]} <= {"write", "private", "read"} and a["value"] == b["value"] == 12.0
+    # the two may also both have met the other's lock and compiled in memory (they start at the same instant):
+    # then the next process writes and seals, and the one after it only reads
     third, _ = result(start(env, generation="default", sleep=-1))
+    if "write" not in (a["mode"], b["mode"]):
+        assert third["mode"] == "write"
+        third, _ = result(start(env, generation="default", sleep=-1))
     assert third["mode"] == "read" and third["compiled"] == 0
 
 

@@ -161,7 +161,8 @@ def use(name, fill=None):
         except BlockingIOError:
             pass
         _STATE["mode"] = "read" if _sealed(folder) else "private"
-        if _STATE["mode"] == "private":
+        if _STATE["mode"] == "private":  # reads nothing: holds no lock, so another process may fill the folder
+            fcntl.flock(fd, fcntl.LOCK_UN)
             _warn(f"{folder}: in use and not sealed (damaged, or being written); compiling in memory")
         return _STATE["mode"]
     if _sealed(folder):  # sealed by another process between the two locks
