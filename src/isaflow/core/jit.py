@@ -131,6 +131,23 @@ def _seal():
     _STATE["mode"] = "read"
 
 
+def _shared(fd, wait):
+    """Take the shared lock of a generation's folder: True once held; wait=False: False if a writer holds it."""
+    try:
+        fcntl.flock(fd, fcntl.LOCK_SH if wait else fcntl.LOCK_SH | fcntl.LOCK_NB)
+        return True
+    except BlockingIOError:
+        return False
+
+
+def _private(why):
+    """Compile in memory: this process reads nothing, so it holds no lock (another may fill the folder)."""
+    fcntl.flock(_STATE["fd"], fcntl.LOCK_UN)
+    _STATE["mode"] = "private"
+    _warn(f"{_STATE['folder']}: {why}; compiling in memory")
+    return "private"
+
+
 def use(name, fill=None):
     """Bind this process to generation ``name`` (before any kernel is loaded) and return its mode.
 
@@ -143,12 +160,9 @@ def use(name, fill=None):
     folder.mkdir(parents=True, exist_ok=True)
     fd = os.open(folder / ".lock", os.O_RDWR | os.O_CREAT, 0o644)
     _STATE.update(name=name, folder=folder, fd=fd)  # the fd stays open: the lock lives with the process
-    try:  # waits while a writer fills the folder; a writer without fill seals only at its exit: never wait for it
-        fcntl.flock(fd, fcntl.LOCK_SH if fill is not None else fcntl.LOCK_SH | fcntl.LOCK_NB)
-    except BlockingIOError:
-        _STATE["mode"] = "private"
-        _warn(f"{folder}: being written by another process; compiling in memory")
-        return "private"
+    # waits while a writer fills the folder; a writer without fill seals only at its exit: never wait for it
+    if not _shared(fd, wait=fill is not None):
+        return _private("being written by another process")
     if _sealed(folder):
         _STATE["mode"] = "read"
         return "read"
@@ -156,15 +170,10 @@ def use(name, fill=None):
     try:
         fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)  # only if no other process reads or writes it
     except BlockingIOError:  # another process reads a damaged seal, or writes: wait for a writer that fills
-        try:
-            fcntl.flock(fd, fcntl.LOCK_SH if fill is not None else fcntl.LOCK_SH | fcntl.LOCK_NB)
-        except BlockingIOError:
-            pass
-        _STATE["mode"] = "read" if _sealed(folder) else "private"
-        if _STATE["mode"] == "private":  # reads nothing: holds no lock, so another process may fill the folder
-            fcntl.flock(fd, fcntl.LOCK_UN)
-            _warn(f"{folder}: in use and not sealed (damaged, or being written); compiling in memory")
-        return _STATE["mode"]
+        if _shared(fd, wait=fill is not None) and _sealed(folder):
+            _STATE["mode"] = "read"
+            return "read"
+        return _private("in use and not sealed (damaged, or being written)")
     if _sealed(folder):  # sealed by another process between the two locks
         fcntl.flock(fd, fcntl.LOCK_SH)
         _STATE["mode"] = "read"
