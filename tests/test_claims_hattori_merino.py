@@ -21,6 +21,7 @@ from conftest import ROOT
 
 PAPERS = {"hattori": mps_claims, "merino_alonso2020": sph1d_claims}
 REGISTRY = {e["id"]: e for e in claims_registry.load(ROOT / "config" / "claims")}
+INPUTS = {i["id"]: i for lst in claims_registry.inputs(ROOT / "config" / "claims").values() for i in lst}
 OURS = {p: [e for e in REGISTRY.values() if e["paper"] == p] for p in PAPERS}
 
 
@@ -144,6 +145,7 @@ def synthetic_sweep(c2_divergent=True):
         cond[0, 1, 2] = [1e3, 1e4, 1e6, 1e8]
     return xr.Dataset(
         {"error": (("variant", "kernel", "ratio", "n"), err), "cond": (("variant", "kernel", "ratio", "n"), cond),
+         "error_max": (("variant", "kernel", "ratio", "n"), err.copy()),
          "neighbours": (("ratio",), np.array([1, 2, 2, 3])),
          "kappa": (("kernel", "ratio"), np.full((4, 4), 1.5)), "residue": (("kernel", "ratio"), np.full((4, 4), 0.5))},
         coords={"variant": VARIANTS, "kernel": KERNELS, "ratio": RATIOS, "n": NS},
@@ -188,6 +190,29 @@ def test_the_extended_sweep_is_the_sensitivity_to_the_window():
     assert m.passed and "n_window (sph1d:sweep_n8192, N = 256-2048): symmetric_hydrostatic: the test fails" in m.sensitivity
 
 
+def test_the_max_norm_and_the_top_particle_on_the_surface_are_swept():
+    """Inputs error_norm (the sweep's error_max) and surface_placement (SURFACE_TOP, when made) enter the row's
+    robustness sweep as their own values: a divergence the max norm or the other placement does not show flips."""
+    entry = REGISTRY["mer-abs-c2-divergent-two"]
+    m = sph1d_claims.measure_c2_divergent_two(FakeContext(synthetic_sweep(True)), entry)
+    assert ("error_norm", "relative max norm", True) in m.sweep and "sph1d:sweep_surface_top not made" in m.sensitivity
+    ds = synthetic_sweep(True)
+    ds["error_max"] = synthetic_sweep(False)["error"]  # the max norm settles where the L2 norm diverges
+    ctx = FakeContext(ds, **{sph1d_claims.SURFACE_TOP: synthetic_sweep(False)})
+    m = sph1d_claims.measure_c2_divergent_two(ctx, entry)
+    assert m.passed and ("error_norm", "relative max norm", False) in m.sweep
+    assert ("surface_placement", "dx / 2 (kept)", True) in m.sweep
+    assert ("surface_placement", "0 (top particle on the surface)", False) in m.sweep
+    cls, flips, _ = claims.robustness(dict(entry, testable=True), m, INPUTS)
+    assert cls == "fragile" and "surface_placement: 0" in flips
+    assert "error_norm" not in flips  # the row does not rest on the norm (its inferred_inputs)
+    small = REGISTRY["mer-abs-two-three-small"]
+    ds = synthetic_sweep(True)
+    ds["error_max"] = ds["error"] * 10  # every limit 0.2 in the max norm: no longer small
+    m = sph1d_claims.measure_two_three_small(FakeContext(ds), small)
+    assert m.passed and "error_norm: relative max norm" in claims.robustness(small, m, INPUTS)[1]
+
+
 def association_sweep(n=12, seed=1):
     """Two-neighbour ratios only (n of them in (1, 1.5]): random cond_1 / N per (variant, kernel, ratio) at the largest
     N; errors settled at 0.02 elsewhere."""
@@ -199,7 +224,7 @@ def association_sweep(n=12, seed=1):
     cond[..., -1] = c * NS[-1]
     return xr.Dataset(
         {"error": (("variant", "kernel", "ratio", "n"), err), "cond": (("variant", "kernel", "ratio", "n"), cond),
-         "neighbours": (("ratio",), np.full(n, 2))},
+         "error_max": (("variant", "kernel", "ratio", "n"), err.copy()), "neighbours": (("ratio",), np.full(n, 2))},
         coords={"variant": VARIANTS, "kernel": KERNELS, "ratio": ratios, "n": NS},
         attrs={"classify_window": 4, "variant_gradient": "symmetric plain",
                "variant_floor": "mirror_hydrostatic mirror_hydrostatic", "height_cm": 100.0, "rho_g_N_cm3": 9.81e-3}), c

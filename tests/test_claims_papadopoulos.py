@@ -135,6 +135,25 @@ def test_a_view_substitutes_runs_and_refuses_the_ones_a_value_changes():
     assert v.opt("isa:c") is None
 
 
+def test_a_longer_time_limit_keeps_a_run_that_ended_at_rest(tmp_path):
+    """sph_rest's 't_max x 3': a liquid that stopped at rest before its t_max runs step for step the same with a
+    longer one, so it stands for itself; one cut off at t_max (step_limit) has no stand-in."""
+    import xarray as xr
+
+    paths = {}
+    for key, status in (("sph:rested", "converged"), ("sph:cut", "step_limit")):
+        paths[key] = str(tmp_path / f"{status}.nc")
+        xr.Dataset({"x": ("n", np.zeros(1), {"units": "1"})}, attrs={"status": status}).to_netcdf(paths[key])
+    ctx = claims.Context(paths)
+    label, subs, affected, params = next(v for v in PC.SWEEPS["sph_rest"] if v[0] == "t_max x 3")
+    v = PC.View(ctx, subs, affected, params)
+    assert v.key("sph:rested") == "sph:rested"
+    with pytest.raises(PC.NoRun):
+        v.key("sph:cut")
+    with pytest.raises(PC.NoRun):  # without the longer time limit (any other value) the rule does not apply
+        PC.View(ctx, subs, affected, {}).key("sph:rested")
+
+
 def test_force_law_shapes():
     """R(l) = r_u (1 - l/l_u)^p: the option's laws by hand; linear is the same arithmetic with or without p."""
     for d in (0.5, 3.0, 7.0):

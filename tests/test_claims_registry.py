@@ -264,7 +264,9 @@ def existing_runs():
     runs |= {"solid:vessel_pressure_load", "solid:vessel_water_particles", "solid:floor_uniform_uniform_load"}
     runs |= {f"solid:floor_{m}_oneway" for m in methods.tank_methods()}
     runs |= {f"solid:{r}" for r in _smk_list("workflow/rules/methods/solid.smk", "SOLID_CLAIM_RUN_IDS")}
-    return runs | {"sph1d:sweep", "sph1d:sweep_n8192"}
+    sweeps = S.read(ROOT / methods.registry()["sph1d"].settings, methods.registry()["sph1d"].values_schema()).get(
+        "resolutions", {})  # sph1d.smk: one sweep per resolution
+    return runs | {"sph1d:sweep"} | {f"sph1d:sweep_{r}" for r in sweeps}
 
 
 def test_runs_exist_or_are_flagged_new():

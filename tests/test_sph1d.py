@@ -164,3 +164,21 @@ def test_condition_estimate_matches_lapack_dgbcon():
             # same operations up to summation order: normwise differences are round-off times cond (eps cond)
             tol = 10 * np.finfo(float).eps * ours * anorm
             assert np.abs(x - ref[:, 0]).max() <= tol * np.abs(ref).max()
+
+
+def test_top_particle_on_the_surface_keeps_half_a_spacing_at_the_floor_and_the_one_neighbour_limit():
+    """Input surface_placement's other value (config/methods/sph1d.yaml resolution surface_top): the top particle
+    at z = H, the bottom one dx/2 above the floor (the mirror ghosts continue the lattice).  With one neighbour the
+    error still tends to |kappa - 1| in the L2 and the max norm (the registry's argument): the placement only adds an
+    O(dx) term, about
+    0.016 x 64 / N of the limit at h/dx = 0.8 (measured from N = 64), so 1 % at N = 4096 cannot pass by chance."""
+    n, height = 8, 100.0
+    z = system.positions(n, height, top_gap=0.0)
+    dx = system.spacing(n, height, 0.0)
+    assert z[-1] == pytest.approx(height, rel=1e-15) and z[0] == pytest.approx(dx / 2, rel=1e-15)
+    assert np.allclose(np.diff(z), dx, rtol=1e-13)
+    assert system.spacing(n, height) == height / n  # the kept placement: dx = H / N exactly
+    residue = abs(float(closed_form.kappa("wendland_c2", 0.8)) - 1.0)
+    sol = column.solve_column(4096, 0.8, "wendland_c2", top_gap=0.0)
+    assert sol.error == pytest.approx(residue, rel=0.01)
+    assert sol.error_max == pytest.approx(residue, rel=0.01)  # input error_norm: |kappa - 1| + O(dx) in any norm

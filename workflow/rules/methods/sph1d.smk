@@ -32,26 +32,34 @@ rule sph1d_sweep:
         "../../scripts/call.py"
 
 
-rule sph1d_sweep_n8192:
-    input:
-        settings_path=SPH1D_SETTINGS,
-        code=SPH1D_CODE,
-    output:
-        "results/sph1d/sweep_n8192.nc",
-    params:
-        func="methods.sph1d.pipeline.run_sweep",
-        kw={"resolution": "n8192"},
-    conda:
-        "../../envs/isaflow.yaml"
-    message:
-        JOB
-    resources:
-        mem_mb=1000,
-        runtime=20,
-    log:
-        "logs/sph1d/sweep_n8192.log",
-    script:
-        "../../scripts/call.py"
+# the sweep at other values of two registry inputs (config/methods/sph1d.yaml resolutions; sensitivity only):
+# n_window (to N = 8192) and surface_placement (the top particle on the surface)
+for _res in ("n8192", "surface_top"):
+
+    rule:
+        name:
+            f"sph1d_sweep_{_res}"
+        input:
+            settings_path=SPH1D_SETTINGS,
+            code=SPH1D_CODE,
+        output:
+            f"results/sph1d/sweep_{_res}.nc",
+        params:
+            func="methods.sph1d.pipeline.run_sweep",
+            kw={"resolution": _res},
+        conda:
+            "../../envs/isaflow.yaml"
+        message:
+            JOB
+        resources:
+            mem_mb=1000,
+            runtime=20,
+        log:
+            f"logs/sph1d/sweep_{_res}.log",
+        script:
+            "../../scripts/call.py"
+
+    OTHER_RUN_FILES[f"sph1d:sweep_{_res}"] = f"results/sph1d/sweep_{_res}.nc"
 
 
 rule sph1d_cases:
@@ -126,4 +134,3 @@ rule sph1d_report:
 
 # the sweep the claims read (claims.smk)
 OTHER_RUN_FILES["sph1d:sweep"] = "results/sph1d/sweep.nc"
-OTHER_RUN_FILES["sph1d:sweep_n8192"] = "results/sph1d/sweep_n8192.nc"  # registry input n_window (sensitivity)

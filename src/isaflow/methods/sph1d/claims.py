@@ -24,6 +24,7 @@ from . import closed_form, column, sweep
 
 SWEEP = "sph1d:sweep"
 EXTENDED = "sph1d:sweep_n8192"  # the sweep to N = 8192 (registry input n_window): sensitivity only
+SURFACE_TOP = "sph1d:sweep_surface_top"  # the top particle on the surface (registry input surface_placement)
 EVIDENCE = "results/sph1d/sweep.nc"
 WENDLAND = ("wendland_c2", "wendland_c4", "wendland_c6")
 SHORT = {"cubic_spline": "cubic", "wendland_c2": "C2", "wendland_c4": "C4", "wendland_c6": "C6"}
@@ -72,8 +73,10 @@ def _variant_forms(ds):
 
 def _judged(ctx, judge, table, entry):
     """Measurement of judge(rows of one variant, entry) -> (passed, text, margin, why) on the sweep's first
-    variant; the sensitivity: the other variants, and the first variant of the sweep extended to N = 8192
-    (EXTENDED, input n_window) when the workflow made it.  table(ds, entry) -> the rows of every variant."""
+    variant; the sensitivity (``sweep``, one value of a registry input each): the other variants (gradient_form,
+    floor_treatment), the same sweep judged by the max norm (error_norm), and the first variant of the sweeps with
+    the top particle on the surface (SURFACE_TOP, surface_placement) and extended to N = 8192 (EXTENDED, n_window)
+    when the workflow made them.  table(ds, entry) -> the rows of every variant."""
     ds = ctx.run(SWEEP)
     rows = table(ds, entry)
     variants = [str(v) for v in ds.variant.values]
@@ -90,17 +93,27 @@ def _judged(ctx, judge, table, entry):
             g, f = forms[v]
             sweep += [("gradient_form", g, bool(per[v][0]))] if g != g0 else []
             sweep += [("floor_treatment", f, bool(per[v][0]))] if f != f0 else []
-    if ctx.has(EXTENDED):
-        ext = ctx.run(EXTENDED)
-        v0 = str(ext.variant.values[0])
-        er = table(ext, entry)
-        e_ok, e_text, _, _ = judge(er[er.variant == v0], entry)
-        notes.append(f"n_window ({EXTENDED}, {_window_text(ext)}): {v0}: the test {'passes' if e_ok else 'fails'} "
-                     f"({e_text})")
-        sweep += [("n_window", f"N up to {int(ds.n.values[-1])} (kept)", bool(ok)),
-                  ("n_window", f"N up to {int(ext.n.values[-1])}", bool(e_ok))]
-    else:
-        notes.append(f"n_window: {EXTENDED} not made")
+
+    def first(other):  # (passed, text) of the first variant of another sweep
+        r = table(other, entry)
+        res = judge(r[r.variant == str(other.variant.values[0])], entry)
+        return bool(res[0]), res[1]
+
+    m_ok, m_text = first(ds.assign(error=ds.error_max))
+    notes.append(f"error_norm (relative max norm): {variants[0]}: the test {'passes' if m_ok else 'fails'} ({m_text})")
+    sweep += [("error_norm", "relative L2 (kept)", bool(ok)), ("error_norm", "relative max norm", m_ok)]
+    for key, name, kept, label in (
+            (SURFACE_TOP, "surface_placement", "dx / 2 (kept)", "0 (top particle on the surface)"),
+            (EXTENDED, "n_window", f"N up to {int(ds.n.values[-1])} (kept)", None)):
+        if not ctx.has(key):
+            notes.append(f"{name}: {key} not made")
+            continue
+        other = ctx.run(key)
+        o_ok, o_text = first(other)
+        label = label or f"N up to {int(other.n.values[-1])}"
+        notes.append(f"{name} ({key}, {_window_text(other)}): {other.variant.values[0]}: the test "
+                     f"{'passes' if o_ok else 'fails'} ({o_text})")
+        sweep += [(name, kept, bool(ok)), (name, label, o_ok)]
     return Measurement(measured=f"{variants[0]}, {_window_text(ds)}: {text}", passed=bool(ok), evidence=EVIDENCE,
                        why="" if ok else why, margin=margin, sensitivity="; ".join(notes), sweep=tuple(sweep))
 

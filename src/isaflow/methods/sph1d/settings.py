@@ -22,6 +22,7 @@ VALUES = {
               "properties": {"start": {"type": "number", "exclusiveMinimum": 0.5}, "stop": _POS, "step": _POS}},
     "n": {"type": "array", "minItems": 2, "items": {"type": "integer", "minimum": 8}},
     "gradient": {"enum": list(GRADIENT_FORMS)}, "floor": {"enum": list(FLOORS)},
+    "surface": {"type": "number", "minimum": 0, "maximum": 0.5},  # the top particle's gap below the surface [dx]
     "classify.window": {"type": "integer", "minimum": 2},
 }
 

@@ -1,8 +1,10 @@
 """The truncated SPH hydrostatic column in 1D as a banded linear system A p = b.
 
 Discrete equations (docs/sph1d.md).  Liquid column 0 <= z <= H (cm), floor at
-z = 0, free surface at z = H, N particles at z_i = (i + 1/2) dx, dx = H / N,
-volume V = dx (per unit cross-section).  Kernel W(r, h) of core.smoothing
+z = 0, free surface at z = H, N particles at z_i = (i + 1/2) dx, volume V = dx (per unit
+cross-section), dx = H / (N - 1/2 + g): g [dx] is the top particle's distance below the surface
+(1/2 kept: dx = H / N; 0: the top particle on the surface).  The bottom particle stays dx/2
+above the floor, so the mirror ghosts continue the lattice below it.  Kernel W(r, h) of core.smoothing
 (support 2 h, 1D normalisation), phi(s) = dW/dz at z_i - z_j = s:
 phi(s) = NORM[kind, 1] / h^2 * f'(|s| / h) * sign(s).
 
@@ -39,10 +41,15 @@ def neighbours_per_side(ratio):
     return (np.ceil(np.round(SUPPORT * r, 9)) - 1).astype(int)
 
 
-def positions(n, height):
-    """(N,) particle heights z_i = (i + 1/2) dx [cm] of a column of height H [cm]."""
-    dx = height / n
-    return (np.arange(n) + 0.5) * dx
+def spacing(n, height, top_gap=0.5):
+    """dx [cm] of N particles in a column of height H [cm], the top one top_gap [dx] below the surface and the
+    bottom one dx/2 above the floor: H / (N - 1/2 + top_gap)."""
+    return height / (n - 0.5 + top_gap)
+
+
+def positions(n, height, top_gap=0.5):
+    """(N,) particle heights z_i = (i + 1/2) dx [cm] of a column of height H [cm] (dx: spacing)."""
+    return (np.arange(n) + 0.5) * spacing(n, height, top_gap)
 
 
 def exact_pressure(z, height, rho_g):
@@ -59,14 +66,14 @@ def _phi(kind, norm, h, s):
 
 
 @njit(**JIT)
-def assemble_banded(n, height, ratio, kind, norm, c_self, beta, rho_g, kl):
+def assemble_banded(n, height, ratio, kind, norm, c_self, beta, rho_g, kl, top_gap):
     """LAPACK band storage of A and the right-hand side b.
 
     Returns ab (2 kl + kl + 1, N) with A[i, j] = ab[2 kl + i - j, j] (the
     layout dgbtrf expects, kl = ku rows of fill-in space on top) and b (N,).
-    A is in 1/cm, b in N/cm^3.
+    A is in 1/cm, b in N/cm^3; top_gap [dx] as in spacing.
     """
-    dx = height / n
+    dx = height / (n - 0.5 + top_gap)  # spacing()
     h = ratio * dx
     vol = dx
     reach = SUPPORT * h
@@ -97,11 +104,11 @@ def assemble_banded(n, height, ratio, kind, norm, c_self, beta, rho_g, kl):
     return ab, b
 
 
-def assemble(n, height, ratio, kernel, gradient="symmetric", floor="mirror_hydrostatic", rho_g=1.0):
+def assemble(n, height, ratio, kernel, gradient="symmetric", floor="mirror_hydrostatic", rho_g=1.0, top_gap=0.5):
     """(ab, b, kl) of the column; kernel an id of core.smoothing; see module docstring."""
     kl = max(1, int(neighbours_per_side(ratio)))
     ab, b = assemble_banded(int(n), float(height), float(ratio), int(kernel), float(NORM[kernel, 1]),
-                            GRADIENT_FORMS[gradient], FLOORS[floor], float(rho_g), kl)
+                            GRADIENT_FORMS[gradient], FLOORS[floor], float(rho_g), kl, float(top_gap))
     return ab, b, kl
 
 
