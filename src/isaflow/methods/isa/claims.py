@@ -1266,6 +1266,10 @@ def first_approx(view, e):
     in the first vessel within one floor row, the second-vessel surface within a/2); the course on the normalised
     axis is reported, not judged."""
     t_left, t_level = tol(e)
+    status = view.run("sph:flow_wcsph_dx2.5").attrs["status"]
+    if status not in ("converged", "step_limit"):  # e.g. no viscosity: a particle left the tank
+        return Out(None, f"the liquid ({view.key('sph:flow_wcsph_dx2.5')}) ends '{status}': no end state to compare "
+                         "with", short=f"liquid {status}")
     ti, fi = transfer(view, ["flow_incomplete", "flow_complete"])
     ts, fs = transfer(view, ["sph:flow_wcsph_dx2.5"])
     gi, s50 = normalised(ti, fi, TAU)
