@@ -154,7 +154,8 @@ def _drop(h, liquid=False):
 def _kp(k, label):
     runs = {"single_coarse": f"single_coarse_kp{k}", "single_refined": f"single_refined_kp{k}",
             "flow_incomplete": f"flow_kp{k}_incomplete", "flow_complete": f"flow_kp{k}",
-            "flow_complete_capped": f"flow_kp{k}_capped"}
+            "flow_complete_capped": f"flow_kp{k}_capped", "flow_refined_incomplete": f"flow_refined_kp{k}_incomplete",
+            "flow_refined_complete": f"flow_refined_kp{k}"}
     return (label, _subs(runs), lambda key: _isa(key) and "calibration" not in key, {})
 
 
