@@ -65,7 +65,8 @@ def flow(paths, out):
                                 "the tank's liquid at rest")):
             ax.plot([x0, x1], [y, y], label=f"{what} {y:.1f} cm (slope {r['second_slope_deg']:+.1f} deg)"
                     if what == "measured surface" else f"{what} {y:.1f} cm", **style)
-XX
+        label = ds.attrs.get("run_label", "none")  # a sweep's run says which value of which input it is
+        label = "" if label == "none" else label  # isaflow.run writes 'none' for a run without a label
         ax.set(aspect="equal", xlabel="x (cm)", ylabel="y (cm)",
                title=f"{ds.attrs['run_id']}" + (f" ({label})" if label else "") + f"\ntank {ds.attrs['tank']}, "
                      f"{ds.sizes['particle']} particles: t = {float(ds['sim_time']):.1f} s, {ds.attrs['status']}, "
