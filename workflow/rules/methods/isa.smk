@@ -202,30 +202,33 @@ rule isa_fig_flow:
         "../../scripts/call.py"
 
 
-_DROPS = ISA.get("floor_drops", {})
+_FIG10_SWEEPS = ISA.get("fig10_sweeps", {})  # Figure 10 across an inferred input: fig10_<name>
 
 
-rule isa_fig_floor_drops:
-    input:
-        inputs=[isa_file(r[k]) for r in _DROPS.get("runs", []) for k in ("complete", "incomplete")],
-        registry=sorted(glob.glob("config/claims/*.yaml")),
-        code=code("methods.isa.figures.flow"),
-    output:
-        figure("fig10_floor_drops"),
-    params:
-        func="methods.isa.figures.flow.floor_drops_figure",
-        kw={"drops": _DROPS.get("runs", []), "kept": _DROPS.get("kept"),
-            "inferred": ISA.get("inferred", {}).get("fig10_floor_drops")},
-    message:
-        JOB
-    resources:
-        **SMALL,
-    log:
-        "logs/isa/figures/fig10_floor_drops.log",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
+for _name, _sweep in _FIG10_SWEEPS.items():
+
+    rule:
+        name:
+            f"isa_fig10_{_name}"
+        input:
+            inputs=[isa_file(r[k]) for r in _sweep["runs"] for k in ("complete", "incomplete")],
+            registry=sorted(glob.glob("config/claims/*.yaml")),
+            code=code("methods.isa.figures.flow"),
+        output:
+            figure(f"fig10_{_name}"),
+        params:
+            func="methods.isa.figures.flow.fig10_sweep_figure",
+            kw={"sweep": _sweep, "inferred": ISA.get("inferred", {}).get(f"fig10_{_name}")},
+        message:
+            JOB
+        resources:
+            **SMALL,
+        log:
+            f"logs/isa/figures/fig10_{_name}.log",
+        conda:
+            "../../envs/isaflow.yaml"
+        script:
+            "../../scripts/call.py"
 
 
 _OD = ISA.get("overdamped", {})
@@ -623,7 +626,7 @@ rule integration:
 
 register(targets=PAPER_TARGETS + figure("calibration_free_surface") + figure("convergence_single")
          + figure("flow_history") + figure("error_vs_runtime") + figure("error_vs_work") + figure("stability_map")
-         + figure("isa_overdamped") + figure("fig10_floor_drops")
+         + figure("isa_overdamped") + [f for n in _FIG10_SWEEPS for f in figure(f"fig10_{n}")]
          + ["results/isa/study/fire_ratio.csv", "results/isa/metrics.csv"])
 register(report=["results/report/10_single.md", "results/report/20_flow.md", "results/report/30_study.md"])
 # the paper's claims are judged by the shared claims rule (claims.smk) from config/claims/papadopoulos2016.yaml

@@ -223,14 +223,15 @@ def flow_history_figure(inputs, outputs, chains=None):
     save(fig, outputs)
 
 
-def floor_drops_figure(inputs, outputs, drops=None, kept=None, registry=None, inferred=None):
-    """Figure 10 at every floor drop of the second vessel the claims sweep (input second_floor_drop): top row, the
-    end of the complete flow at each drop (particles by vessel, the one surface); bottom row, what the fragile rows
-    read at each drop against their tolerances: particles left (pap-6.4-fourteen: the paper's 14, +- half a floor
+def fig10_sweep_figure(inputs, outputs, sweep=None, registry=None, inferred=None):
+    """Figure 10 at every value of one inferred input the claims sweep (e.g. second_floor_drop, k_pair): top row,
+    the end of the complete flow at each value (particles by vessel, the one surface); bottom row, what the rows
+    read at each value against their tolerances: particles left (pap-6.4-fourteen: the paper's 14, +- half a floor
     row) and the horizontal resultant at 100,000 steps (pap-6.3-sum-fx: >= 10 N f_tol).
 
-    drops: [{drop, complete, incomplete}] (run ids; inputs: their run files); kept: the kept drop (cm); registry:
-    the claims registry's files (the paper's 14, the tolerances of both rows are read from it)."""
+    sweep: config/methods/isa_workflow.yaml fig10_sweeps entry {input, what, axis, units, kept, runs: [{value,
+    complete, incomplete}]} (run ids; inputs: their run files); registry: the claims registry's files (the paper's
+    14, the tolerances of both rows are read from it)."""
     from ....claims_registry import load
 
     by = {p.rsplit("/", 1)[-1].removesuffix(".nc"): p for p in inputs}
@@ -239,10 +240,11 @@ def floor_drops_figure(inputs, outputs, drops=None, kept=None, registry=None, in
     four, sfx = reg["pap-6.4-fourteen"], reg["pap-6.3-sum-fx"]
     claims = {"fourteen": (four["numbers"]["particles_left"]["value"], four["tolerance"]["value"]),
               "sum_fx": sfx["tolerance"]["value"]}
+    kept, units, what = sweep["kept"], sweep["units"], sweep["what"]
     rows = []
-    for d in drops:
+    for d in sweep["runs"]:
         ds, di = read(by[d["complete"]]), read(by[d["incomplete"]])
-        rows.append(dict(drop=float(d["drop"]), ds=ds, left=metrics.flow_measures(ds)["particles_left"],
+        rows.append(dict(value=float(d["value"]), ds=ds, left=metrics.flow_measures(ds)["particles_left"],
                          sum_fx=metrics.flow_measures(di)["sum_fx_N"], steps_i=int(di["steps"])))
     n = len(rows)
     fig = plt.figure(figsize=(3.3 * n, 7.4))
@@ -269,11 +271,11 @@ def floor_drops_figure(inputs, outputs, drops=None, kept=None, registry=None, in
         if k:
             ax.set_yticklabels([])
         ok = abs(r["left"] - p14) <= t14
-        tag = " (kept)" if r["drop"] == kept else ""
-        ax.set_title(f"floor drop {r['drop']:g} cm{tag}\n{r['left']} left ({'within' if ok else 'outside'} "
+        tag = " (kept)" if r["value"] == kept else ""
+        ax.set_title(f"{what} {r['value']:g} {units}{tag}\n{r['left']} left ({'within' if ok else 'outside'} "
                      f"{p14:g} ± {t14:g}); {ds.attrs['status']}", fontsize=8.5,
-                     fontweight="bold" if r["drop"] == kept else "normal")
-    d = np.array([r["drop"] for r in rows])
+                     fontweight="bold" if r["value"] == kept else "normal")
+    d = np.array([r["value"] for r in rows])
     ax_l = fig.add_subplot(gs[1, : n // 2 + n % 2])
     ax_f = fig.add_subplot(gs[1, n // 2 + n % 2:])
     left = np.array([r["left"] for r in rows])
@@ -287,21 +289,24 @@ def floor_drops_figure(inputs, outputs, drops=None, kept=None, registry=None, in
     ax_f.axhline(thr / 10, color="0.4", lw=1, ls=":", label=f"equilibrium bound N f_tol = {thr / 10:g} N")
     ax_f.plot(d, fx, "o-", color=RESULTANT, label="ΣF_x at the end of application 3 (step 100,000 or an earlier cycle)")
     for r, y in zip(rows, fx):
-        ax_f.annotate(f"{y:+.0f} N\n(step {r['steps_i']:,})", (r["drop"], y), xytext=(0, 8), textcoords="offset points",
+        ax_f.annotate(f"{y:+.0f} N\n(step {r['steps_i']:,})", (r["value"], y), xytext=(0, 8), textcoords="offset points",
                       ha="center", fontsize=7)
-    for ax, what in ((ax_l, "particles"), (ax_f, "ΣF_x (N)")):
+    for ax, quantity in ((ax_l, "particles"), (ax_f, "ΣF_x (N)")):
         ax.axvline(kept, color="0.5", lw=1, ls="--")
-        ax.text(kept, 1.01, f"kept {kept:g} cm", transform=ax.get_xaxis_transform(), ha="center", va="bottom",
+        ax.text(kept, 1.01, f"kept {kept:g} {units}", transform=ax.get_xaxis_transform(), ha="center", va="bottom",
                 fontsize=8, color="0.3")
-        ax.set_xlabel("second vessel's floor below the first (cm), inferred: second_floor_drop")
-        ax.set_ylabel(what)
-        ax.set_xticks(d)
+        ax.set_xlabel(f"{sweep['axis']} ({units}), inferred: {sweep['input']}")
+        ax.set_ylabel(quantity)
+        if d.max() / d.min() > 4:  # a range of factors (k_p): log axis
+            ax.set_xscale("log")
+            ax.minorticks_off()
+        ax.set_xticks(d, [f"{v:g}" for v in d])
         ax.legend(loc="upper right" if ax is ax_l else "upper left", fontsize=7.5, frameon=True, framealpha=0.9)
     for r, y in zip(rows, left):
-        ax_l.annotate(f"{y}", (r["drop"], y), xytext=(6, 4), textcoords="offset points", fontsize=8)
+        ax_l.annotate(f"{y}", (r["value"], y), xytext=(6, 4), textcoords="offset points", fontsize=8)
     ax_l.set_ylim(0, max(left.max(), p14 + t14) * 1.35)
     ax_f.set_ylim(min(0.0, fx.min() * 1.3), max(fx.max(), thr) * 1.35)
-    fig.suptitle("Figure 10 at every floor drop the claims sweep: the end of the complete flow (paper's update) and "
-                 "the two rows whose verdict flips with the drop", fontsize=10)
+    fig.suptitle(f"Figure 10 at every {what} the claims sweep ({sweep['input']}): the end of the complete flow (paper's "
+                 "update) and two rows that read it: particles left and the horizontal resultant", fontsize=10)
     inferred_note(fig, inferred)
     save(fig, outputs)
