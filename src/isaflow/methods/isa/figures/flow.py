@@ -247,8 +247,10 @@ def fig10_sweep_figure(inputs, outputs, sweep=None, registry=None, inferred=None
         rows.append(dict(value=float(d["value"]), ds=ds, left=metrics.flow_measures(ds)["particles_left"],
                          sum_fx=metrics.flow_measures(di)["sum_fx_N"], steps_i=int(di["steps"])))
     n = len(rows)
-    fig = plt.figure(figsize=(3.3 * n, 7.4))
-    gs = fig.add_gridspec(2, n, height_ratios=[0.8, 1.0], hspace=0.32, wspace=0.08, top=0.86, bottom=0.08)
+    fig = plt.figure(figsize=(max(3.3 * n, 14.0), 7.4))
+    grid = dict(height_ratios=[0.8, 1.0], hspace=0.32, top=0.86, bottom=0.08)
+    gs = fig.add_gridspec(2, n, wspace=0.08, **grid)  # top row: one panel per value
+    gb = fig.add_gridspec(2, 2, wspace=0.16, **grid)  # bottom row: the two rows' readings, half each
     p14, t14 = claims["fourteen"]
     thr = claims["sum_fx"]
     for k, r in enumerate(rows):
@@ -276,8 +278,8 @@ def fig10_sweep_figure(inputs, outputs, sweep=None, registry=None, inferred=None
                      f"{p14:g} ± {t14:g}); {ds.attrs['status']}", fontsize=8.5,
                      fontweight="bold" if r["value"] == kept else "normal")
     d = np.array([r["value"] for r in rows])
-    ax_l = fig.add_subplot(gs[1, : n // 2 + n % 2])
-    ax_f = fig.add_subplot(gs[1, n // 2 + n % 2:])
+    ax_l = fig.add_subplot(gb[1, 0])
+    ax_f = fig.add_subplot(gb[1, 1])
     left = np.array([r["left"] for r in rows])
     ax_l.axhspan(p14 - t14, p14 + t14, color="tab:red", alpha=0.12, lw=0,
                  label=f"the paper's {p14:g} ± {t14:g} (half a floor row): pap-6.4-fourteen passes")
