@@ -89,6 +89,8 @@ rule sph1d_figures:
         settings_path=SPH1D_SETTINGS,
         sweep_nc="results/sph1d/sweep.nc",
         cases_csv="results/sph1d/cases.csv",
+        surface_nc="results/sph1d/sweep_surface_top.nc",  # input surface_placement's other value (variants figure)
+        registry=SPH1D_REGISTRY,
         code=SPH1D_CODE + code("figures/style"),
     output:
         SPH1D_FIGURES,

@@ -89,8 +89,10 @@ def maps(sweep_nc, cases_csv, variant, outputs):
     save(fig, outputs)
 
 
-def variants(cases_csv, labels, outputs):
-    """Error at the largest N against h/dx for every variant (does a claim depend on the reading?)."""
+def variants(cases_csv, labels, outputs, surface=None):
+    """Error at the largest N against h/dx for every variant (does a claim depend on the reading?), and (surface:
+    sweep.classify rows of the first variant with the top particle on the surface, input surface_placement) the
+    same reading with the other particle placement, dashed."""
     cases = pd.read_csv(cases_csv)
     kernels = list(dict.fromkeys(cases.kernel))
     fig, axes = plt.subplots(2, 2, figsize=(8, 6.2), sharex=True, sharey=True)
@@ -100,6 +102,12 @@ def variants(cases_csv, labels, outputs):
             ax.semilogy(k.ratio, np.clip(k.error_limit, 1e-17, None), color=colour, lw=1, label=var)
             d = k[k.behaviour == "divergent"]
             ax.plot(d.ratio, d.error_limit, "x", color=colour, ms=4)
+        if surface is not None:
+            k = surface[surface.kernel == kern].sort_values("ratio")
+            ax.semilogy(k.ratio, np.clip(k.error_limit, 1e-17, None), color="k", lw=0.8, ls="--",
+                        label=f"{k.variant.iloc[0]}, top particle on the surface")
+            d = k[k.behaviour == "divergent"]
+            ax.plot(d.ratio, d.error_limit, "x", color="k", ms=4)
         ax.set_title(KERNEL_LABELS[kern])
         ax.set_ylim(1e-5, 1e4)
         ax.grid(True, lw=0.3)
@@ -108,6 +116,7 @@ def variants(cases_csv, labels, outputs):
         ax.set_xlabel("h / dx [1]")
     for ax in axes[:, 0]:
         ax.set_ylabel("error at the largest N [1]")
-    fig.suptitle("Gradient form and floor closure (x: divergent)", fontsize=9)
+    fig.suptitle("Gradient form, floor closure and the top particle's placement (inputs gradient_form, "
+                 "floor_treatment, surface_placement; x: divergent)", fontsize=9)
     fig.tight_layout()
     save(fig, outputs)

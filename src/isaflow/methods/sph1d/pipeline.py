@@ -62,8 +62,10 @@ def _labels():
 FIGURES = ("error_vs_n", "maps", "variants")
 
 
-def make_figures(settings_path, sweep_nc, cases_csv, outputs):
-    """outputs: [png, pdf] of each of FIGURES, in that order."""
+def make_figures(settings_path, sweep_nc, cases_csv, outputs, surface_nc=None, registry=None):
+    """outputs: [png, pdf] of each of FIGURES, in that order; surface_nc: the sweep with the top particle on the
+    surface (registry input surface_placement), classified by the rule of the claims registry file ``registry``
+    and drawn beside the variants."""
     out = {name: outputs[2 * k:2 * k + 2] for k, name in enumerate(FIGURES)}
     handler = _logging()
     try:
@@ -72,7 +74,13 @@ def make_figures(settings_path, sweep_nc, cases_csv, outputs):
         figures.error_vs_n(sweep_nc, cases_csv, default, out["error_vs_n"])
         figures.maps(sweep_nc, cases_csv, default, out["maps"])
         labels = {v: lc for v, lc in _labels().items() if v in s["variants"]}
-        figures.variants(cases_csv, labels, out["variants"])
+        surface = None
+        if surface_nc:
+            band, round_off = claims.rule_of_file(registry)
+            with xr.open_dataset(surface_nc) as ds:
+                surface = sweep.classify(ds.load(), int(ds.attrs["classify_window"]), band, round_off)
+            surface = surface[surface.variant == default]
+        figures.variants(cases_csv, labels, out["variants"], surface)
         log.info("sph1d figures written")
     finally:
         log.removeHandler(handler)
