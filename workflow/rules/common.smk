@@ -276,7 +276,9 @@ def report_captions():
             lines += [f"Verdicts ({paper}, {path}):", ""]
             for cid in ids:
                 r = rows.get(cid)
-                what = f"{_rst(r['verdict'])}: {_rst(r['claim'], 160) or 'project check'}" if r else "not in the registry"
+                rob = f", {r['robustness']}" + (f" (flips at {r['flips']})" if r.get("flips") else "") if r else ""
+                what = (f"{_rst(r['verdict'] + rob)}: {_rst(r['claim'], 160) or 'project check'}" if r
+                        else "not in the registry")
                 lines.append(f"- ``{cid}``: {what}")
             lines.append("")
         out[name] = "\n".join(lines)
