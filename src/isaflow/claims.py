@@ -30,6 +30,7 @@ Units: cm, N, s.
 """
 
 import importlib
+import json
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -41,7 +42,7 @@ from .html import page
 VERDICTS = ("reproduced", "reproduced only after calibrating", "not reproduced", "not testable here")
 ROBUSTNESS = ("robust", "fragile", "unswept")
 COLUMNS = ["id", "paper", "section", "kind", "half", "claim", "measured", "tolerance", "verdict", "robustness",
-           "flips", "robustness_evidence", "evidence", "why", "margin", "sensitivity", "depends_on", "post_hoc"]
+           "flips", "robustness_evidence", "evidence", "why", "margin", "sensitivity", "depends_on", "post_hoc", "sweep"]
 
 
 @dataclass
@@ -219,8 +220,15 @@ def judge(ctx, claims=None, inputs=None, found=None):
                          verdict=verdict(e, m, inputs), robustness=rob, flips=flips, robustness_evidence=rob_ev,
                          evidence=m.evidence, why=m.why, margin=m.margin, sensitivity=m.sensitivity,
                          depends_on=" ".join(e.get("depends_on", [])),
-                         post_hoc=f"{post['commit']}: {post['seen']}" if post else ""))
+                         post_hoc=f"{post['commit']}: {post['seen']}" if post else "", sweep=sweep_json(m)))
     return pd.DataFrame(rows, columns=COLUMNS)
+
+
+def sweep_json(m):
+    """The measurement's sweep as JSON: [[input id, value label, passed (true / false / null)], ...] in range order
+    (figures.robustness draws it)."""
+    rows = [] if m is None else [[str(i), str(v), None if p is None else bool(p)] for i, v, p in m.sweep]
+    return json.dumps(rows)
 
 
 def verdict_class(v):

@@ -30,3 +30,27 @@ rule claims:
         "../envs/isaflow.yaml"
     script:
         "../scripts/call.py"
+
+
+# where each fragile method result flips (isaflow.figures.robustness): from the claims tables alone
+rule claims_robustness_figure:
+    input:
+        tables=[f"results/claims/registry/{p}.csv" for p in CLAIM_PAPERS],
+        code=code("figures.robustness", "figures.style"),
+    output:
+        figure("claims_robustness"),
+    params:
+        func="figures.robustness.robustness_figure",
+    message:
+        JOB
+    resources:
+        **SMALL,
+    log:
+        "logs/claims/robustness_figure.log",
+    conda:
+        "../envs/isaflow.yaml"
+    script:
+        "../scripts/call.py"
+
+
+register(targets=figure("claims_robustness"))
