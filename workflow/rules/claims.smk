@@ -36,6 +36,7 @@ rule claims:
 rule claims_robustness_figure:
     input:
         tables=[f"results/claims/registry/{p}.csv" for p in CLAIM_PAPERS],
+        registry=sorted(glob.glob("config/claims/*.yaml")),
         code=code("figures.robustness", "figures.style"),
     output:
         figure("claims_robustness"),

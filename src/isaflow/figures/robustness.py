@@ -7,6 +7,8 @@ judged at is outlined.  The verdict and the row's id label each line.
 """
 
 import json
+import textwrap
+from pathlib import Path
 
 import pandas as pd
 
@@ -31,17 +33,32 @@ def _lines(tables):
     return out
 
 
-def robustness_figure(tables, outputs):
-    """tables: the claims rule's per-paper CSVs; outputs: [png, pdf]."""
+def judged_at(vals, kept_text=""):
+    """Index of the value a row is judged at among [(label, passed)]: the one labelled 'judged' (an input whose
+    paper's version is run), else the one labelled 'kept', else the one the registry's kept text starts with."""
+    for word in ("judged", "kept"):
+        hit = [k for k, (label, _) in enumerate(vals) if word in label.lower()]
+        if hit:
+            return hit[0]
+    return next((k for k, (label, _) in enumerate(vals) if kept_text.startswith(label.split(" (")[0])), None)
+
+
+def robustness_figure(tables, outputs, registry=()):
+    """tables: the claims rule's per-paper CSVs; registry: the claims registry's files (each input's kept value);
+    outputs: [png, pdf]."""
+    from ..claims_registry import inputs
+
+    kept = {i["id"]: str(i.get("kept", "")) for lst in (inputs(Path(registry[0]).parent) if registry else {}).values()
+            for i in lst}
     lines = _lines(tables)
     width = max((len(v) for *_, v in lines), default=1)
     fig, ax = plt.subplots(figsize=(4.5 + 2.3 * width, 0.42 * len(lines) + 1.4))
     for y, (paper, cid, verdict, name, vals) in enumerate(lines):
+        at = judged_at(vals, kept.get(name, ""))
         for x, (label, passed) in enumerate(vals):
-            kept = "(kept)" in label or "judged" in label
-            ax.add_patch(plt.Rectangle((x + 0.03, -y - 0.42), 0.94, 0.84, color=COLOURS[passed],
-                                       ec="k" if kept else "none", lw=1.6 if kept else 0))
-            ax.text(x + 0.5, -y, label.replace(" (kept)", "\n(kept)") if len(label) < 40 else label[:38] + "...",
+            ax.add_patch(plt.Rectangle((x + 0.03, -y - 0.42), 0.94, 0.84, fc=COLOURS[passed],
+                                       ec="k" if x == at else "none", lw=1.6 if x == at else 0))
+            ax.text(x + 0.5, -y, "\n".join(textwrap.wrap(label, 34, max_lines=2, placeholder="...")),
                     ha="center", va="center", fontsize=6.2)
         ax.text(-0.1, -y, f"{cid}: {verdict}\n{name}", ha="right", va="center", fontsize=7)
     ax.set_xlim(-0.05, width)
