@@ -184,3 +184,29 @@ def test_committed_first_screen_counts_equal_a_count_of_the_registry_by_kind():
         for k, short in RC.SHORT.items():
             n = cls[k]
             assert (f" {n} {short}" in line) == bool(n), (paper, short, n, line)
+
+
+def test_the_robustness_figure_draws_every_input_a_fragile_method_result_flips_in(tmp_path):
+    """figures.robustness: one line per (fragile method result, input in its flips), from the claims table's sweep
+    column; robust rows and other kinds are left out; the judged value is the one labelled judged, else kept."""
+    import json
+
+    import pandas as pd
+
+    from isaflow.figures import robustness
+
+    sweep = [["a", "1 (kept)", False], ["a", "2", True], ["b", "x", False], ["b", "y (kept)", False]]
+    rows = [dict(id="r1", paper="p", kind="method result", robustness="fragile", verdict="not reproduced",
+                 flips="a: 2", sweep=json.dumps(sweep)),
+            dict(id="r2", paper="p", kind="method result", robustness="robust", verdict="reproduced", flips="",
+                 sweep="[]"),
+            dict(id="r3", paper="p", kind="paper arithmetic", robustness="fragile", verdict="reproduced",
+                 flips="a: 1", sweep=json.dumps(sweep))]
+    table = tmp_path / "p.csv"
+    pd.DataFrame(rows).to_csv(table, index=False)
+    lines = robustness._lines([table])
+    assert lines == [("p", "r1", "not reproduced", "a", [("1 (kept)", False), ("2", True)])]
+    assert robustness.judged_at([("g 0.2 (kept)", True), ("g 1 (judged)", False)]) == 1
+    assert robustness.judged_at([("10 dx (held)", True), ("11 dx", False)], "10 dx = 23.4 cm") == 0
+    robustness.robustness_figure([table], [tmp_path / "f.png"])
+    assert (tmp_path / "f.png").stat().st_size > 0

@@ -239,9 +239,10 @@ def opening(df, registry):
         "calibrating <input>` (an input was chosen to match that very number), `not reproduced`, `not testable here`. "
         "A verdict is **robust** when it holds at both ends of every inferred input it rests on, **fragile** when a "
         "value of an input's range flips it (the input and the values are named); the evidence is in the full rows "
-        "(`results/claims/registry/<paper>.csv`, column `robustness_evidence`). Rows decided by this project's own "
-        "choices are deviations of this project, listed apart and never scored against a paper; where the paper's "
-        "version could be run the claim is judged on it.",
+        "(`results/claims/registry/<paper>.csv`, column `robustness_evidence`), and "
+        "[`figures/claims_robustness.png`](../figures/claims_robustness.png) draws where each fragile method result "
+        "flips. Rows decided by this project's own choices are deviations of this project, listed apart and never "
+        "scored against a paper; where the paper's version could be run the claim is judged on it.",
         "",
         f"**Tolerances.** Of the {testable} testable rows' tolerances, {len(marked)} were chosen after the measured "
         "value had been printed and are marked post hoc in their rows (with the commit that set them): "
