@@ -178,7 +178,10 @@ def test_report_holds_each_figure_the_run_made_with_its_own_caption(tmp_path):
         (shutil.copytree if src.is_dir() else shutil.copy)(src, tmp_path / item)
     (tmp_path / "src").symlink_to(ROOT / "src")
     spec = yaml.safe_load((ROOT / "workflow" / "report" / "figures.yaml").read_text())
-    names = sorted(p.stem for p in (tmp_path / "figures").glob("*.png") if p.stem in spec)
+    # claims_robustness is drawn from the claims rule's tables, whose job also makes report pages this stand-in
+    # run has not made: a report holding it needs the claims rule's outputs too (the full run makes both)
+    names = sorted(p.stem for p in (tmp_path / "figures").glob("*.png")
+                   if p.stem in spec and p.stem != "claims_robustness")
     assert len(names) >= 25
     made, left = names[:-1], names[-1]  # the last committed figure is not made by this "run"
     copies = [f"results/report/figures/{n}.png" for n in made]
