@@ -151,12 +151,17 @@ def _drop(h, liquid=False):
     return (f"{h} cm", _subs(runs), _flow_tank, {})
 
 
+def _isa_uncalibrated(key):
+    """ISA runs other than the calibration sweep's (a k_pair value changes them)."""
+    return _isa(key) and "calibration" not in key
+
+
 def _kp(k, label):
     runs = {"single_coarse": f"single_coarse_kp{k}", "single_refined": f"single_refined_kp{k}",
             "flow_incomplete": f"flow_kp{k}_incomplete", "flow_complete": f"flow_kp{k}",
             "flow_complete_capped": f"flow_kp{k}_capped", "flow_refined_incomplete": f"flow_refined_kp{k}_incomplete",
             "flow_refined_complete": f"flow_refined_kp{k}"}
-    return (label, _subs(runs), lambda key: _isa(key) and "calibration" not in key, {})
+    return (label, _subs(runs), _isa_uncalibrated, {})
 
 
 SWEEPS = {
@@ -172,7 +177,7 @@ SWEEPS = {
         ("500 N/cm (kept)", {}, _never, {}),
         ("1000 N/cm (literal k_b/2)", _subs({"single_coarse": "single_coarse_kp1000",
                                              "single_refined": "single_refined_kp1000"}),
-         lambda k: _isa(k) and "calibration" not in k, {}),
+         _isa_uncalibrated, {}),
         _kp(2000, "2000 N/cm"),
     ],
     "refined_wall_law": [

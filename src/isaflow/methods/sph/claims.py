@@ -51,7 +51,7 @@ def spam_tensile(ctx, e):
         firsts.append(t1)
         cfl = float(ds.attrs["sph_cfl"])
         at_dt.append((f"strain 1 %, dt {cfl:g} h/c0" + (" (kept)" if cfl == KEPT_CFL else ""), bool(ok)))
-        rows.append(f"dt = {float(ds.attrs['sph_cfl']):g} h/c0: {'clumps' if ok else 'no clumping'} "
+        rows.append(f"dt = {cfl:g} h/c0: {'clumps' if ok else 'no clumping'} "
                     f"(non-affine > {lim:g} spacing at t = {t1:.3f} s, largest {na:.2f}, smallest pair distance "
                     f"{dmin:.2f} spacing; initial P = {float(ds.attrs['initial_pressure']) / 1e-4 / 1e3:.0f} kPa, "
                     f"{ds.attrs['status']})")
@@ -65,7 +65,7 @@ def spam_tensile(ctx, e):
         ds = ctx.run(key)
         ok, t1, na, dmin = clumping(ds, lim)
         pct = f"{100 * float(ds.attrs['sph_stretch']):g} %"
-        strains.append((f"strain {pct}, dt 0.25 h/c0", bool(ok)))
+        strains.append((f"strain {pct}, dt {float(ds.attrs['sph_cfl']):g} h/c0", bool(ok)))
         notes.append(f"strain {pct}: " + (f"clumps (non-affine > {lim:g} at t = {t1:.3f} s, smallest pair distance "
                                             f"{dmin:.2f} spacing)" if ok else f"no clumping (largest {na:.3f} spacing)"))
     sweep = [("tension_test_setup", label, ok) for label, ok in strains[:1] + at_dt + strains[1:]]
