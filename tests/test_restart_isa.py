@@ -108,3 +108,26 @@ def test_a_changed_scene_continues_from_positions_only(tmp_path):
     leg2 = runfile.read(run(tmp_path, "leg2", "capped", "solver.max_steps=300", start=leg1))
     assert leg2.attrs["restart"].startswith("positions only") and "variant" in leg2.attrs["restart"]
     assert leg2.attrs["start_sha256"] == runfile.sha256(leg1) and leg2.attrs["start_file"] == str(leg1)
+
+
+def test_chunks_replayed_inside_an_exact_cycle_change_no_output(monkeypatch):
+    """With the cycle stop off, a chunk whose input arrays repeat bit for bit is replayed from memory
+    (solver.ChunkMemo): the single coarse vessel's paper rule, 100,000 steps (it cycles from about
+    step 50,000), gives the same arrays, to the last bit, as the run that computes every chunk."""
+    from conftest import solve_scene
+
+    from isaflow.methods.isa import solver
+
+    sets = ["solver.stop_on_cycle=false", "solver.max_steps=100000"]
+    _, memo = solve_scene("single", "coarse", overrides=sets)
+    monkeypatch.setattr(solver.ChunkMemo, "get", lambda *a: None)
+    _, plain = solve_scene("single", "coarse", overrides=sets)
+    assert memo.params["replayed_chunks"] > 10 and plain.params["replayed_chunks"] == 0
+    assert memo.status == plain.status == "step_limit" and memo.steps == plain.steps == 100000
+    for name in ("pos", "contact_force", "residual"):
+        assert np.array_equal(getattr(memo, name), getattr(plain, name)), name
+    for group in ("history", "fields"):
+        a, b = getattr(memo, group), getattr(plain, group)
+        assert a.keys() == b.keys()
+        for k in a:
+            assert np.array_equal(a[k][1], b[k][1]), k
