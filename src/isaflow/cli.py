@@ -18,9 +18,9 @@ import signal
 import sys
 
 from . import inputs, methods, preflight
+from .settings import OUTCOMES
 from . import run as runs
 
-OUTCOMES = ("converged", "cycle", "step_limit", "escaped", "nonfinite", "solver_failed")
 
 
 def _interrupted(signum, frame):
@@ -99,10 +99,9 @@ def main(argv=None):
             if bad:
                 _error(f"argument --accept: unknown outcome '{inputs.printable(bad[0])}' (choose from {', '.join(OUTCOMES)})")
                 return 2
-        unstable = [a for a in accept if a in preflight.UNSTABLE]
-        if unstable and not stability:
-            _error(f"argument --accept: outcome '{unstable[0]}' may be accepted only by a stability case "
-                   f"(add --stability-case)")
+        bad = preflight.unstable_accepted(accept, stability)
+        if bad:
+            _error(f"argument --accept: outcome '{bad}' {preflight.UNSTABLE_RULE}")
             return 2
         if max_hours is not None and not (math.isfinite(max_hours) and max_hours > 0):
             _error("argument --max-hours: must be a finite positive number of hours")

@@ -34,15 +34,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-# The shared outcome list (run-file attribute ``status``).
-OUTCOMES = {
-    "converged": "stop criterion met: static equilibrium (max|F| < f_tol) or liquid at rest (kinetic-energy criterion)",
-    "cycle": "the iteration repeats with a fixed period and can never converge (detected)",
-    "step_limit": "step or time limit reached while still out of balance or moving",
-    "escaped": "a particle would cross a wall, or left the walls' bounding box",
-    "nonfinite": "a position, velocity or force became NaN or infinite",
-    "solver_failed": "an implicit (pressure) solve did not reach its tolerance",
-}
+from .settings import OUTCOMES  # noqa: E402,F401 (the shared outcome list, defined with the accept vocabulary)
 
 
 @dataclass

@@ -22,18 +22,24 @@ from . import tank as tanks
 from .inputs import InputError
 
 UNSTABLE = ("escaped", "nonfinite", "solver_failed")  # outcomes only a stability case may accept
+UNSTABLE_RULE = ("may be accepted only by a declared stability case (stability: true / --stability-case); any other "
+                 "run that ends so fails")
+
+
+def unstable_accepted(accept, stability):
+    """The first outcome of ``accept`` that only a stability case may accept, if this run is none; else None."""
+    return None if stability else next((a for a in accept if a in UNSTABLE), None)
 WORKFLOW_KEYS = ("meta", "runtime")  # keys the workflow adds to a declaration (not part of RUN_SCHEMA)
 
 
-def check(method, tank, s, accept=("converged",), stability=False, max_hours=None, particles=None):
+def check(method, tank, s, accept=("converged",), stability=False, max_hours=None, particles=None, field="accept"):
     """Refuse (InputError) a run whose outcomes, settings, cost or threads are not allowed.  tank: tank.Tank or
     None; s: resolved settings.Settings; particles: a start file's count (None: the resolution's).  Returns the
-    largest of its costs (budget.Cost)."""
+    largest of its costs (budget.Cost).  field: how a refusal of ``accept`` names it."""
     budget.check_environment()
-    unstable = [a for a in accept if a in UNSTABLE]
-    if unstable and not stability:
-        raise InputError(f"accept: outcome '{unstable[0]}' may be accepted only by a declared stability case "
-                         f"(stability: true / --stability-case); any other run that ends so fails")
+    bad = unstable_accepted(accept, stability)
+    if bad:
+        raise InputError(f"{field}: outcome '{bad}' {UNSTABLE_RULE}")
     checks = methods.get(method).checks_module()
     checks.plausible(tank, s, stability)  # first: it refuses derived numbers that over- or underflow
     costs = [budget.check(s.path, c, max_hours) for c in checks.cost(tank, s, particles)]
@@ -94,9 +100,5 @@ class Declarations:
             raise InputError(f"{where}.tank': {err}") from None
         s = settings.load(path, m.values_schema(), decl["variant"], decl["resolution"], decl.get("set", {}),
                           spec=spec)
-        accept = decl.get("accept", ["converged"])
-        unstable = [a for a in accept if a in UNSTABLE]
-        if unstable and not decl.get("stability"):
-            raise InputError(f"{where}.accept': outcome '{unstable[0]}' may be accepted only by a stability "
-                             f"case (stability: true); any other run that ends so fails its job")
-        return check(method, tank, s, accept, decl.get("stability", False), decl.get("max_hours"))
+        return check(method, tank, s, decl.get("accept", ["converged"]), decl.get("stability", False),
+                     decl.get("max_hours"), field=f"{where}.accept'")

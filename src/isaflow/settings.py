@@ -30,7 +30,17 @@ RESERVED = ("variants", "resolutions", "runs")
 SOURCE = {"type": "string", "maxLength": 2000,
           "pattern": "^(page text|literature|inferred|issue text|calibrated|study plan)( \\([^)]*\\))?[:;] .+"}
 NAME = {"type": "string", "pattern": "^[A-Za-z0-9_.]+\\Z", "maxLength": 64}
-OUTCOME_NAMES = ["converged", "cycle", "step_limit", "escaped", "nonfinite", "solver_failed"]
+# The one list of run outcomes (run-file attribute ``status``; a run declaration's ``accept``), read
+# while the workflow is parsed (so here, free of the numerical stack); contract re-exports it.
+OUTCOMES = {
+    "converged": "stop criterion met: static equilibrium (max|F| < f_tol) or liquid at rest (kinetic-energy criterion)",
+    "cycle": "the iteration repeats with a fixed period and can never converge (detected)",
+    "step_limit": "step or time limit reached while still out of balance or moving",
+    "escaped": "a particle would cross a wall, or left the walls' bounding box",
+    "nonfinite": "a position, velocity or force became NaN or infinite",
+    "solver_failed": "an implicit (pressure) solve did not reach its tolerance",
+}
+OUTCOME_NAMES = list(OUTCOMES)
 
 
 def leaf(value_schema):
