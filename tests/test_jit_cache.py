@@ -123,3 +123,38 @@ def test_a_process_without_a_fill_never_waits_for_a_long_lived_writer(env):
     finally:
         holder.kill()
         holder.wait()
+
+
+READER = textwrap.dedent('''
+    import json, sys
+    import numpy as np
+    from isaflow.core import jit
+    import tiny
+    jit.use(sys.argv[1])
+    read = jit.read_also(*sys.argv[2:], package="{}")
+    value = tiny.outer(np.arange(4.0))
+    print(json.dumps(dict(jit.counters(), read=read, value=value)))
+''')
+
+
+def test_a_process_reads_another_methods_sealed_generation_and_writes_nothing_there(env, tmp_path):
+    """The claims job's case: bound to one generation, it loads another method's kernels from that method's
+    sealed generation (read_also) instead of compiling them, and saves nothing into either."""
+    filled, _ = result(start(env, "tiny"))
+    assert filled["mode"] == "read" and filled["compiled"] > 0
+    sealed = (tmp_path / "cache" / "tiny" / "MANIFEST.json").read_text()
+
+    def reader(*also):
+        p = subprocess.run([sys.executable, "-c", READER, "claims", *also], env=env, text=True, capture_output=True,
+                           timeout=300)
+        assert p.returncode == 0, p.stderr
+        return json.loads(p.stdout.splitlines()[-1])
+
+    both = reader("tiny")
+    assert both["read"] == ["tiny"] and both["compiled"] == 0 and both["loaded"] >= 1 and both["value"] == 12.0
+    assert (tmp_path / "cache" / "tiny" / "MANIFEST.json").read_text() == sealed
+    assert not (tmp_path / "cache" / "claims" / "tiny").exists()
+    alone = reader()  # without it the same kernels compile (in its own generation)
+    assert alone["read"] == [] and alone["compiled"] > 0
+    missing = reader("nowhere")  # a generation that does not exist is skipped
+    assert missing["read"] == []

@@ -4,7 +4,7 @@ params.func names 'module.function' under isaflow (e.g. 'methods.isa.tables.erro
 'figures.methods.tanks_figure').  It is called as func(**named inputs except 'code' and 'compiled',
 outputs=[output files], **params.kw); single-file inputs are passed as a path, others as a list.
 params.kernels, if given, names the kernel generation (isaflow.core.jit.use) of its kernels, whose
-compile stamp is the input 'compiled'.  stderr goes to the rule's log.  BLAS and OpenMP run on the
+compile stamp is the input 'compiled', or a list: that generation, then others it reads too (jit.read_also).  stderr goes to the rule's log.  BLAS and OpenMP run on the
 rule's threads.  An input error (isaflow.inputs.InputError, or a
 file that is no run file) ends the job with one line in the log and exit status 2, no traceback.
 """
@@ -25,7 +25,10 @@ sys.argv = ["snakemake", f"rule {snakemake.rule}:", f"isaflow.{snakemake.params.
 if snakemake.params.get("kernels"):  # noqa: F821  the kernel generation (isaflow.core.jit) its calls use
     from isaflow.core import jit  # noqa: E402
 
-    jit.use(snakemake.params.kernels)  # noqa: F821
+    _kernels = snakemake.params.kernels  # noqa: F821  one generation, or [its own, others it reads too]
+    _kernels = [_kernels] if isinstance(_kernels, str) else list(_kernels)
+    jit.use(_kernels[0])
+    jit.read_also(*_kernels[1:])
 from isaflow.inputs import InputError  # noqa: E402
 from isaflow.runfile import RunFileError  # noqa: E402
 

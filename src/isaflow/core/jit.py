@@ -24,6 +24,10 @@ only**, then sealed:
   or the seal is damaged while others read it) compiles in memory only
   (``private``).  Readers hold
   a shared lock, so a folder is never wiped under them.
+- A process may also *read* other methods' sealed generations (:func:`read_also`,
+  e.g. the claims job, which calls every method's code): a kernel of package
+  ``isaflow.methods.<name>`` then loads from generation ``<name>``, under a
+  shared lock held for the process's life; nothing is ever written there.
 - A damaged, partial or foreign cache is therefore rebuilt or ignored, never
   loaded; in ``read`` mode a kernel missing from the cache is compiled in
   memory and counted (:func:`counters` ``gaps``), never saved.
@@ -51,6 +55,7 @@ from numba.core.caching import (CompileResultCacheImpl, FunctionCache, IndexData
 MANIFEST = "MANIFEST.json"
 _COUNTERS = {"compiled": 0, "compile_s": 0.0, "loaded": 0, "load_s": 0.0, "gaps": []}
 _STATE = {"name": None, "mode": None, "folder": None, "fd": None}
+_EXTRA = {}  # {package prefix 'isaflow.methods.<name>': (folder, fd)} of generations read beside this one (read_also)
 
 
 def counters():
@@ -190,6 +195,32 @@ def use(name, fill=None):
     return _STATE["mode"]
 
 
+def read_also(*names, package="isaflow.methods.{}"):
+    """Load the kernels of methods ``names`` from their own generations too (read only, after :func:`use` and
+    before any of their kernels is loaded): the kernels of package ``package.format(name)`` and its
+    sub-packages.  A generation that is not sealed, or is being written, is skipped (its kernels compile in
+    memory, counted as gaps).  Returns the packages read this way."""
+    for name in names:
+        key = package.format(name)
+        folder = root() / name
+        if name == _STATE["name"] or key in _EXTRA or not folder.is_dir():
+            continue
+        fd = os.open(folder / ".lock", os.O_RDWR | os.O_CREAT, 0o644)
+        if _shared(fd, wait=False) and _sealed(folder):
+            _EXTRA[key] = (folder, fd)  # the fd stays open: the shared lock lives with the process
+        else:
+            os.close(fd)  # releases the lock
+    return list(_EXTRA)
+
+
+def _extra(package):
+    """The folder of the generation read beside this process's one that holds package's kernels, or None."""
+    for key, (folder, _) in _EXTRA.items():
+        if package == key or package.startswith(key + "."):
+            return folder
+    return None
+
+
 class _Locator(_SourceFileBackedLocatorMixin, _CacheLocator):
     """A kernel's folder inside this process's generation: <generation>/<its package>; nothing made on import."""
 
@@ -200,7 +231,11 @@ class _Locator(_SourceFileBackedLocatorMixin, _CacheLocator):
     def get_cache_path(self):
         if _STATE["name"] is None:
             use("default")
-        return str(_STATE["folder"] / self._package)
+        return str((_extra(self._package) or _STATE["folder"]) / self._package)
+
+    def read_only(self):
+        """True for a kernel of a generation read beside this process's own (read_also)."""
+        return _extra(self._package) is not None
 
     @classmethod
     def from_function(cls, py_func, py_file):
@@ -234,13 +269,14 @@ class _Cache(FunctionCache):
 
     def load_overload(self, sig, target_context):
         f = self._cache_file_here()
-        if _STATE["mode"] == "private":
+        extra = self._impl.locator.read_only()
+        if _STATE["mode"] == "private" and not extra:
             return None
         t0 = time.perf_counter()
         target_context.refresh()
         data = f.load(self._index_key(sig, target_context.codegen()))
         if data is None:
-            if _STATE["mode"] == "read":
+            if _STATE["mode"] == "read" or extra:
                 _COUNTERS["gaps"].append(self._py_func.__qualname__)
             return None
         cres = self._impl.rebuild(target_context, data)
@@ -250,7 +286,7 @@ class _Cache(FunctionCache):
 
     def save_overload(self, sig, data):
         f = self._cache_file_here()
-        if _STATE["mode"] != "write" or not self._impl.check_cachable(data):
+        if _STATE["mode"] != "write" or self._impl.locator.read_only() or not self._impl.check_cachable(data):
             return
         os.makedirs(self.cache_path, exist_ok=True)
         f.save(self._index_key(sig, data.codegen), self._impl.reduce(data))
