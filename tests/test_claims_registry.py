@@ -314,11 +314,24 @@ def test_copy_loads(registry_copy):
      "depends_on: [pap-9-nothing]", "depends_on"),
     ("wrong prefix", "hattori.yaml", "id: hat-eq1-5-algebra", "id: mer-eq1-5-algebra", "prefix"),
     ("NaN", "hattori.yaml", "value: 1.5\n", "value: .nan\n", "finite"),
+    ("unregistered method", "marko2017.yaml", '{id: "solid:floor_uniform_uniform_load"}', '{id: "dem:floor"}',
+     "'dem:floor' names no registered method"),
 ])
 def test_loader_refuses(registry_copy, case, file, old, new, message):
     _edit(registry_copy / file, old, new)
     with pytest.raises(InputError, match=re.escape(message) if case != "unknown field" else message):
         reg.load(registry_copy)
+
+
+def test_a_tank_method_run_is_one_entry_per_tank_method():
+    """'{tank_method}' in a run id: the floor under every tank method's liquid, from the registry, in its order
+    (a new tank method's floor is judged without editing config/claims/marko2017.yaml)."""
+    from isaflow import methods
+
+    floor = next(c for c in CLAIMS if c["id"] == "prj-floor-beam")
+    assert "floor_{tank_method}_oneway" in (CLAIMS_DIR / "marko2017.yaml").read_text()
+    assert [r["id"] for r in floor["runs"]] == ["solid:floor_uniform_uniform_load"] + [
+        f"solid:floor_{m}_oneway" for m in methods.tank_methods()]
 
 
 def test_loader_refuses_duplicate_ids_across_files(registry_copy):

@@ -7,7 +7,9 @@ sweep covers).  Each file is read through :func:`isaflow.inputs.load` (no aliase
 duplicate keys, NaN) against ``claims.schema.json``; :func:`load` then checks what a schema
 cannot: file name = paper, ids unique across files, every reference (inferred inputs,
 ``depends_on``, ``calibrated_against``) resolves, id prefix = paper, testable entries carry a
-tolerance that can fail, untestable ones say why.
+tolerance that can fail, untestable ones say why, every run names a registered method.  A run id
+holding ``{tank_method}`` is one entry per tank method of the registry (e.g. the solid floor under each
+method's liquid), so a new method's run is judged without editing a registry file.
 
 Kinds: ``method result`` (a number or property the method produces), ``paper arithmetic`` (the
 paper's own formula or number re-evaluated), ``holds by construction`` (true because of how the
@@ -32,7 +34,7 @@ from importlib import resources
 from pathlib import Path
 
 from .inputs import InputError, load as load_yaml
-from .methods import papers
+from .methods import papers, registry
 
 SCHEMA = json.loads(resources.files("isaflow").joinpath("claims.schema.json").read_text())
 PAPERS = tuple(papers())  # the paper ids of the method registry, the paper replicated first
@@ -65,11 +67,36 @@ def load_files(directory=DEFAULT_DIRECTORY):
         if spec["paper"] != path.stem:
             raise InputError(f"{path}: field 'paper': '{spec['paper']}' does not match the file name "
                              f"'{path.stem}' (one file per paper, named after it)")
+        _expand_runs(spec, str(path))
         out[spec["paper"]] = spec | {"_path": str(path)}
     missing = [p for p in PAPERS if p not in out]
     if missing:
         raise InputError(f"{d}: no registry file for {', '.join(missing)}")
     return out
+
+
+TANK_METHOD = "{tank_method}"
+
+
+def _expand_runs(spec, path):
+    """Every ``runs`` list of a registry file in place: '{tank_method}' entries become one per tank method
+    (registry order); a run naming no registered method is refused (InputError naming the file and entry)."""
+    methods = registry()
+    tank = [name for name, m in methods.items() if m.tank]
+    entries = [(f"inputs.{k}", i) for k, i in enumerate(spec.get("inputs", []))] + [
+        (f"claims.{k}", c) for k, c in enumerate(spec.get("claims", []))] + [
+        (f"claims.{k}.deviation", c["deviation"]) for k, c in enumerate(spec.get("claims", [])) if "deviation" in c]
+    for where, node in entries:
+        if "runs" not in node:
+            continue
+        runs = []
+        for r in node["runs"]:
+            method = r["id"].split(":", 1)[0]
+            if method not in methods:
+                raise InputError(f"{path}: {where}.runs: '{r['id']}' names no registered method "
+                                 f"(choose from {', '.join(methods)})")
+            runs += [dict(r, id=r["id"].replace(TANK_METHOD, m)) for m in tank] if TANK_METHOD in r["id"] else [r]
+        node["runs"] = runs
 
 
 def _check_file(paper, spec, ids):
