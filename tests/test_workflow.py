@@ -1,5 +1,6 @@
 """Workflow: the real config builds a complete DAG; one figure needs only its own run."""
 
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -91,8 +92,21 @@ def test_every_rule_has_a_log_and_solver_rules_a_benchmark():
 
 
 def rule_blocks():
+    """The text of every rule of the rules files, from its name on.  A rule made by `use rule T as NAME with:`
+    (workflow/rules/templates.smk) is its `with:` block and then every directive of T's block it does not
+    give itself (a directive given in `with:` replaces the template's)."""
     files = sorted((ROOT / "workflow" / "rules").rglob("*.smk"))
-    return [b for p in files for b in ("\n" + p.read_text()).split("\nrule ")[1:]]
+    chunks = [c for p in files for c in re.split(r"\n(?=rule |use rule )", "\n" + p.read_text())[1:]]
+    blocks = {c[len("rule "):].split(":")[0]: c[len("rule "):] for c in chunks if c.startswith("rule ")}
+    out = list(blocks.values())
+    for c in chunks:
+        m = re.match(r"use rule (\w+) as (\w+) with:\n", c)
+        if m:
+            own = set(re.findall(r"^    (\w+):", c, re.M))
+            inherited = [d for d in re.split(r"\n(?=    \w+:)", blocks[m.group(1)])[1:]
+                         if re.match(r"    (\w+):", d).group(1) not in own]
+            out.append("\n".join([f"{m.group(2)}:" + c[m.end() - 1:].rstrip("\n"), *inherited]))
+    return out
 
 
 def test_every_rule_declares_its_resources_and_a_message():

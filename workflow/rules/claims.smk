@@ -7,7 +7,7 @@
 CLAIMS_KERNELS = next(iter(REGISTRY))
 
 
-rule claims:
+use rule call as claims with:
     input:
         run_files=claim_inputs,
         registry_files=sorted(glob.glob("config/claims/*.yaml")),
@@ -21,20 +21,14 @@ rule claims:
         func="claims.write",
         kernels=[CLAIMS_KERNELS] + [m for m in REGISTRY if m != CLAIMS_KERNELS],
         kw=lambda wc: {"registry": "config/claims", "runs": claim_runs()},
-    message:
-        JOB
     resources:
         **CLAIMS,
     log:
         "logs/claims.log",
-    conda:
-        "../envs/isaflow.yaml"
-    script:
-        "../scripts/call.py"
 
 
 # where each fragile method result flips (isaflow.figures.robustness): from the claims tables alone
-rule claims_robustness_figure:
+use rule call as claims_robustness_figure with:
     input:
         tables=[f"results/claims/registry/{p}.csv" for p in CLAIM_PAPERS],
         registry=sorted(glob.glob("config/claims/*.yaml")),
@@ -43,16 +37,8 @@ rule claims_robustness_figure:
         figure("claims_robustness"),
     params:
         func="figures.robustness.robustness_figure",
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/claims/robustness_figure.log",
-    conda:
-        "../envs/isaflow.yaml"
-    script:
-        "../scripts/call.py"
 
 
 register(targets=figure("claims_robustness"))

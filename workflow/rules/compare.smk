@@ -3,7 +3,7 @@
 # config.yaml's compare.tanks; 'runtime: true' adds single-vessel points to the run-time figure).
 
 
-rule compare_table:
+use rule call as compare_table with:
     input:
         runs=lambda wc: sorted(set(compare_runs()) | set(runtime_runs())),
         code=code("tables"),
@@ -12,19 +12,11 @@ rule compare_table:
     params:
         func="tables.compare_table",
         kw=lambda wc: {"compare": compare_runs()},
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/compare/table.log",
-    conda:
-        "../envs/isaflow.yaml"
-    script:
-        "../scripts/call.py"
 
 
-rule compare_figure_tanks:
+use rule call as compare_figure_tanks with:
     input:
         table="results/compare/runs.csv",
         code=code("figures.methods"),
@@ -33,19 +25,11 @@ rule compare_figure_tanks:
     params:
         func="figures.methods.tanks_figure",
         kw={"tanks": config["compare"]["tanks"]},
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/compare/figure_tanks.log",
-    conda:
-        "../envs/isaflow.yaml"
-    script:
-        "../scripts/call.py"
 
 
-rule compare_figure_runtime:
+use rule call as compare_figure_runtime with:
     input:
         table="results/compare/runs.csv",
         code=code("figures.methods"),
@@ -53,19 +37,11 @@ rule compare_figure_runtime:
         figure("methods_error_vs_runtime"),
     params:
         func="figures.methods.error_vs_runtime_figure",
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/compare/figure_runtime.log",
-    conda:
-        "../envs/isaflow.yaml"
-    script:
-        "../scripts/call.py"
 
 
-rule compare_report:
+use rule call as compare_report with:
     input:
         table="results/compare/runs.csv",
         code=code("report.methods"),
@@ -75,16 +51,8 @@ rule compare_report:
     params:
         func="report.methods.methods_section",
         kw={"tanks": config["compare"]["tanks"]},
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/compare/report.log",
-    conda:
-        "../envs/isaflow.yaml"
-    script:
-        "../scripts/call.py"
 
 
 register(targets=figure("methods_tanks") + figure("methods_error_vs_runtime") + ["docs/tables/methods_compare.csv"])

@@ -2,7 +2,7 @@
 # first, then every registered fragment in NN order) and docs/timing.md (every timing fragment).
 
 
-rule report_inferred:
+use rule call as report_inferred with:
     input:
         inferred="config/inferred.yaml",
         settings=[m.settings for m in REGISTRY.values()],
@@ -11,19 +11,11 @@ rule report_inferred:
         "results/report/90_inferred.md",
     params:
         func="report.inferred.inferred_section",
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/report/inferred.log",
-    conda:
-        "../envs/isaflow.yaml"
-    script:
-        "../scripts/call.py"
 
 
-rule replication_report:
+use rule call as replication_report with:
     input:
         parts=lambda wc: sorted(TARGETS["report"], key=lambda p: p.rsplit("/", 1)[-1]),
         claims=[f"results/claims/registry/{p}.csv" for p in CLAIM_PAPERS],
@@ -37,19 +29,11 @@ rule replication_report:
         report_file("results/report/replication.html", "replication", "Report"),
     params:
         func="report.assemble",
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/report/assemble.log",
-    conda:
-        "../envs/isaflow.yaml"
-    script:
-        "../scripts/call.py"
 
 
-rule timing_report:
+use rule call as timing_report with:
     input:
         parts=lambda wc: sorted(TARGETS["timing"]),
         code=code("report.speed"),
@@ -57,16 +41,8 @@ rule timing_report:
         "docs/timing.md",
     params:
         func="report.speed.timing_report",
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/report/timing.log",
-    conda:
-        "../envs/isaflow.yaml"
-    script:
-        "../scripts/call.py"
 
 
 register(targets=["docs/replication.md", "docs/timing.md"], report=["results/report/90_inferred.md"])
@@ -74,7 +50,7 @@ register(targets=["docs/replication.md", "docs/timing.md"], report=["results/rep
 
 # the benchmarks (snakemake -c2 benchmarks): step costs, compile and memory of every method against its peers;
 # each takes the whole machine for minutes, so the full run leaves them out
-rule bench_report:
+use rule call as bench_report with:
     input:
         parts=lambda wc: sorted(p for p in TARGETS["bench"] if p.endswith(".md")),
         code=code("report.speed"),
@@ -83,16 +59,8 @@ rule bench_report:
     params:
         func="report.speed.timing_report",
         kw={"title": "Benchmarks"},
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/report/benchmarks.log",
-    conda:
-        "../envs/isaflow.yaml"
-    script:
-        "../scripts/call.py"
 
 
 rule benchmarks:

@@ -47,7 +47,7 @@ isa_file = lambda run: run_file("isa", run)  # noqa: E731
 study_files = lambda group, **match: _isa_plan.run_files(STUDY_RUNS, group, **match)  # noqa: E731
 
 
-rule isa_metrics:
+use rule call as isa_metrics with:
     input:
         runs=[isa_file(r) for r in ISA_RUNS],
         code=code("methods.isa.tables"),
@@ -55,19 +55,11 @@ rule isa_metrics:
         "results/isa/metrics.csv",
     params:
         func="methods.isa.tables.metrics_table",
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/isa/metrics.log",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
-rule isa_calibration_table:
+use rule call as isa_calibration_table with:
     input:
         runs=CAL_FILES,
         code=code("methods.isa.tables"),
@@ -75,19 +67,11 @@ rule isa_calibration_table:
         "results/isa/calibration.csv",
     params:
         func="methods.isa.tables.calibration_table",
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/isa/calibration_table.log",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
-rule isa_fig_inputs:
+use rule call as isa_fig_inputs with:
     input:
         inputs=lambda wc: [isa_file(FIGS[wc.name])],
         code=code("methods.isa.figures.single"),
@@ -96,21 +80,13 @@ rule isa_fig_inputs:
     params:
         func="methods.isa.figures.single.inputs_figure",
         kw=lambda wc: {"inferred": ISA.get("inferred", {}).get(wc.name)},
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/isa/figures/{name}.log",
     wildcard_constraints:
         name="fig05_inputs_coarse|fig07_inputs_refined",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
-rule isa_fig_single:
+use rule call as isa_fig_single with:
     input:
         inputs=lambda wc: [isa_file(FIGS[wc.name])],
         code=code("methods.isa.figures.single"),
@@ -120,21 +96,13 @@ rule isa_fig_single:
         func="methods.isa.figures.single.single_vessel_figure",
         kw=lambda wc: {"paper_level": ISA["paper"][FIGS[wc.name].removesuffix("_capped")]["level"],
                        "inferred": ISA.get("inferred", {}).get(wc.name)},
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/isa/figures/{name}.log",
     wildcard_constraints:
         name="fig06_single_coarse|fig08_single_refined",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
-rule isa_fig_calibration:
+use rule call as isa_fig_calibration with:
     input:
         inputs=CAL_FILES,
         code=code("methods.isa.figures.single"),
@@ -143,19 +111,11 @@ rule isa_fig_calibration:
     params:
         func="methods.isa.figures.single.calibration_figure",
         kw={"paper_levels": {k: v["level"] for k, v in ISA["paper"].items()}, "adopted": ISA["calibration"]["adopted"]},
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/isa/figures/calibration_free_surface.log",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
-rule isa_fig_convergence:
+use rule call as isa_fig_convergence with:
     input:
         inputs=[isa_file(r) for r in ["single_coarse", "single_coarse_capped", "single_coarse_nocycle", "single_refined",
                                       "single_refined_capped", "single_refined_nocycle"]],
@@ -164,19 +124,11 @@ rule isa_fig_convergence:
         figure("convergence_single"),
     params:
         func="methods.isa.figures.single.convergence_figure",
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/isa/figures/convergence_single.log",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
-rule isa_fig_flow:
+use rule call as isa_fig_flow with:
     input:
         inputs=lambda wc: [isa_file(FIGS[wc.name])],
         code=code("methods.isa.figures.flow"),
@@ -188,18 +140,10 @@ rule isa_fig_flow:
             "fig10_flow_complete": "methods.isa.figures.flow.flow_complete_figure",
         }[wc.name],
         kw=lambda wc: {"paper": FLOW["paper"], "inferred": ISA.get("inferred", {}).get(wc.name)},
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/isa/figures/{name}.log",
     wildcard_constraints:
         name="fig09_flow_incomplete|fig10_flow_complete",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
 _FIG10_SWEEPS = ISA.get("fig10_sweeps", {})  # Figure 10 across an inferred input: fig10_<name>
@@ -235,7 +179,7 @@ _OD = ISA.get("overdamped", {})
 OD_RUNS = [*_OD.get("isa_chain", []), _OD.get("single"), *_OD.get("flows", []), *_OD.get("singles", [])] if _OD else []
 
 
-rule isa_fig_overdamped:
+use rule call as isa_fig_overdamped with:
     input:
         inputs=[isa_file(r) for r in OD_RUNS],
         code=code("methods.isa.figures.damping"),
@@ -244,19 +188,11 @@ rule isa_fig_overdamped:
     params:
         func="methods.isa.figures.damping.overdamped_figure",
         kw={**_OD, "inferred": ISA.get("inferred", {}).get("isa_overdamped")},
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/isa/figures/isa_overdamped.log",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
-rule isa_fig_flow_history:
+use rule call as isa_fig_flow_history with:
     input:
         inputs=sorted({isa_file(r) for chain in FLOW["chains"].values() for r in chain}),
         code=code("methods.isa.figures.flow"),
@@ -265,19 +201,11 @@ rule isa_fig_flow_history:
     params:
         func="methods.isa.figures.flow.flow_history_figure",
         kw={"chains": FLOW["chains"]},
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/isa/figures/flow_history.log",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
-rule isa_table1:
+use rule call as isa_table1 with:
     input:
         runs=[isa_file(r) for r in TABLE1_RUNS],
         benchmarks=[f"results/benchmarks/runs/isa/{r}.tsv" for r in TABLE1_RUNS],
@@ -288,19 +216,11 @@ rule isa_table1:
     params:
         func="methods.isa.tables.write_table1",
         kw={"rows": ISA["table1"]},
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/isa/table1.log",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
-rule isa_study_error_table:
+use rule call as isa_study_error_table with:
     input:
         runs=study_files("error_runtime"),
         code=code("methods.isa.tables"),
@@ -309,19 +229,11 @@ rule isa_study_error_table:
     params:
         func="methods.isa.tables.error_table",
         kw={"meta": STUDY_META, "paper": ISA["paper"]},
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/isa/study/error_table.log",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
-rule isa_study_fire_tables:
+use rule call as isa_study_fire_tables with:
     input:
         tuning=study_files("fire_tuning"),
         references=[f for lat in STUDY["fire_tuning"]["lattices"] for var in ("capped", "paper")
@@ -333,19 +245,11 @@ rule isa_study_fire_tables:
     params:
         func="methods.isa.tables.fire_tables",
         kw={"meta": STUDY_META, "paper": ISA["paper"], "required_ratio": STUDY["fire_tuning"]["required_ratio"]},
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/isa/study/fire_tables.log",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
-rule isa_study_map_table:
+use rule call as isa_study_map_table with:
     input:
         runs=study_files("stability_map"),
         code=code("methods.isa.tables"),
@@ -354,19 +258,11 @@ rule isa_study_map_table:
     params:
         func="methods.isa.tables.map_table",
         kw={"meta": STUDY_META},
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/isa/study/map_table.log",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
-rule isa_study_cases_table:
+use rule call as isa_study_cases_table with:
     input:
         runs=study_files("cases"),
         code=code("methods.isa.tables"),
@@ -375,19 +271,11 @@ rule isa_study_cases_table:
     params:
         func="methods.isa.tables.cases_table",
         kw={"meta": STUDY_META},
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/isa/study/cases_table.log",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
-rule isa_fig_error_vs_runtime:
+use rule call as isa_fig_error_vs_runtime with:
     input:
         inputs=["results/isa/study/error_vs_runtime.csv"],
         code=code("methods.isa.figures.study"),
@@ -396,21 +284,13 @@ rule isa_fig_error_vs_runtime:
     params:
         func="methods.isa.figures.study.error_vs_runtime_figure",
         kw=lambda wc: {"x": {"error_vs_runtime": "wall_time_s", "error_vs_work": "particle_steps"}[wc.name]},
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/isa/figures/{name}.log",
     wildcard_constraints:
         name="error_vs_runtime|error_vs_work",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
-rule isa_fig_stability_map:
+use rule call as isa_fig_stability_map with:
     input:
         inputs=["results/isa/study/stability_map.csv", "results/isa/study/stability_cases.csv"],
         code=code("methods.isa.figures.study"),
@@ -418,19 +298,11 @@ rule isa_fig_stability_map:
         figure("stability_map"),
     params:
         func="methods.isa.figures.study.stability_map_figure",
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/isa/figures/stability_map.log",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
-rule isa_report_findings:
+use rule call as isa_report_findings with:
     input:
         metrics="results/isa/metrics.csv",
         calibration="results/isa/calibration.csv",
@@ -439,19 +311,11 @@ rule isa_report_findings:
         "results/report/findings.md",
     params:
         func="methods.isa.report.findings.findings_file",
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/isa/report/findings.log",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
-rule isa_report_single:
+use rule call as isa_report_single with:
     input:
         metrics="results/isa/metrics.csv",
         calibration="results/isa/calibration.csv",
@@ -463,19 +327,11 @@ rule isa_report_single:
         "docs/tables/calibration.csv",
     params:
         func="methods.isa.report.single.single_section",
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/isa/report/single.log",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
-rule isa_report_flow:
+use rule call as isa_report_flow with:
     input:
         metrics="results/isa/metrics.csv",
         config=ISA_WORKFLOW_CFG,
@@ -484,19 +340,11 @@ rule isa_report_flow:
         "results/report/20_flow.md",
     params:
         func="methods.isa.report.flow.flow_section",
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/isa/report/flow.log",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
-rule isa_report_study:
+use rule call as isa_report_study with:
     input:
         errors="results/isa/study/error_vs_runtime.csv",
         fire_ratio="results/isa/study/fire_ratio.csv",
@@ -511,16 +359,8 @@ rule isa_report_study:
         "docs/tables/study_cases.csv",
     params:
         func="methods.isa.report.study.report_section",
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/isa/report/study.log",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
 rule isa_bench_step:
@@ -573,7 +413,7 @@ rule isa_bench_output:
         "PYTHONPATH={params.src} python {input.script} > {log} 2>&1"
 
 
-rule isa_timing:
+use rule call as isa_timing with:
     input:
         step_cost="benchmarks/results/step_cost.csv",
         compile="benchmarks/results/compile.csv",
@@ -587,16 +427,8 @@ rule isa_timing:
         "results/bench/10_isa.md",
     params:
         func="methods.isa.report.speed.timing_fragment",
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/isa/report/timing.log",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
 # the paper's own outputs, Figures 5-10 and Table 1, and only what they need (quick start: snakemake -c2

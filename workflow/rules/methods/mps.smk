@@ -11,7 +11,7 @@ MPS_BEFORE = [run_file("mps", r) for r in _MPS_RUNS if r.startswith("kog_")]  # 
 MPS_FLOW_FINEST = [run_file("mps", r) for r, d in _MPS_RUNS.items() if r.startswith("flow_") and d["resolution"] == "dx3.45"]
 
 
-rule mps_summary:
+use rule call as mps_summary with:
     input:
         runs=MPS_FILES,
         code=code("methods.mps.outputs"),
@@ -19,19 +19,11 @@ rule mps_summary:
         "results/mps/summary.csv",
     params:
         func="methods.mps.outputs.summary",
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/mps/summary.log",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
-rule mps_figure_loads:
+use rule call as mps_figure_loads with:
     input:
         runs=MPS_SINGLE,
         code=code("methods.mps.figures"),
@@ -39,19 +31,11 @@ rule mps_figure_loads:
         figure("mps_wall_loads"),
     params:
         func="methods.mps.figures.wall_loads",
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/mps/figure_loads.log",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
-rule mps_figure_rest:
+use rule call as mps_figure_rest with:
     input:
         runs=MPS_SINGLE,
         before=MPS_BEFORE,
@@ -60,19 +44,11 @@ rule mps_figure_rest:
         figure("mps_rest"),
     params:
         func="methods.mps.figures.rest",
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/mps/figure_rest.log",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
-rule mps_figure_column:
+use rule call as mps_figure_column with:
     input:
         runs=MPS_SINGLE,
         code=code("methods.mps.figures"),
@@ -80,19 +56,11 @@ rule mps_figure_column:
         figure("mps_column"),
     params:
         func="methods.mps.figures.column",
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/mps/figure_column.log",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
-rule mps_figure_flow:
+use rule call as mps_figure_flow with:
     input:
         runs=MPS_FLOW_FINEST,
         code=code("methods.mps.figures"),
@@ -100,16 +68,8 @@ rule mps_figure_flow:
         figure("mps_flow"),
     params:
         func="methods.mps.figures.flow",
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/mps/figure_flow.log",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
 rule mps_bench:
@@ -133,7 +93,7 @@ rule mps_bench:
         "PYTHONPATH={params.src} python {input.script} > {log} 2>&1"
 
 
-rule mps_report:
+use rule call as mps_report with:
     input:
         summary="results/mps/summary.csv",
         cfg=REGISTRY["mps"].settings,
@@ -144,16 +104,8 @@ rule mps_report:
         table="docs/tables/mps_single.csv",
     params:
         func="methods.mps.report.write",
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/mps/report.log",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
 register(MPS_FILES + ["results/mps/summary.csv"] + figure("mps_wall_loads") + figure("mps_flow") + figure("mps_rest")
@@ -161,7 +113,7 @@ register(MPS_FILES + ["results/mps/summary.csv"] + figure("mps_wall_loads") + fi
          ["results/report/55_mps.md"], timing=["results/timing/55_mps.md"])
 
 
-rule mps_bench_fragment:
+use rule call as mps_bench_fragment with:
     input:
         bench="benchmarks/results/mps_step_cost.csv",
         code=code("methods.mps.report"),
@@ -169,16 +121,8 @@ rule mps_bench_fragment:
         "results/bench/55_mps.md",
     params:
         func="methods.mps.report.bench_fragment",
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/mps/bench_fragment.log",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
 register(bench=["results/bench/55_mps.md"])

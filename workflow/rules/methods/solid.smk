@@ -60,7 +60,7 @@ SOLID_BLOCK = [(os.path.basename(f)[:-3].rsplit("_", 1), f) for f in SOLID_RUNS 
     (["floor_uniform", "uniform_load"], "results/solid/floor_uniform_uniform_load.nc")]
 
 
-rule solid_cases:
+use rule call as solid_cases with:
     input:
         cfg=SOLID_CFG,
         code=SOLID_NEW_CODE,
@@ -69,8 +69,6 @@ rule solid_cases:
     params:
         func="methods.solid.outputs.run_cases",
         kw={"cases": [c for c, _ in SOLID_BLOCK]},
-    conda:
-        "../../envs/isaflow.yaml"
     message:
         f"solid_cases: {len(SOLID_BLOCK)} runs in one process"
     resources:
@@ -78,13 +76,11 @@ rule solid_cases:
         runtime=SOLID["runtime"] * 4,
     log:
         "logs/solid/cases.log",
-    script:
-        "../../scripts/call.py"
 
 
 # the elastic floor under each tank method's liquid (its first compared single-vessel run): one job, after the
 # solid cases' job has filled the solid's kernel cache (ancient: their dates do not matter)
-rule solid_floors_oneway:
+use rule call as solid_floors_oneway with:
     input:
         cfg=SOLID_CFG,
         loads=lambda wc: [first_run(m, "single") for m in SOLID_FLOOR_LOADS],
@@ -95,19 +91,15 @@ rule solid_floors_oneway:
     params:
         func="methods.solid.outputs.run_cases",
         kw={"cases": [[f"floor_{src}", "oneway"] for src in SOLID_FLOOR_LOADS]},
-    conda:
-        "../../envs/isaflow.yaml"
     message:
         f"solid_floors_oneway: {len(SOLID_FLOOR_LOADS)} runs in one process"
     resources:
         **SOLID,
     log:
         "logs/solid/floors_oneway.log",
-    script:
-        "../../scripts/call.py"
 
 
-rule solid_figures_44:
+use rule call as solid_figures_44 with:
     input:
         cfg=SOLID_CFG,
         runs=SOLID_NEW_RUNS,
@@ -117,19 +109,11 @@ rule solid_figures_44:
         SOLID_FIGURES_44,
     params:
         func="methods.solid.figures.vessel_and_floor",
-    conda:
-        "../../envs/isaflow.yaml"
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/solid/figures_44.log",
-    script:
-        "../../scripts/call.py"
 
 
-rule solid_figures:
+use rule call as solid_figures with:
     input:
         cfg=SOLID_CFG,
         runs=SOLID_RUNS,
@@ -138,19 +122,11 @@ rule solid_figures:
         SOLID_FIGURES_41_43,
     params:
         func="methods.solid.figures.bar_and_hertz",
-    conda:
-        "../../envs/isaflow.yaml"
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/solid/figures.log",
-    script:
-        "../../scripts/call.py"
 
 
-rule solid_report:
+use rule call as solid_report with:
     input:
         runs=SOLID_RUNS + SOLID_NEW_RUNS + SOLID_CLAIM_RUNS,
         claims="results/claims/registry/marko2017.csv",
@@ -160,16 +136,8 @@ rule solid_report:
         "results/timing/65_solid.md",
     params:
         func="methods.solid.report.report",
-    conda:
-        "../../envs/isaflow.yaml"
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/solid/report.log",
-    script:
-        "../../scripts/call.py"
 
 
 # the solid runs the claims read (claims.smk): 'solid:<case>_<variant>'

@@ -12,7 +12,7 @@ SPH_FLOW = [run_file("sph", r) for r, d in _SPH_RUNS.items() if d["tank"] != "si
 SPH_FIGURES = [f for name in ("sph_single", "sph_flow", "sph_flow_snapshots") for f in figure(name)]
 
 
-rule sph_summary:
+use rule call as sph_summary with:
     input:
         runs=SPH_FILES,
         code=code("methods.sph.outputs"),
@@ -20,19 +20,11 @@ rule sph_summary:
         "results/sph/summary.csv",
     params:
         func="methods.sph.outputs.summary",
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/sph/summary.log",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
-rule sph_figures:
+use rule call as sph_figures with:
     input:
         single_runs=SPH_SINGLE,
         flow_runs=SPH_FLOW,
@@ -41,19 +33,11 @@ rule sph_figures:
         SPH_FIGURES,
     params:
         func="methods.sph.figures.all_figures",
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/sph/figures.log",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
-rule sph_report:
+use rule call as sph_report with:
     input:
         summary="results/sph/summary.csv",
         code=code("methods.sph.report"),
@@ -62,16 +46,8 @@ rule sph_report:
         "results/timing/50_sph.md",
     params:
         func="methods.sph.report.write",
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/sph/report.log",
-    conda:
-        "../../envs/isaflow.yaml"
-    script:
-        "../../scripts/call.py"
 
 
 rule sph_bench:

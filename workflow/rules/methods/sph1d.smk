@@ -12,7 +12,7 @@ register(SPH1D_FIGURES + ["results/sph1d/summary.csv"], ["results/report/60_sph1
          timing=["results/timing/60_sph1d.md"])
 
 
-rule sph1d_sweep:
+use rule call as sph1d_sweep with:
     input:
         settings_path=SPH1D_SETTINGS,
         code=SPH1D_CODE,
@@ -20,16 +20,10 @@ rule sph1d_sweep:
         "results/sph1d/sweep.nc",
     params:
         func="methods.sph1d.pipeline.run_sweep",
-    conda:
-        "../../envs/isaflow.yaml"
-    message:
-        JOB
     resources:
         **SOLID,
     log:
         "logs/sph1d/sweep.log",
-    script:
-        "../../scripts/call.py"
 
 
 # the sweep at other values of two registry inputs (config/methods/sph1d.yaml resolutions; sensitivity only):
@@ -62,7 +56,7 @@ for _res in ("n8192", "surface_top"):
     OTHER_RUN_FILES[f"sph1d:sweep_{_res}"] = f"results/sph1d/sweep_{_res}.nc"
 
 
-rule sph1d_cases:
+use rule call as sph1d_cases with:
     input:
         sweep_nc="results/sph1d/sweep.nc",
         registry=SPH1D_REGISTRY,
@@ -72,19 +66,11 @@ rule sph1d_cases:
         "results/sph1d/summary.csv",
     params:
         func="methods.sph1d.pipeline.make_cases",
-    conda:
-        "../../envs/isaflow.yaml"
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/sph1d/cases.log",
-    script:
-        "../../scripts/call.py"
 
 
-rule sph1d_figures:
+use rule call as sph1d_figures with:
     input:
         settings_path=SPH1D_SETTINGS,
         sweep_nc="results/sph1d/sweep.nc",
@@ -96,19 +82,11 @@ rule sph1d_figures:
         SPH1D_FIGURES,
     params:
         func="methods.sph1d.pipeline.make_figures",
-    conda:
-        "../../envs/isaflow.yaml"
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/sph1d/figures.log",
-    script:
-        "../../scripts/call.py"
 
 
-rule sph1d_report:
+use rule call as sph1d_report with:
     input:
         settings_path=SPH1D_SETTINGS,
         sweep_nc="results/sph1d/sweep.nc",
@@ -122,16 +100,8 @@ rule sph1d_report:
         "results/timing/60_sph1d.md",
     params:
         func="methods.sph1d.pipeline.make_report",
-    conda:
-        "../../envs/isaflow.yaml"
-    message:
-        JOB
-    resources:
-        **SMALL,
     log:
         "logs/sph1d/report.log",
-    script:
-        "../../scripts/call.py"
 
 
 # the sweep the claims read (claims.smk)
