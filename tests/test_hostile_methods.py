@@ -399,6 +399,19 @@ def test_the_workflow_refuses_bad_inputs_while_it_is_parsed(tmp_path, case):
     _parse_refuses(proj, field, "-c1")
 
 
+def test_a_tank_method_without_a_compared_single_vessel_run_is_refused(tmp_path):
+    """The comparison, the integration target and the solid floor under each tank method's liquid read its first
+    compared run on `single`: a method that declares none is refused in one line (it failed while the DAG was
+    built)."""
+    proj = _project(tmp_path)
+    path = proj / "config" / "methods" / "mps.yaml"
+    text = path.read_text()
+    lines = [line.replace(", compare: true", "") if "{tank: single," in line else line for line in text.splitlines(True)]
+    assert "".join(lines) != text
+    path.write_text("".join(lines))
+    _parse_refuses(proj, "config/methods/mps.yaml: field 'runs': a tank method needs a run on tank 'single'", "-c1")
+
+
 PARSE_ARGS = {
     "cores_zero": (["-c0"], "'--cores'"),
     "cores_negative": (["--cores", "-1"], "'--cores'"),

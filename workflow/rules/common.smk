@@ -331,6 +331,10 @@ def check_inputs():
                 raise _inputs.InputError(f"config/config.yaml: field 'compare.tanks': {err}") from None
         for method in TANK_METHODS:
             d.check(method, RUNS[method])
+            # the comparison, the integration target and the solid floor under its liquid read its first one
+            if not any(r.get("compare") and r["tank"] == "single" for r in RUNS[method].values()):
+                raise _inputs.InputError(f"{REGISTRY[method].settings}: field 'runs': a tank method needs a run on "
+                                         f"tank 'single' with compare: true (none declared)")
         for name, m in REGISTRY.items():
             if not m.tank:
                 _preflight.check_file(name)
