@@ -105,12 +105,6 @@ def func_code(func):
     return code(func.rsplit(".", 1)[0])
 
 
-# Run declarations of every tank method: {method: {run id: {tank, variant, resolution, set, accept,
-# start, threads, compare, label, meta}}} (isaflow.settings.RUN_SCHEMA); each method's rules file
-# declares its runs with declare_runs(); the one rule `run` (runs.smk) makes them.
-RUNS = {name: {} for name in TANK_METHODS}
-
-
 def settings_runs(method):
     """The runs section of a tank method's settings file (read by the one loader, refused on any error)."""
     from isaflow import settings as _settings
@@ -120,6 +114,13 @@ def settings_runs(method):
         return _settings.read(m.settings, m.values_schema(), f"{method} settings").get("runs", {})
     except _inputs.InputError as err:
         refuse(err)
+
+
+# Run declarations of every tank method: {method: {run id: {tank, variant, resolution, set, accept,
+# start, threads, compare, label, meta}}} (isaflow.settings.RUN_SCHEMA): the runs section of each tank method's
+# settings file, from the registry (a method needs no rules file to have its runs made); a rules file adds
+# the runs it generates (e.g. ISA's study plan) with declare_runs(); the one rule `run` (runs.smk) makes them.
+RUNS = {name: dict(settings_runs(name)) for name in TANK_METHODS}
 
 
 def declare_runs(method, runs):

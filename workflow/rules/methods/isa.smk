@@ -29,7 +29,7 @@ except (_inputs.InputError, KeyError) as _err:
 for _sid in STUDY_RUNS:
     if STUDY_RUNS[_sid]["meta"]["group"] == "error_runtime":
         STUDY_RUNS[_sid]["runtime"] = True  # single-vessel points of the methods' error-against-run-time figure
-declare_runs("isa", {**ISA_RUNS, **STUDY_RUNS, **CAL_RUNS})
+declare_runs("isa", {**STUDY_RUNS, **CAL_RUNS})  # its settings file's runs are declared already (common.smk)
 STUDY_META = _isa_plan.meta(STUDY_RUNS)
 # groups of runs the claims read (claims.smk)
 RUN_GROUPS.update({"isa:error_vs_runtime": _isa_plan.run_files(STUDY_RUNS, "error_runtime"),

@@ -4,7 +4,6 @@
 # claims.smk, measures in methods/mps/claims.py).
 # Package: src/isaflow/methods/mps/.
 _MPS_RUNS = settings_runs("mps")
-declare_runs("mps", _MPS_RUNS)
 MPS_FILES = [run_file("mps", r) for r in _MPS_RUNS]
 MPS_SINGLE = [run_file("mps", r) for r in _MPS_RUNS if r.startswith("single_")]
 MPS_BEFORE = [run_file("mps", r) for r in _MPS_RUNS if r.startswith("kog_")]  # the settings before issue 30

@@ -2,7 +2,6 @@
 # single vessel, both flow tanks, stability cases) go through the shared rule `run`; here the summary,
 # figures, claims, report fragment 50 and timing fragment.  Package: src/isaflow/methods/sph/.
 _SPH_RUNS = settings_runs("sph")
-declare_runs("sph", _SPH_RUNS)
 # the periodic blocks (tensile-instability test, settings.domain periodic_block) load no wall: claims only
 _SPH_BLOCKS = [r for r, d in _SPH_RUNS.items()
                if d.get("set", {}).get("settings.domain", {}).get("value") == "periodic_block"]
