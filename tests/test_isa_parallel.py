@@ -19,7 +19,6 @@ import numpy as np
 import pytest
 
 from isaflow.core import neighbours as NB
-from isaflow.methods.isa import cells as C
 from isaflow.methods.isa import relax as R
 from isaflow.methods.isa import scene as S
 from isaflow.methods.isa import solver
@@ -125,8 +124,8 @@ def test_parallel_neighbour_list_equals_cell_rows(seed, nb):
     nbr_ref, cs_ref = NB.cell_rows(pos, box, rc, ref[0], ref[1], ref[2], np.empty(16, np.int32))
     for hint in (8.0, 0.1):  # 0.1: the blocks' scratch overflows and the serial search takes over
         order, row_start = np.empty(n, np.int32), np.empty(n + 1, np.int32)
-        nbr, cs = C.cell_rows_par(pos, box, rc, order, np.empty(1, np.int32), row_start, np.empty(16, np.int32), nb,
-                                  hint)
+        nbr, cs = NB.cell_rows_par(pos, box, rc, order, np.empty(1, np.int32), row_start, np.empty(16, np.int32), nb,
+                                   hint)
         m = row_start[n]
         assert m == ref[2][n] > 10 * n
         assert np.array_equal(order, ref[0]) and np.array_equal(row_start, ref[2]) and np.array_equal(cs, cs_ref)

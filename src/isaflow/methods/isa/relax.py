@@ -32,7 +32,7 @@ from numba import prange
 from ...core.jit import njit
 
 from ...core.geometry import crossed_wall, segment_closest
-from .cells import cell_rows_par
+from ...core.neighbours import cell_rows_par
 from .forces import pair_push, track_max, wall_push
 
 JIT = dict(cache=True, nogil=True)
