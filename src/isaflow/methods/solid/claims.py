@@ -733,13 +733,20 @@ def worst(x):
     return float(np.inf if np.isnan(x).any() else np.abs(x).max())
 
 
-def pmax_error(ctx, e):
-    """mar-4.3-pmax-error: peak contact pressure against eq. 25 at every depth, paper variant."""
+def hertz_judged(ctx, e, key):
+    """The Hertz paper-variant run judged on one error (key 'p': peak pressure, 'line': load; hertz_errors) in plane
+    strain: (tolerance, depths um, paper variant's errors, hooke's, paper's status, its increments at rest, the
+    judged errors, all within the tolerance)."""
     lim = tol(e)
     d, ep, st, conv = hertz_row(ctx, "hertz_paper", N_DEPTHS)
-    _, eh, sth, convh = hertz_row(ctx, "hertz_hooke", N_DEPTHS)
-    err = ep["plane strain"]["p"]
-    ok = worst(err) <= lim
+    eh = hertz_row(ctx, "hertz_hooke", N_DEPTHS)[1]
+    err = ep["plane strain"][key]
+    return lim, d, ep, eh, st, conv, err, worst(err) <= lim
+
+
+def pmax_error(ctx, e):
+    """mar-4.3-pmax-error: peak contact pressure against eq. 25 at every depth, paper variant."""
+    lim, d, ep, eh, st, conv, err, ok = hertz_judged(ctx, e, "p")
     return measurement(
         f"paper variant: {fmt_list(err)} at {fmt_list(d, '{:g}')} um ({conv} of {N_DEPTHS} increments at rest, {st}); "
         f"hooke (completion): {fmt_list(eh['plane strain']['p'])}", ok,
@@ -753,11 +760,7 @@ def pmax_error(ctx, e):
 
 def load_error(ctx, e):
     """mar-4.3-load-error: the numerically integrated load against the Hertz line contact at every depth."""
-    lim = tol(e)
-    d, ep, st, conv = hertz_row(ctx, "hertz_paper", N_DEPTHS)
-    _, eh, _, _ = hertz_row(ctx, "hertz_hooke", N_DEPTHS)
-    err = ep["plane strain"]["line"]
-    ok = worst(err) <= lim
+    lim, d, ep, eh, st, _, err, ok = hertz_judged(ctx, e, "line")
     return measurement(
         f"paper variant: {fmt_list(err)} at {fmt_list(d, '{:g}')} um ({st}); hooke (completion): "
         f"{fmt_list(eh['plane strain']['line'])}", ok,
