@@ -59,6 +59,11 @@ class Out:
     partial: str = ""  # runs an aggregate left out in a sweep (no stand-in)
 
 
+def not_swept(left):
+    """Out.partial of an aggregate that left out the runs ``left`` in a sweep ('' if none)."""
+    return ("not swept: " + ", ".join(left)) if left else ""
+
+
 class View:
     """The context seen under one value of an inferred input: run keys substituted (subs), runs the value
     changes without a stand-in refused (affected(key) -> NoRun), reading parameters (params), and the
@@ -84,11 +89,7 @@ class View:
         return self.ctx.has(key) and self.ctx.run(key).attrs.get("status") == "converged"
 
     def run(self, key):
-        k = self.key(key)
-        ds = self.ctx.run(k)
-        if k not in self.read:
-            self.read.append(k)
-        return ds
+        return self._read(key, self.ctx.run)
 
     def opt(self, key):
         """The run, or None when it is missing or the swept value has no stand-in for it."""
@@ -97,9 +98,24 @@ class View:
         except (Missing, NoRun):
             return None
 
+    def tolerant(self, left, read, *args):
+        """read(*args), or None where a sweep's aggregate (a partial view) reads a run its value has no stand-in
+        for: the run's id is then appended to left (elsewhere NoRun propagates)."""
+        try:
+            return read(*args)
+        except NoRun as err:
+            if not self.partial:
+                raise
+            left.append(err.args[0].removeprefix(ISA))
+            return None
+
     def group(self, key):
+        return self._read(key, self.ctx.group)
+
+    def _read(self, key, read):
+        """read(the key under this view) (ctx.run or ctx.group), the key kept among those read (the evidence)."""
         k = self.key(key)
-        out = self.ctx.group(k)
+        out = read(k)
         if k not in self.read:
             self.read.append(k)
         return out
@@ -576,29 +592,20 @@ def converges(view, e):
     keys = ["single_coarse", "single_refined", "flow_complete", "flow_refined_complete"]
     rows, n_ok, left = [], 0, []
     for k in keys:
-        try:
-            step, ds, words = outcome(view, k)
-        except NoRun as err:
-            if not view.partial:
-                raise
-            left.append(err.args[0].removeprefix(ISA))
+        got = view.tolerant(left, outcome, view, k)
+        if got is None:
             continue
+        step, ds, words = got
         n_ok += step is not None
         rows.append(f"{k}: {words}")
-    try:
-        group = view.group("isa:error_vs_runtime")
-    except NoRun:
-        if not view.partial:
-            raise
-        group = {}
-        left.append("error_vs_runtime")
+    group = view.tolerant(left, view.group, "isa:error_vs_runtime") or {}
     for rid, ds in sorted(group.items()):
         if ds.attrs["variant"] != "paper" or not rid.endswith("_du1"):
             continue
         n_ok += ds.attrs["status"] == "converged"
         rows.append(f"{rid}: {ds.attrs['status']} at step {int(ds['steps']):,}")
     return Out(n_ok == len(rows), "; ".join(rows), short=f"{n_ok} of {len(rows)} converge",
-               partial=("not swept: " + ", ".join(left)) if left else "",
+               partial=not_swept(left),
                why="the paper's update x += du F / max|F| is gradient descent with gain du / max|F|: unstable along "
                    "the stiffest mode once max|F| < lambda_max du / 2, it settles in a period-2 cycle at that floor "
                    "(15.9 N coarse, 4.0 N refined) instead of reaching 0.1 N",
@@ -639,18 +646,14 @@ def rigid(view, e):
     bound = tol(e)
     rows, worst, left = [], 0.0, []
     for k in ("single_coarse", "single_refined", "single_coarse_capped", "single_refined_capped"):
-        try:
-            ds = view.run(k)
-        except NoRun as err:
-            if not view.partial:
-                raise
-            left.append(err.args[0].removeprefix(ISA))
+        ds = view.tolerant(left, view.run, k)
+        if ds is None:
             continue
         c = IM.compressibility(ds)
         worst = max(worst, c["rhomb_loss_max"])
         rows.append(f"{k}: interior rhombs lose at most {c['rhomb_loss_max']:.1%} (mean {c['rhomb_loss_mean']:.1%})")
     return Out(worst <= bound, "; ".join(rows) + f" (bound {bound:.2%})", short=f"max loss {worst:.1%}",
-               partial=("not swept: " + ", ".join(left)) if left else "",
+               partial=not_swept(left),
                margin=f"flips if the largest loss falls to {bound:.2%}",
                why="once the vertical diagonal comes within l_pu it pushes with the same linear law as the sides: it "
                    "resists but does not stop compression, and the weight of the column above compresses interior "
@@ -702,13 +705,9 @@ def incompressible(view, e):
         worst = max(worst, loss)
         rows.append(f"{k}: {loss:.1%} ({level(view, ds):.2f} cm from {init:.2f} cm)")
     left = []
-    try:
-        fc, sc = view.run("flow_complete"), view.run("single_coarse")
-    except NoRun as err:
-        if not view.partial:
-            raise
-        left.append(err.args[0].removeprefix(ISA))
-    else:
+    both = view.tolerant(left, lambda: (view.run("flow_complete"), view.run("single_coarse")))
+    if both is not None:
+        fc, sc = both
         v2, v1 = M.vessel_view(fc, second(fc)), M.vessel_view(sc)
         per2 = v2["width"] * (level(view, fc, second(fc)) - v2["floor_y"]) / int(v2["inside"].sum())
         per0 = v1["width"] * (_initial_level(view, sc) - v1["floor_y"]) / sc.sizes["particle"]
@@ -717,7 +716,7 @@ def incompressible(view, e):
         rows.append(f"flow_complete, second vessel: {loss:.1%} (area per particle {per2:.1f} against {per0:.1f} cm^2)")
     return Out(worst <= bound, "area per particle lost against the initial lattice (same level definition): "
                                + "; ".join(rows) + f" (bound {bound:.2%})", short=f"worst {worst:.1%}",
-               partial=("not swept: " + ", ".join(left)) if left else "",
+               partial=not_swept(left),
                margin=f"flips if the largest loss falls to {bound:.2%}",
                why="the lattice compacts by a fifth of its area under its own weight: the activated diagonals are "
                    "linear springs, not rigid bars")
@@ -1311,12 +1310,8 @@ def isa_oscillations(view, e):
     t = tol(e)
     rows, ok, left = [], True, []
     for k in ("single_coarse", "single_refined", "flow_complete"):
-        try:
-            ds = view.run(k)
-        except NoRun as err:
-            if not view.partial:
-                raise
-            left.append(err.args[0].removeprefix(ISA))
+        ds = view.tolerant(left, view.run, k)
+        if ds is None:
             continue
         st = ds.attrs["status"]
         c = IM.convergence_measures(ds)
@@ -1329,7 +1324,7 @@ def isa_oscillations(view, e):
     cap = view.opt("single_coarse_capped")
     rep = f"; single_coarse_capped (an added technique, not judged): {cap.attrs['status']}" if cap is not None else ""
     return Out(ok, "; ".join(rows) + rep, short=f"{sum('converged' in r.split(',')[0] for r in rows)} of {len(rows)} reach 0.1 N",
-               partial=("not swept: " + ", ".join(left)) if left else "",
+               partial=not_swept(left),
                margin=f"band width against f_tol = {t:g} N",
                why="the paper's update, with no added technique, ends in a sustained period-2 oscillation of "
                    "max|F| (the highest frequency a stepping method carries) wider than f_tol")
