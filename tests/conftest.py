@@ -22,17 +22,26 @@ ISA_SETTINGS = ROOT / "config" / "methods" / "isa.yaml"
 L_B, R_B = 5.0, 10000.0  # wall: l_bu, R_bu (k_b = 2000 N/cm)
 L_P, R_P = 7.0710678, 3535.5339  # pair: l_pu = a / sqrt(2), R_pu (k_p = 500 N/cm)
 OUTCOMES = ["converged", "cycle", "step_limit", "escaped", "nonfinite"]  # the ISA solver's outcomes
-BOX = [{"name": "left", "from": [0, 20], "to": [0, 0]}, {"name": "floor", "from": [0, 0], "to": [20, 0]},
-       {"name": "right", "from": [20, 0], "to": [20, 20]}]
+LAWS = {"wall": {"law": "linear", "l_u": L_B, "r_u": R_B}, "pair": {"law": "linear", "l_u": L_P, "r_u": R_P}}
+
+
+def vessel(width, height):
+    """Walls mapping [cm] of an open vessel from the origin: left wall, floor, right wall."""
+    return [{"name": "left", "from": [0, height], "to": [0, 0]}, {"name": "floor", "from": [0, 0], "to": [width, 0]},
+            {"name": "right", "from": [width, 0], "to": [width, height]}]
+
+
+def coarse_lattice(rows, row_lengths, center_x):
+    """Particles mapping of the coarse lattice (a = 10 cm, w = 50 N), rows of row_lengths alternating, centred
+    at center_x [cm], the bottom row at y = 5 cm."""
+    return {"weight": 50.0, "lattice": {"a": 10.0, "rows": rows, "row_lengths": row_lengths, "center_x": center_x,
+                                        "bottom_y": 5.0}}
+
+
+BOX = vessel(20, 20)
 # four particles of the coarse lattice in a 20 cm box (w = 50 N, k_b = 2000, k_p = 500 N/cm)
-TINY = {
-    "name": "tiny",
-    "walls": BOX,
-    "particles": {"weight": 50.0, "lattice": {"a": 10.0, "rows": 3, "row_lengths": [1, 2], "center_x": 10.0,
-                                              "bottom_y": 5.0}},
-    "forces": {"wall": {"law": "linear", "l_u": L_B, "r_u": R_B}, "pair": {"law": "linear", "l_u": L_P, "r_u": R_P}},
-    "solver": {"variant": "capped", "du": 0.01, "f_tol": 0.1, "max_steps": 20000},
-}
+TINY = {"name": "tiny", "walls": BOX, "particles": coarse_lattice(3, [1, 2], 10.0), "forces": LAWS,
+        "solver": {"variant": "capped", "du": 0.01, "f_tol": 0.1, "max_steps": 20000}}
 TINY_TANK = {"name": "tiny", "walls": BOX, "liquid": {"weight": 200.0, "depth": 10.0}}
 
 

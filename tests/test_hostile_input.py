@@ -22,9 +22,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from conftest import ROOT, TINY, settings_spec, write_spec
+from conftest import ROOT, TINY, settings_spec, vessel, write_spec
 
-from isaflow import cli, runfile
+from isaflow import cli, methods, runfile
 
 CORPUS = Path(__file__).parent / "data" / "hostile"
 
@@ -235,16 +235,12 @@ def test_unknown_variant_resolution_and_outcome_are_refused(tmp_path, capsys):
 RESOURCE_CASES = {
     "1e10_particles": ([("particles.lattice.rows", 100_000), ("particles.lattice.row_lengths", [100_000]),
                         ("particles.lattice.a", 0.5), ("particles.lattice.center_x", 2.75e4),
-                        ("walls", [{"name": "left", "from": [0, 3e4], "to": [0, 0]},
-                                   {"name": "floor", "from": [0, 0], "to": [5.5e4, 0]},
-                                   {"name": "right", "from": [5.5e4, 0], "to": [5.5e4, 3e4]}])], "'particles.lattice'"),
+                        ("walls", vessel(5.5e4, 3e4))], "'particles.lattice'"),
     "chunk_1e12": ([("solver.chunk", 10**12), ("solver.max_steps", 10**12)], "'solver.chunk'"),
     "records_every_step": ([("solver.max_steps", 10**15), ("solver.history", {"every": 1})],
                            "'solver.history.every'"),
     "snapshots_of_1e6_particles": ([("particles.lattice.rows", 1000), ("particles.lattice.row_lengths", [1000]),
-                                    ("walls", [{"name": "left", "from": [0, 6000], "to": [0, 0]},
-                                               {"name": "floor", "from": [0, 0], "to": [11000, 0]},
-                                               {"name": "right", "from": [11000, 0], "to": [11000, 6000]}]),
+                                    ("walls", vessel(11000, 6000)),
                                     ("particles.lattice.center_x", 5500.0), ("solver.max_steps", 10**15),
                                     ("solver.history", {"snapshots": 10**6})], "'solver.history.snapshots'"),
     "grid_of_1e15_cells": ([("forces.pair.l_u", 1e-6), ("forces.pair.r_u", 1e-3), ("solver.du", 1e-7)],
@@ -510,14 +506,7 @@ def test_a_run_started_at_its_step_limit_computes_its_forces_once(tmp_path):
     assert res.status == "step_limit" and res.residual == np.abs(res.fields["force"][1]).max() > 1.0
 
 
-# Method settings files (config/methods/*.yaml) go through the same reader and checks as scenes.
-METHOD_SETTINGS = {
-    "isa": ("config/methods/isa.yaml", "isaflow.settings"),
-    "sph": ("config/methods/sph.yaml", "isaflow.methods.sph.settings"),
-    "mps": ("config/methods/mps.yaml", "isaflow.methods.mps.settings"),
-    "sph1d": ("config/methods/sph1d.yaml", "isaflow.methods.sph1d.settings"),
-    "solid": ("config/methods/solid.yaml", "isaflow.methods.solid.settings"),
-}
+# Method settings files (config/methods/*.yaml, the registry's) go through the same reader and checks as scenes.
 SETTINGS_MUTATIONS = {
     "alias": lambda t: "base: &a {value: 1}\n" + t,
     # the first top-level key again at the end
@@ -529,18 +518,19 @@ SETTINGS_MUTATIONS = {
 
 
 @pytest.mark.parametrize("mutation", sorted(SETTINGS_MUTATIONS))
-@pytest.mark.parametrize("method", sorted(METHOD_SETTINGS))
+@pytest.mark.parametrize("method", sorted(methods.PACKAGES))
 def test_bad_method_settings_are_refused_naming_the_file(tmp_path, method, mutation):
+    """ISA's settings by the one reader (isaflow.settings.read), every other method's by its settings module's load."""
     import importlib
 
-    src, module = METHOD_SETTINGS[method]
+    m = methods.get(method)
     bad = tmp_path / f"{method}_{mutation}.yaml"
-    bad.write_text(SETTINGS_MUTATIONS[mutation]((ROOT / src).read_text()))
+    bad.write_text(SETTINGS_MUTATIONS[mutation]((ROOT / m.settings).read_text()))
     with pytest.raises(ValueError, match=f"^{bad}: ") as err:
         if method == "isa":
-            from isaflow.methods.isa.settings import VALUES
+            from isaflow import settings
 
-            importlib.import_module(module).read(bad, VALUES)
+            settings.read(bad, m.values_schema())
         else:
-            importlib.import_module(module).load(bad)
+            importlib.import_module(m.values.split(":")[0]).load(bad)
     assert "\n" not in str(err.value)

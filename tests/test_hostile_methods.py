@@ -17,7 +17,7 @@ import time
 
 import pytest
 import yaml
-from conftest import ROOT
+from conftest import ROOT, vessel
 
 from isaflow import budget, cli, preflight, settings, tank as tanks
 from isaflow.inputs import InputError
@@ -56,8 +56,7 @@ def _tank(base=SINGLE, **change):
     return spec
 
 
-W = [{"name": "left", "from": [0, 100], "to": [0, 0]}, {"name": "floor", "from": [0, 0], "to": [100, 0]},
-     {"name": "right", "from": [100, 0], "to": [100, 100]}]
+W = vessel(100, 100)
 TANK_CASES = {
     "depth_above_walls": (_tank(liquid={"weight": 9000.0, "depth": 150.0}), "'liquid.depth'"),
     "depth_zero": (_tank(liquid={"weight": 9000.0, "depth": 0.0}), "'liquid.depth"),
@@ -179,10 +178,8 @@ def test_bad_method_settings_are_refused_with_their_reason(tmp_path, capsys, cas
 
 
 # ---- a derived number names the input it follows: the tank's field when the tank's liquid or walls are its cause
-BIG = [{"name": "left", "from": [0, 7e5], "to": [0, 0]}, {"name": "floor", "from": [0, 0], "to": [7e5, 0]},
-       {"name": "right", "from": [7e5, 0], "to": [7e5, 7e5]}]
-TALL = [{"name": "left", "from": [0, 2e6], "to": [0, 0]}, {"name": "floor", "from": [0, 0], "to": [100, 0]},
-        {"name": "right", "from": [100, 0], "to": [100, 2e6]}]
+BIG = vessel(7e5, 7e5)
+TALL = vessel(100, 2e6)
 BLAME_CASES = {
     # a 1e-9 cm liquid was reported as the method's resolution.particles / resolution.spacing
     "depth_1e-9_sph": ("sph", _tank(liquid={"weight": 9000.0, "depth": 1e-9}), "'liquid.depth'"),

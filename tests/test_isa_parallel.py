@@ -18,8 +18,9 @@ import numba
 import numpy as np
 import pytest
 
+from conftest import coarse_lattice, vessel
+
 from isaflow.core import neighbours as NB
-from isaflow.methods.isa import cells as C
 from isaflow.methods.isa import relax as R
 from isaflow.methods.isa import scene as S
 from isaflow.methods.isa import solver
@@ -125,8 +126,8 @@ def test_parallel_neighbour_list_equals_cell_rows(seed, nb):
     nbr_ref, cs_ref = NB.cell_rows(pos, box, rc, ref[0], ref[1], ref[2], np.empty(16, np.int32))
     for hint in (8.0, 0.1):  # 0.1: the blocks' scratch overflows and the serial search takes over
         order, row_start = np.empty(n, np.int32), np.empty(n + 1, np.int32)
-        nbr, cs = C.cell_rows_par(pos, box, rc, order, np.empty(1, np.int32), row_start, np.empty(16, np.int32), nb,
-                                  hint)
+        nbr, cs = NB.cell_rows_par(pos, box, rc, order, np.empty(1, np.int32), row_start, np.empty(16, np.int32), nb,
+                                   hint)
         m = row_start[n]
         assert m == ref[2][n] > 10 * n
         assert np.array_equal(order, ref[0]) and np.array_equal(row_start, ref[2]) and np.array_equal(cs, cs_ref)
@@ -149,11 +150,7 @@ def test_near_wall_list_holds_exactly_the_particles_within_reach():
 
 
 TINY = {
-    "name": "wide", "walls": [{"name": "left", "from": [0, 100], "to": [0, 0]},
-                              {"name": "floor", "from": [0, 0], "to": [2410, 0]},
-                              {"name": "right", "from": [2410, 0], "to": [2410, 100]}],
-    "particles": {"weight": 50.0, "lattice": {"a": 10.0, "rows": 19, "row_lengths": [240, 241], "center_x": 1205.0,
-                                              "bottom_y": 5.0}},
+    "name": "wide", "walls": vessel(2410, 100), "particles": coarse_lattice(19, [240, 241], 1205.0),
     "forces": {"wall": {"law": "linear", "l_u": L_B, "r_u": R_B}, "pair": {"law": "linear", "l_u": L_P, "r_u": R_P}},
     "solver": {"variant": "paper", "du": 0.01, "f_tol": 0.1, "max_steps": 1500, "chunk": 1000,
                "accept": ["step_limit"], "history": {"every": 7}},

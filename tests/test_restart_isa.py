@@ -17,18 +17,15 @@ split step on, chunk-end samples after it.
 
 import numpy as np
 import pytest
-from conftest import L_B, L_P, R_B, R_P, run_spec
+from conftest import LAWS, coarse_lattice, run_spec, vessel
 
 from isaflow import runfile
 
-WALLS = [{"name": "left", "from": [0, 80], "to": [0, 0]}, {"name": "floor", "from": [0, 0], "to": [80, 0]},
-         {"name": "right", "from": [80, 0], "to": [80, 80]}]
 SCENE = {
     "name": "restart",
-    "walls": WALLS,
-    "particles": {"weight": 50.0, "lattice": {"a": 10.0, "rows": 9, "row_lengths": [2, 3], "center_x": 15.0,
-                                              "bottom_y": 5.0}},
-    "forces": {"wall": {"law": "linear", "l_u": L_B, "r_u": R_B}, "pair": {"law": "linear", "l_u": L_P, "r_u": R_P}},
+    "walls": vessel(80, 80),
+    "particles": coarse_lattice(9, [2, 3], 15.0),
+    "forces": LAWS,
     "solver": {"variant": "paper", "du": 0.01, "f_tol": 0.1, "max_steps": 8000, "chunk": 1000, "skin": 4.0,
                "accept": ["converged", "cycle", "step_limit"], "history": {"every": 7, "walls": True}},
 }
@@ -41,11 +38,7 @@ OWN = {"pos0", "start_step", "force_evals", "wall_time"}  # properties of the co
 
 
 # the same lattice settled in a 40 cm vessel: the paper's rule ends in a limit cycle
-SETTLED = {**SCENE, "walls": [{"name": "left", "from": [0, 60], "to": [0, 0]},
-                              {"name": "floor", "from": [0, 0], "to": [40, 0]},
-                              {"name": "right", "from": [40, 0], "to": [40, 60]}],
-           "particles": {"weight": 50.0, "lattice": {"a": 10.0, "rows": 7, "row_lengths": [3, 4], "center_x": 20.0,
-                                                     "bottom_y": 5.0}}}
+SETTLED = {**SCENE, "walls": vessel(40, 60), "particles": coarse_lattice(7, [3, 4], 20.0)}
 
 
 def run(tmp_path, name, rule, *sets, base=SCENE, start=None):

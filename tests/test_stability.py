@@ -9,7 +9,7 @@ import pytest
 from isaflow import runfile
 from isaflow.methods.isa import tables
 
-from conftest import BOX, OUTCOMES as ALL, TINY, run_spec
+from conftest import BOX, OUTCOMES as ALL, TINY, run_spec, vessel
 from isaflow.core import geometry as GEO
 from isaflow.methods.isa import relax as R
 
@@ -114,7 +114,7 @@ def test_nonfinite_forces_stop_the_run(tmp_path):
 def test_no_outcome_hides_nan_or_a_tunnelled_particle(tmp_path, variant, du):
     """Across step lengths up to a = 10 cm, every run either keeps all particles finite
     and inside the walls or says why not."""
-    walls = [{"name": "left", "from": [0, 40], "to": [0, 0]}, BOX[1], {"name": "right", "from": [20, 0], "to": [20, 40]}]
+    walls = vessel(20, 40)
     spec = scene(walls=walls, particles={**TINY["particles"], "lattice": {**TINY["particles"]["lattice"], "rows": 5}},
                  solver={"variant": variant, "du": du, "max_steps": 5000})
     ds = run(tmp_path, spec)

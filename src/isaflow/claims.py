@@ -3,7 +3,8 @@
 The claims are the registry (config/claims/<paper>.yaml, isaflow.claims_registry): quote, kind,
 the quantity, the tolerance with its derivation and source, the runs.  What each claim measures is a
 function of the run outputs, kept with the method it measures: every method package may define a
-module ``claims`` with ``MEASURES = {claim id: function(ctx, entry) -> Measurement}``.  A measure
+module ``claims`` with ``MEASURES = {claim id: function(ctx, entry) -> Measurement}``, filled by
+:func:`measure_table`'s decorator ``@claim(id)`` on each measure.  A measure
 returns numbers and whether the tolerance's test passed (reading the tolerance from the entry, never
 holding one of its own); :func:`verdict` turns that into the verdict:
 
@@ -124,6 +125,24 @@ def measures():
                 raise ValueError(f"claim '{cid}' is measured twice (methods.{name}.claims)")
             out[cid] = fn
     return out
+
+
+def measure_table():
+    """(MEASURES, claim): a claims module's empty {claim id: measure function} and the decorator that enters a
+    function under its claim ids, ``@claim("id", ...)`` (returns the function; an id entered twice: ValueError)."""
+    table = {}
+
+    def claim(*ids):
+        def enter(fn):
+            for cid in ids:
+                if cid in table:
+                    raise ValueError(f"claim '{cid}' is measured twice")
+                table[cid] = fn
+            return fn
+
+        return enter
+
+    return table, claim
 
 
 def number(entry, name):

@@ -78,6 +78,29 @@ def _var(dims, data, units, long_name, **attrs):
     return xr.Variable(dims, data, {"units": units, "long_name": long_name, **attrs})
 
 
+def contract_variables(r):
+    """The variables every run file holds of a contract.Result r, as two {name: xarray.Variable} in file order:
+    the particles' (pos0, pos (N, 2) cm, weight (N,) N) and the wall contacts' (contact_wall, contact_point cm,
+    contact_force N) with the run's counts, time and residual."""
+    xy = ("particle", "xy")
+    particles = {
+        "pos0": _var(xy, r.pos0, "cm", "initial particle position"),
+        "pos": _var(xy, r.pos, "cm", "final particle position"),
+        "weight": _var(("particle",), r.weight, "N", "particle weight m g"),
+    }
+    rest = {
+        "contact_wall": _var(("contact",), np.asarray(r.contact_wall, np.int32), "1", "wall index of wall contact"),
+        "contact_point": _var(("contact", "xy"), r.contact_point, "cm", "contact point (or panel centre) on the wall"),
+        "contact_force": _var(("contact", "xy"), r.contact_force, "N", "force of the wall on the liquid at the contact"),
+        "steps": _var((), np.int64(r.steps), "1", "total algorithm steps since the start of the chain"),
+        "start_step": _var((), np.int64(r.start_step), "1", "steps taken before this run (continued runs)"),
+        "wall_time": _var((), r.wall_time, "s", "solver wall-clock time of this run"),
+        "force_evals": _var((), np.int64(r.force_evals), "1", "force (or pressure-solve) evaluations of this run"),
+        "residual": _var((), r.residual, r.residual_units, f"final {r.residual_name}"),
+    }
+    return particles, rest
+
+
 def to_dataset(result, tank, prov, started, finished, spacing=None, references=""):
     """xarray Dataset of a contract.Result with CF/ACDD metadata.
 
@@ -90,22 +113,13 @@ def to_dataset(result, tank, prov, started, finished, spacing=None, references="
     spacing = r.spacing if spacing is None else spacing
     walls = tank.walls
     vessels = tank.spec.get("vessels", [])
-    xy = ("particle", "xy")
+    particles, rest = contract_variables(r)
     data = {
-        "pos0": _var(xy, r.pos0, "cm", "initial particle position"),
-        "pos": _var(xy, r.pos, "cm", "final particle position"),
-        "weight": _var(("particle",), r.weight, "N", "particle weight m g"),
+        **particles,
         "wall_segment": _var(("wall", "end"), walls, "cm", "wall segment x0, y0, x1, y1"),
         "wall_resultant": _var(("wall", "xy"), contract.wall_resultants(r.contact_wall, r.contact_force, len(walls)),
                                "N", "resultant force of wall on liquid (= minus load on wall)"),
-        "contact_wall": _var(("contact",), np.asarray(r.contact_wall, np.int32), "1", "wall index of wall contact"),
-        "contact_point": _var(("contact", "xy"), r.contact_point, "cm", "contact point (or panel centre) on the wall"),
-        "contact_force": _var(("contact", "xy"), r.contact_force, "N", "force of the wall on the liquid at the contact"),
-        "steps": _var((), np.int64(r.steps), "1", "total algorithm steps since the start of the chain"),
-        "start_step": _var((), np.int64(r.start_step), "1", "steps taken before this run (continued runs)"),
-        "wall_time": _var((), r.wall_time, "s", "solver wall-clock time of this run"),
-        "force_evals": _var((), np.int64(r.force_evals), "1", "force (or pressure-solve) evaluations of this run"),
-        "residual": _var((), r.residual, r.residual_units, f"final {r.residual_name}"),
+        **rest,
         "converged": _var((), np.int8(r.status == "converged"), "1", "1 if the stop criterion was met"),
     }
     if np.isfinite(r.sim_time):

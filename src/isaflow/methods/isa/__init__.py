@@ -11,25 +11,16 @@ contract.Result).
 from .. import Method, Variant
 
 METHOD = Method(
-    name="isa",
+    name="isa", order=10, marker="o", tank=True,
     label="incremental static analysis of point particles",
-    paper="papadopoulos2016",
-    variants={
-        "paper": Variant("paper", "paper: x += du F / max|F| (section 3.3, literal)", "tab:blue", "o", paper=True),
-        "capped": Variant("capped", "capped: x += du F / max(max|F|, f_ref) (variant, not in paper)", "tab:green", "s"),
-        "fire": Variant("fire", "fire: FIRE relaxation, Bitzek et al. 2006 (variant, not in paper)", "tab:purple", "^"),
-        "overdamped": Variant("overdamped", "overdamped: m x'' = F - c x', m = w/g, same laws (variant, not in paper)",
-                              "tab:olive", "v"),
-        "newton_lm": Variant("newton_lm", "newton_lm: energy minimisation, Newton-type (Levenberg-Marquardt) with "
-                             "the contacts' Hessian (equilibrium solver, not in paper)", "tab:brown", "X"),
-    },
-    marker="o",
-    paper_label="Papadopoulos, Koutitas & Lazaridis (2016), the paper replicated",
-    tank=True,
-    entry="isaflow.methods.isa.method",
-    checks="isaflow.methods.isa.checks",
-    values="isaflow.methods.isa.settings:VALUES",
-    settings="config/methods/isa.yaml",
-    report="results/report/10_isa.md",
-    timing="results/timing/10_isa.md",
+    paper="papadopoulos2016", paper_label="Papadopoulos, Koutitas & Lazaridis (2016), the paper replicated",
+    variants=(
+        Variant("paper", "paper: x += du F / max|F| (section 3.3, literal)", "tab:blue", "o", paper=True),
+        Variant("capped", "capped: x += du F / max(max|F|, f_ref) (variant, not in paper)", "tab:green", "s"),
+        Variant("fire", "fire: FIRE relaxation, Bitzek et al. 2006 (variant, not in paper)", "tab:purple", "^"),
+        Variant("overdamped", "overdamped: m x'' = F - c x', m = w/g, same laws (variant, not in paper)",
+                "tab:olive", "v"),
+        Variant("newton_lm", "newton_lm: energy minimisation, Newton-type (Levenberg-Marquardt) with "
+                "the contacts' Hessian (equilibrium solver, not in paper)", "tab:brown", "X"),
+    ),
 )

@@ -19,20 +19,30 @@ The stop: max|F| < f_tol (the paper's equilibrium criterion on the same forces) 
 rest by the project's one criterion (config/rest.yaml, isaflow.rest): e = KE / (W h) below
 ``e_limit`` at every step of the last ``window`` seconds.
 
-The step loop reuses relax.py's kernels (cell-ordered pair rows, near-wall lists, the wall-crossing
-test), so forces are evaluated exactly as for the other update rules.  Units: cm, N, s; mass N s^2/cm.
+The step loop reuses relax.py's kernels (its start, list rebuilds and write-back, cell-ordered pair
+rows, near-wall lists, the wall-crossing test), so forces are evaluated exactly as for the other update
+rules.  Units: cm, N, s; mass N s^2/cm.
 """
 
 import numpy as np
 from ...core.jit import njit
 
-from ...core.neighbours import cell_rows
-from .relax import (CONVERGED, CROSSED, NONFINITE, RUNNING, _evaluate, _first_crossing, _near_walls, _pair_scratch,
-                    _row_starts, _to_caller_order, _to_cell_order)
+from .relax import (CONVERGED, CROSSED, NONFINITE, RUNNING, _evaluate, _finish, _first_crossing, _move_and_rebuild,
+                    _start)
 
 JIT = dict(cache=True, nogil=True)
 
 OVERDAMPED = 3  # settings.RULE_IDS["overdamped"]
+
+
+@njit(**JIT)
+def _kinetic(rank, weight_c, vel_c, g):
+    """Kinetic energy [N cm] of the particles (cell order, masses weight_c / g), summed in the caller's order."""
+    ke = 0.0
+    for i in range(rank.shape[0]):
+        q = rank[i]
+        ke += 0.5 * weight_c[q] / g * (vel_c[q, 0] ** 2 + vel_c[q, 1] ** 2)
+    return ke
 
 
 @njit(**JIT)
@@ -58,49 +68,25 @@ def overdamped_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u
     nw = walls.shape[0]
     rc = pair_l_u + skin
     reach = wall_l_u + skin
-    order = np.empty(n, np.int32)
-    rank = np.empty(n, np.int32)
-    row_start = np.empty(n + 1, np.int32)
-    near_start = np.empty(n + 1, np.int32)
-    pos_c = np.empty((n, 2))
-    new_c = np.empty((n, 2))
-    vel_c = np.empty((n, 2))
-    force_c = np.empty((n, 2))
-    force_n = np.empty((n, 2))
-    weight_c = np.empty(n)
-    one = np.empty(1, np.int64)  # the serial pass's block scratch (relax._evaluate, _first_crossing with nb = 1)
     serial = np.int64(1)  # one block, typed int64 as relax_resume passes it (a literal 1 compiles a second overload)
-    one_b, one_w, one_bad, fmax_b, none = one.copy(), one.copy(), one.copy(), np.empty(1), np.empty(0)
-    if not resume:
-        pos_build[:, :] = pos
-    nbr, cstart = cell_rows(pos_build, box, rc, order, np.empty(1, np.int32), row_start,
-                            np.empty(4 * n + 16, np.int32))
-    _to_cell_order(pos_build, vel, weight, order, nbr, row_start[n], rank, pos_c, vel_c, weight_c)
-    owner, gx, gy = _pair_scratch(row_start, n, np.empty(0, np.int32), np.empty(0), np.empty(0))
-    near_part, near_wall = _near_walls(pos_c, walls, reach)
-    _row_starts(near_part, n, near_start)
-    if resume:
-        for q in range(n):
-            pos_c[q, 0] = pos[order[q], 0]
-            pos_c[q, 1] = pos[order[q], 1]
-        moved = state[0]
-    else:
-        moved = 0.0
+    # the serial pass's block scratch (relax._evaluate, _first_crossing with nb = 1)
+    one_b, one_w, one_bad, fmax_b, none = (np.empty(1, np.int64), np.empty(1, np.int64), np.empty(1, np.int64),
+                                           np.empty(1), np.empty(0))
+    (order, rank, row_start, near_start, pos_c, new_c, vel_c, force_c, force_n, weight_c, halo, nbr, cstart, owner,
+     gx, gy, near_part, near_wall) = _start(pos, vel, weight, pos_build, resume, box, rc, walls, reach, serial)
+    moved = state[0] if resume else 0.0
     t = state[1]
     quiet = state[2]
     move = n < 0  # False, computed (relax_resume's one specialisation of _evaluate)
     fire = move  # no FIRE sums: False, computed for the same reason
-    ke = 0.0
-    for i in range(n):  # caller order, as the sums below
-        q = rank[i]
-        ke += 0.5 * weight_c[q] / g * (vel_c[q, 0] ** 2 + vel_c[q, 1] ** 2)
+    ke = _kinetic(rank, weight_c, vel_c, g)
     status = RUNNING
     crossing = -1
     done = n_steps
     step_move = 0.0
     step = -1
     while True:  # evaluate at the new positions, then test and step
-        fmax, bad = _evaluate(serial, one, pos_c, new_c, vel_c, dt, move, weight_c, walls, wall_l_u, wall_r_u, near_start,
+        fmax, bad = _evaluate(serial, halo, pos_c, new_c, vel_c, dt, move, weight_c, walls, wall_l_u, wall_r_u, near_start,
                               near_part, near_wall, pair_l_u, pair_r_u, wall_p, pair_p, row_start, nbr, owner, gx, gy,
                               force_n, fire, order, vel_c, none, none, none, fmax_b, one_bad)
         pos_c, new_c = new_c, pos_c
@@ -139,33 +125,18 @@ def overdamped_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u
         moved += max_move
         move = True
         t += dt
-        ke = 0.0
-        for i in range(n):  # the step's kinetic energy (velocities are set before the move)
-            q = rank[i]
-            ke += 0.5 * weight_c[q] / g * (vel_c[q, 0] ** 2 + vel_c[q, 1] ** 2)
+        ke = _kinetic(rank, weight_c, vel_c, g)  # the step's (velocities are set before the move)
         if ke / e_norm < e_limit:
             if quiet < 0.0:
                 quiet = t
         else:
             quiet = -1.0
         if moved > 0.5 * skin:
-            for q in range(n):
-                pos_c[q, 0] = pos_c[q, 0] + dt * vel_c[q, 0]
-                pos_c[q, 1] = pos_c[q, 1] + dt * vel_c[q, 1]
-            _to_caller_order(order, pos_c, pos)
-            _to_caller_order(order, vel_c, vel)
-            pos_build[:, :] = pos
-            nbr, cstart = cell_rows(pos, box, rc, order, cstart, row_start, nbr)
-            _to_cell_order(pos, vel, weight, order, nbr, row_start[n], rank, pos_c, vel_c, weight_c)
-            owner, gx, gy = _pair_scratch(row_start, n, owner, gx, gy)
-            near_part, near_wall = _near_walls(pos_c, walls, reach)
-            _row_starts(near_part, n, near_start)
+            nbr, cstart, owner, gx, gy, near_part, near_wall = _move_and_rebuild(
+                pos_c, dt, vel_c, pos, vel, weight, pos_build, box, rc, walls, reach, serial, order, cstart, row_start,
+                nbr, rank, vel_c, weight_c, owner, gx, gy, halo, near_start)
             moved = 0.0
             move = False
-    _to_caller_order(order, pos_c, pos)
-    _to_caller_order(order, vel_c, vel)
-    _to_caller_order(order, force_c, force)
+    _finish(order, pos_c, vel_c, force_c, pos, vel, force, state, step_move)
     state[0], state[1], state[2] = moved, t, quiet
-    if state.shape[0] > 4:
-        state[4] = step_move
     return done, status, crossing

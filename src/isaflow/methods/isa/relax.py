@@ -32,7 +32,7 @@ from numba import prange
 from ...core.jit import njit
 
 from ...core.geometry import crossed_wall, segment_closest
-from .cells import cell_rows_par
+from ...core.neighbours import cell_rows_par
 from .forces import pair_push, track_max, wall_push
 
 JIT = dict(cache=True, nogil=True)
@@ -426,6 +426,85 @@ def _to_caller_order(order, src, dst):
 
 
 @njit(**JIT)
+def _cell_lists(pos, vel, weight, box, rc, walls, reach, nb, hint, order, cstart, row_start, nbr, rank, pos_c, vel_c,
+                weight_c, owner, gx, gy, halo, near_start):
+    """The lists of a build at pos (N, 2) cm (caller order): the pair rows within rc [cm]
+    (core.neighbours.cell_rows_par in nb blocks, hint pairs per particle), the state gathered into their
+    cell order (pos_c, vel_c, weight_c), the pair scratch, the halo rows (nb > 1) and the near-wall rows
+    within reach [cm].  Returns (nbr, cstart, owner, gx, gy, near_part, near_wall)."""
+    n = pos.shape[0]
+    nbr, cstart = cell_rows_par(pos, box, rc, order, cstart, row_start, nbr, nb, hint)
+    _to_cell_order(pos, vel, weight, order, nbr, row_start[n], rank, pos_c, vel_c, weight_c)
+    owner, gx, gy = _pair_scratch(row_start, n, owner, gx, gy)
+    if nb > 1:
+        _halo_rows(row_start, nbr, n, nb, halo)
+    near_part, near_wall = _near_walls(pos_c, walls, reach)
+    _row_starts(near_part, n, near_start)
+    return nbr, cstart, owner, gx, gy, near_part, near_wall
+
+
+@njit(**JIT)
+def _start(pos, vel, weight, pos_build, resume, box, rc, walls, reach, nb):
+    """A step loop's buffers and first lists (:func:`_cell_lists`), built at pos_build (set to pos unless
+    resume), with pos_c at pos.  Returns (order, rank, row_start, near_start, pos_c, new_c, vel_c, force_c,
+    force_n, weight_c, halo, nbr, cstart, owner, gx, gy, near_part, near_wall): order[q] the caller's index of
+    the q-th particle in cell order, rank its inverse; new_c and force_n the next step's positions and forces
+    (double buffers)."""
+    n = pos.shape[0]
+    order = np.empty(n, np.int32)
+    rank = np.empty(n, np.int32)
+    row_start = np.empty(n + 1, np.int32)
+    near_start = np.empty(n + 1, np.int32)
+    pos_c = np.empty((n, 2))
+    new_c = np.empty((n, 2))
+    vel_c = np.empty((n, 2))
+    force_c = np.empty((n, 2))
+    force_n = np.empty((n, 2))
+    weight_c = np.empty(n)
+    halo = np.empty(nb, np.int64)
+    if not resume:
+        pos_build[:, :] = pos
+    nbr, cstart, owner, gx, gy, near_part, near_wall = _cell_lists(
+        pos_build, vel, weight, box, rc, walls, reach, nb, 4.0, order, np.empty(1, np.int32), row_start,
+        np.empty(4 * n + 16, np.int32), rank, pos_c, vel_c, weight_c, np.empty(0, np.int32), np.empty(0),
+        np.empty(0), halo, near_start)
+    if resume:
+        for q in range(n):
+            pos_c[q, 0] = pos[order[q], 0]
+            pos_c[q, 1] = pos[order[q], 1]
+    return (order, rank, row_start, near_start, pos_c, new_c, vel_c, force_c, force_n, weight_c, halo, nbr, cstart,
+            owner, gx, gy, near_part, near_wall)
+
+
+@njit(**JIT)
+def _move_and_rebuild(pos_c, scale, direction, pos, vel, weight, pos_build, box, rc, walls, reach, nb, order,
+                      cstart, row_start, nbr, rank, vel_c, weight_c, owner, gx, gy, halo, near_start):
+    """Take the step pos_c += scale direction, write positions and velocities back in the caller's order
+    (pos, vel, and pos_build: the new build's positions) and rebuild the lists there (:func:`_cell_lists`,
+    sized by the last build's pairs per particle).  Returns what :func:`_cell_lists` returns."""
+    n = pos.shape[0]
+    for q in range(n):
+        pos_c[q, 0] = pos_c[q, 0] + scale * direction[q, 0]
+        pos_c[q, 1] = pos_c[q, 1] + scale * direction[q, 1]
+    _to_caller_order(order, pos_c, pos)
+    _to_caller_order(order, vel_c, vel)
+    pos_build[:, :] = pos
+    return _cell_lists(pos, vel, weight, box, rc, walls, reach, nb, 1.25 * row_start[n] / max(n, 1) + 2.0, order,
+                       cstart, row_start, nbr, rank, pos_c, vel_c, weight_c, owner, gx, gy, halo, near_start)
+
+
+@njit(**JIT)
+def _finish(order, pos_c, vel_c, force_c, pos, vel, force, state, step_move):
+    """Write positions, velocities and forces back in the caller's order; state[4] (if state has it) =
+    step_move, the largest displacement component [cm] of the call."""
+    _to_caller_order(order, pos_c, pos)
+    _to_caller_order(order, vel_c, vel)
+    _to_caller_order(order, force_c, force)
+    if state.shape[0] > 4:
+        state[4] = step_move
+
+
+@njit(**JIT)
 def _fire_range(lo, hi, vel, force, mix, one_minus_alpha, c, dt):
     """FIRE's velocity update of particles lo <= q < hi: v = (1 - alpha) v + c F if mix, else
     v = 0; then v += dt F (semi-implicit Euler).  Returns max(|vx|, |vy|) over the range."""
@@ -554,16 +633,6 @@ def relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pai
     fire = rule == FIRE
     rc = pair_l_u + skin
     reach = wall_l_u + skin
-    order = np.empty(n, np.int32)  # order[q]: caller's index of the q-th particle in cell order
-    rank = np.empty(n, np.int32)  # inverse of order
-    row_start = np.empty(n + 1, np.int32)
-    near_start = np.empty(n + 1, np.int32)
-    pos_c = np.empty((n, 2))
-    new_c = np.empty((n, 2))
-    vel_c = np.empty((n, 2))
-    force_c = np.empty((n, 2))
-    force_n = np.empty((n, 2))  # the next forces (force_c is the move direction of the paper/capped rules)
-    weight_c = np.empty(n)
     nf = n if fire else 0
     power_i = np.empty(nf)
     vnorm2_i = np.empty(nf)
@@ -572,21 +641,11 @@ def relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pai
     best_b = np.empty(nb, np.int64)
     wall_b = np.empty(nb, np.int64)
     bad_b = np.empty(nb, np.int64)
-    halo = np.empty(nb, np.int64)
-    if not resume:
-        pos_build[:, :] = pos
-    nbr, cstart = cell_rows_par(pos_build, box, rc, order, np.empty(1, np.int32), row_start,
-                                np.empty(4 * n + 16, np.int32), nb, 4.0)
-    _to_cell_order(pos_build, vel, weight, order, nbr, row_start[n], rank, pos_c, vel_c, weight_c)
-    owner, gx, gy = _pair_scratch(row_start, n, np.empty(0, np.int32), np.empty(0), np.empty(0))
-    if nb > 1:
-        _halo_rows(row_start, nbr, n, nb, halo)
-    near_part, near_wall = _near_walls(pos_c, walls, reach)
-    _row_starts(near_part, n, near_start)
+    # state in cell order between builds: order[q] the caller's index of the q-th particle; force_n the next
+    # forces (force_c is the move direction of the paper/capped rules)
+    (order, rank, row_start, near_start, pos_c, new_c, vel_c, force_c, force_n, weight_c, halo, nbr, cstart, owner,
+     gx, gy, near_part, near_wall) = _start(pos, vel, weight, pos_build, resume, box, rc, walls, reach, nb)
     if resume:
-        for q in range(n):
-            pos_c[q, 0] = pos[order[q], 0]
-            pos_c[q, 1] = pos[order[q], 1]
         moved, dt, alpha, n_pos = state[0], state[1], state[2], int(state[3])
     else:
         moved, dt, alpha, n_pos = 0.0, 0.1 * dt_max, FIRE_ALPHA0, 0  # moved: bound on any displacement, cm
@@ -643,26 +702,11 @@ def relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pai
         moved += max_move
         move = True
         if moved > 0.5 * skin:
-            for q in range(n):
-                pos_c[q, 0] = pos_c[q, 0] + scale * direction[q, 0]
-                pos_c[q, 1] = pos_c[q, 1] + scale * direction[q, 1]
-            _to_caller_order(order, pos_c, pos)
-            _to_caller_order(order, vel_c, vel)
-            pos_build[:, :] = pos
-            nbr, cstart = cell_rows_par(pos, box, rc, order, cstart, row_start, nbr, nb,
-                                        1.25 * row_start[n] / max(n, 1) + 2.0)
-            _to_cell_order(pos, vel, weight, order, nbr, row_start[n], rank, pos_c, vel_c, weight_c)
-            owner, gx, gy = _pair_scratch(row_start, n, owner, gx, gy)
-            if nb > 1:
-                _halo_rows(row_start, nbr, n, nb, halo)
-            near_part, near_wall = _near_walls(pos_c, walls, reach)
-            _row_starts(near_part, n, near_start)
+            nbr, cstart, owner, gx, gy, near_part, near_wall = _move_and_rebuild(
+                pos_c, scale, direction, pos, vel, weight, pos_build, box, rc, walls, reach, nb, order, cstart,
+                row_start, nbr, rank, vel_c, weight_c, owner, gx, gy, halo, near_start)
             moved = 0.0
             move = False
-    _to_caller_order(order, pos_c, pos)
-    _to_caller_order(order, vel_c, vel)
-    _to_caller_order(order, force_c, force)
+    _finish(order, pos_c, vel_c, force_c, pos, vel, force, state, step_move)
     state[0], state[1], state[2], state[3] = moved, dt, alpha, n_pos
-    if state.shape[0] > 4:
-        state[4] = step_move
     return done, status, crossing

@@ -15,10 +15,12 @@ import random
 
 import numpy as np
 
-from ...claims import Measurement
+from ...claims import Measurement, measure_table
 from ...core import units
 from ...tank import load as load_tank
 from . import model, settings, solver
+
+MEASURES, claim = measure_table()  # {claim id: measure(ctx, entry)}, each measure entered by @claim(id)
 
 ROOT = Path(__file__).resolve().parents[4]
 # measurement design of the registry's 'measure' fields (not tolerances): the eps sequence of
@@ -124,6 +126,7 @@ def eq1_5_residuals(particles=12, seed=0):
     return float(worst1), float(worst2)
 
 
+@claim("hat-eq1-5-algebra")
 def measure_eq1_5_algebra(ctx, entry):
     tol = entry["tolerance"]["value"]
     r1, r2 = eq1_5_residuals()
@@ -178,6 +181,7 @@ def eq6_orders(eps_sequence=EPS_SEQUENCE, rho0=1.0, density_offset=0.0):
     return rel, np.log2(rel[:-1] / rel[1:]), rel_std, np.log2(rel_std[:-1] / rel_std[1:])
 
 
+@claim("hat-eq6-derivation")
 def measure_eq6_derivation(ctx, entry):
     qmin = entry["tolerance"]["value"]
     rel, q, rel_std, q_std = eq6_orders()
@@ -243,6 +247,7 @@ def dilation_sources(ds, e=DILATION):
                 scope=str(cfg["model.relaxation_scope"]), source=str(ds.attrs["source_term"]))
 
 
+@claim("hat-eq4-rho-star")
 def measure_rho_star(ctx, entry):
     key = entry["runs"][0]["id"]
     ds = ctx.run(key)
@@ -272,11 +277,17 @@ def measure_rho_star(ctx, entry):
 # --- hat-eq5-implicit and prj-hat-mps-step: one MPS step against eqs. (1)-(2) ------------------------------
 
 
-def measure_eq5_implicit(ctx, entry):
-    tol = entry["tolerance"]["value"]
+def _stepped(ctx, entry):
+    """(tolerance, run key, run, :func:`one_step` from its final state) of a row judged on one MPS step from its
+    first run."""
     key = entry["runs"][0]["id"]
     ds = ctx.run(key)
-    st = one_step(ds)
+    return entry["tolerance"]["value"], key, ds, one_step(ds)
+
+
+@claim("hat-eq5-implicit")
+def measure_eq5_implicit(ctx, entry):
+    tol, key, ds, st = _stepped(ctx, entry)
     found = st["res1_new"] > tol and st["res1_star"] <= tol  # the registry's test: the inconsistency is there
     return Measurement(
         measured=f"one step (dt = {st['dt']:.4g} s, {st['particles']} particles, collision off) from {_run_text(key, ds)}: "
@@ -291,11 +302,9 @@ def measure_eq5_implicit(ctx, entry):
         margin=f"residual at U[n+1] {st['res1_new']:.3g} and at U* {st['res1_star']:.3g} against {tol:g}")
 
 
+@claim("prj-hat-mps-step")
 def measure_mps_step(ctx, entry):
-    tol = entry["tolerance"]["value"]
-    key = entry["runs"][0]["id"]
-    ds = ctx.run(key)
-    st = one_step(ds)
+    tol, key, ds, st = _stepped(ctx, entry)
     worst = max(st["res1_star"], st["res2"])
     return Measurement(
         measured=f"one step (dt = {st['dt']:.4g} s, {st['particles']} particles, collision off, pressure-solve "
@@ -306,12 +315,3 @@ def measure_mps_step(ctx, entry):
                  "tests/test_mps.py::test_eqs_3_and_5_add_up_to_the_discrete_navier_stokes_eqs_1_2",
         why="" if worst <= tol else f"a residual {worst:.3g} > {tol:g}",
         margin=f"largest residual {worst:.3g} against {tol:g}")
-
-
-MEASURES = {
-    "hat-eq1-5-algebra": measure_eq1_5_algebra,
-    "hat-eq5-implicit": measure_eq5_implicit,
-    "hat-eq4-rho-star": measure_rho_star,
-    "hat-eq6-derivation": measure_eq6_derivation,
-    "prj-hat-mps-step": measure_mps_step,
-}

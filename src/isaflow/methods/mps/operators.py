@@ -174,6 +174,27 @@ def near_thin(pos, thin, reach):
     return out
 
 
+@njit(inline="always", **JIT)
+def _row(i, pos, order, cstart, cell, ncx, ncy, rc2, tw, tside, near, thin, store, nbr, k):
+    """The neighbours of particle i (:func:`neighbour_list`'s order), stored at nbr[k:] if store (a literal:
+    the counting pass compiles without the stores); returns their count."""
+    c = cell[i]
+    cx, cy = c % ncx, c // ncx
+    m = 0
+    for yy in range(max(0, cy - 1), min(ncy, cy + 2)):
+        for xx in range(max(0, cx - 1), min(ncx, cx + 2)):
+            cc = yy * ncx + xx
+            for q in range(cstart[cc], cstart[cc + 1]):
+                j = order[q]
+                dx = pos[j, 0] - pos[i, 0]
+                dy = pos[j, 1] - pos[i, 1]
+                if j != i and dx * dx + dy * dy < rc2 and visible(i, j, pos, tw, tside, near, thin):
+                    if store:
+                        nbr[k + m] = j
+                    m += 1
+    return m
+
+
 @njit(**PAR)
 def neighbour_list(pos, kind, box, rc, tw, tside, thin):
     """Full neighbour lists: every visible j != i closer than rc [cm] (dummy particles get empty rows: no
@@ -187,41 +208,16 @@ def neighbour_list(pos, kind, box, rc, tw, tside, thin):
     near = near_thin(pos, thin, rc)
     rc2 = rc * rc
     count = np.zeros(n + 1, np.int64)
-    for i in prange(n):
-        if kind[i] == DUMMY:
-            continue
-        c = cell[i]
-        cx, cy = c % ncx, c // ncx
-        k = 0
-        for yy in range(max(0, cy - 1), min(ncy, cy + 2)):
-            for xx in range(max(0, cx - 1), min(ncx, cx + 2)):
-                cc = yy * ncx + xx
-                for q in range(cstart[cc], cstart[cc + 1]):
-                    j = order[q]
-                    dx = pos[j, 0] - pos[i, 0]
-                    dy = pos[j, 1] - pos[i, 1]
-                    if j != i and dx * dx + dy * dy < rc2 and visible(i, j, pos, tw, tside, near, thin):
-                        k += 1
-        count[i + 1] = k
+    none = np.empty(0, np.int32)
+    for i in prange(n):  # count the rows, then fill them
+        if kind[i] != DUMMY:
+            count[i + 1] = _row(i, pos, order, cstart, cell, ncx, ncy, rc2, tw, tside, near, thin, False, none, 0)
     for i in range(n):
         count[i + 1] += count[i]
     nbr = np.empty(count[n], np.int32)
     for i in prange(n):
-        if kind[i] == DUMMY:
-            continue
-        c = cell[i]
-        cx, cy = c % ncx, c // ncx
-        k = count[i]
-        for yy in range(max(0, cy - 1), min(ncy, cy + 2)):
-            for xx in range(max(0, cx - 1), min(ncx, cx + 2)):
-                cc = yy * ncx + xx
-                for q in range(cstart[cc], cstart[cc + 1]):
-                    j = order[q]
-                    dx = pos[j, 0] - pos[i, 0]
-                    dy = pos[j, 1] - pos[i, 1]
-                    if j != i and dx * dx + dy * dy < rc2 and visible(i, j, pos, tw, tside, near, thin):
-                        nbr[k] = j
-                        k += 1
+        if kind[i] != DUMMY:
+            _row(i, pos, order, cstart, cell, ncx, ncy, rc2, tw, tside, near, thin, True, nbr, count[i])
     return count, nbr
 
 

@@ -10,28 +10,19 @@ of modulus G, our reading of how the paper's Poisson and shear numbers arise).
 from isaflow.methods import Method, Variant
 
 METHOD = Method(
-    name="solid",
+    name="solid", order=65, marker="D",
     label="Hooke's-law solid particles (Marko 2017)",
-    paper="marko2017",
-    variants={
-        "paper": Variant("paper", "paper: eqs. 11-16 as printed (normal Hooke springs, no Poisson or shear term)",
-                         "tab:red", "s"),
-        "hooke": Variant("hooke", "hooke: eqs. 11-16 + Poisson size coupling + G shear springs (not in the paper)",
-                         "tab:blue", "o"),
-        "pressure_load": Variant("pressure_load", "pressure_load: 4.4 vessel, the water replaced by its pressure on the "
-                                 "ring's wetted faces (what Lame assumes; the paper couples SPH water)", "tab:purple", "D"),
-        "water_particles": Variant("water_particles", "water_particles: 4.4 vessel with weakly compressible SPH "
-                                   "water (linear EOS from p0) pushing on the ring, one-step coupled", "tab:cyan", "P"),
-        "uniform_load": Variant("uniform_load", "uniform_load: elastic floor under the hydrostatic W / span as nodal "
-                                "loads (beam-theory check; not in either paper)", "0.3", "^"),
-        "oneway": Variant("oneway", "oneway: elastic floor, one-way: loads from the rigid-floor run of another method "
-                          "(not in either paper)", "tab:green", "v"),
-    },
-    marker="D",
-    paper_label="Marko et al. (2017), SPH liquid and Hooke's-law solid particles",
-    settings="config/methods/solid.yaml",
-    checks="isaflow.methods.solid.checks",
-    values="isaflow.methods.solid.settings:VALUES",
-    report="results/report/65_solid.md",
-    timing="results/timing/65_solid.md",
+    paper="marko2017", paper_label="Marko et al. (2017), SPH liquid and Hooke's-law solid particles",
+    variants=(
+        Variant("paper", "paper: eqs. 11-16 as printed (normal Hooke springs, no Poisson or shear term)", "tab:red", "s"),
+        Variant("hooke", "hooke: eqs. 11-16 + Poisson size coupling + G shear springs (not in the paper)", "tab:blue", "o"),
+        Variant("pressure_load", "pressure_load: 4.4 vessel, the water replaced by its pressure on the "
+                "ring's wetted faces (what Lame assumes; the paper couples SPH water)", "tab:purple", "D"),
+        Variant("water_particles", "water_particles: 4.4 vessel with weakly compressible SPH "
+                "water (linear EOS from p0) pushing on the ring, one-step coupled", "tab:cyan", "P"),
+        Variant("uniform_load", "uniform_load: elastic floor under the hydrostatic W / span as nodal "
+                "loads (beam-theory check; not in either paper)", "0.3", "^"),
+        Variant("oneway", "oneway: elastic floor, one-way: loads from the rigid-floor run of another method "
+                "(not in either paper)", "tab:green", "v"),
+    ),
 )

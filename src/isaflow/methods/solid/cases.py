@@ -25,11 +25,10 @@ def _budget(cfg, variant):
     return s["max_steps"] if variant == "hooke" else s["max_steps_mechanism"]
 
 
-def run_bar(cfg, variant, sign=+1):
-    """4.1: the 5 x 11 x 5 bar pulled (sign +1) or pushed (-1) by pull_um along y.
-
-    Measures: stress sigma_yy at the centre particle and its largest magnitude
-    in the middle layer, the per-side width change in x and z at mid-length."""
+def _bar(cfg, variant):
+    """The 4.1 bar of cfg['bar'] (particles nx x ny x nz, spacing dx_mm, centred in x and z, y from 0) as a State of
+    variant: (block, state, lattice row j of each particle along y, mask (N, 3) of the components its grips hold:
+    the end layers' y, and x and z too with clamped grips, else one end-layer centre particle's)."""
     c = cfg["bar"]
     nx, ny, nz = c["particles"]
     dx = c["dx_mm"] * MM
@@ -43,6 +42,17 @@ def run_bar(cfg, variant, sign=+1):
     else:
         mask[ends, 1] = True
         mask[(j == 0) & (b.index[:, 0] == nx // 2) & (b.index[:, 2] == nz // 2)] = True
+    return b, st, j, mask
+
+
+def run_bar(cfg, variant, sign=+1):
+    """4.1: the 5 x 11 x 5 bar pulled (sign +1) or pushed (-1) by pull_um along y.
+
+    Measures: stress sigma_yy at the centre particle and its largest magnitude
+    in the middle layer, the per-side width change in x and z at mid-length."""
+    c = cfg["bar"]
+    nx, ny, nz = c["particles"]
+    b, st, j, mask = _bar(cfg, variant)
     disp = np.zeros((b.n, 3))
     disp[j == ny - 1, 1] = sign * c["pull_um"] * UM
     S.prescribe(st, mask, disp)
@@ -225,21 +235,11 @@ def run_bar_long(cfg, variant, strain, dt_frac, case="bar_tension_long"):
     the smallest linked distance and the smallest distance of any two particles over dx, the kinetic
     energy."""
     c, lg = cfg["bar"], cfg["bar_long"]
-    nx, ny, nz = c["particles"]
     dx = c["dx_mm"] * MM
-    b = L.block(nx, ny, nz, dx, (-(nx - 1) / 2 * dx, 0.0, -(nz - 1) / 2 * dx))
-    st = S.State(b, _material(cfg), variant, np.ones((b.n, 3)))
+    b, st, _, mask = _bar(cfg, variant)
     st.damp = 0
-    j = b.index[:, 1]
     affine = np.zeros((b.n, 3))
     affine[:, 1] = strain * b.ref[:, 1]
-    mask = np.zeros((b.n, 3), bool)
-    ends = (j == 0) | (j == ny - 1)
-    if c["grips"] == "clamped":
-        mask[ends] = True
-    else:
-        mask[ends, 1] = True
-        mask[(j == 0) & (b.index[:, 0] == nx // 2) & (b.index[:, 2] == nz // 2)] = True
     S.prescribe(st, mask, affine)
     rng = np.random.default_rng(lg["seed"])
     kick = lg["perturbation_dx"] * dx * rng.uniform(-1.0, 1.0, (b.n, 3)) * st.free

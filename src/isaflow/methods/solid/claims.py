@@ -30,6 +30,8 @@ from . import theory as T
 from .cases import MM, UM, to_pa
 from .settings import material_units
 
+MEASURES, claim = C.measure_table()  # {claim id: measure(ctx, entry)}, each measure entered by @claim(id)
+
 # ---------------------------------------------------------------------------------------------- helpers
 
 
@@ -104,6 +106,7 @@ def measurement(measured, passed, evidence="", why="", margin="", sensitivity=""
 # ---------------------------------------------------------------------------------- abstract and section 3
 
 
+@claim("mar-abs-stable")
 def abs_stable(ctx, e):
     """mar-abs-stable: every paper-variant run at the paper's settings stays within eq. 27's 10 % standard."""
     lim = tol(e)
@@ -117,6 +120,7 @@ def abs_stable(ctx, e):
         margin=f"largest step move {worst:.3g} dx against {lim:g} dx; any escape fails regardless")
 
 
+@claim("mar-abs-all-match")
 def abs_all_match(ctx, e):
     """mar-abs-all-match: every row it depends on passes."""
     parts, fails = [], []
@@ -130,6 +134,7 @@ def abs_all_match(ctx, e):
                        margin=f"{len(e['depends_on']) - len(fails)} of {len(e['depends_on'])} rows pass")
 
 
+@claim("mar-abs-tensile-solid")
 def abs_tensile_solid(ctx, e):
     """mar-abs-tensile-solid: the bar held in sustained tension keeps every particle within 0.1 dx of its
     affine position, at every strain and step of the sweep present (bar_tension_long*_paper)."""
@@ -160,6 +165,7 @@ def abs_tensile_solid(ctx, e):
         + ("" if len(rows) > 1 else " (sweep runs absent)"))
 
 
+@claim("mar-3-eq15-rest-length")
 def eq15_rest_length(ctx, e):
     """mar-3-eq15-rest-length: eq. 15 as printed, epsilon_ab = dx_ab / (dx (1 + E_uu)) at dx_ab = dx, E_uu = 0."""
     dx = 1.0
@@ -173,6 +179,7 @@ def eq15_rest_length(ctx, e):
         margin=f"|epsilon| = {abs(eps):g} against {lim:g}")
 
 
+@claim("mar-3-no-poisson")
 def no_poisson(ctx, e):
     """mar-3-no-poisson: eq. 14 (the kernels' strain update with the Poisson term off) under uniaxial stress."""
     sig = np.zeros((1, 6))
@@ -209,6 +216,7 @@ def lattice_shear_modulus(E, nu, gamma=1e-6, n=4):
     return float(np.abs(vir[inner, 3] / 2.0).max() / gamma)
 
 
+@claim("mar-3-shear-mechanism")
 def shear_mechanism(ctx, e):
     """mar-3-shear-mechanism: the printed lattice's shear modulus against G."""
     E, nu = num(e, "E_GPa"), num(e, "nu")
@@ -228,6 +236,7 @@ def shear_mechanism(ctx, e):
 STOP = "vessel_water_stop_paper"  # the vessel with the paper's stop-at-the-boundary coupling (printed ring)
 
 
+@claim("mar-3-coupling")
 def coupling(ctx, e):
     """mar-3-coupling, a project deviation judged on the paper's version: the coupling of the run with the stated
     stop-at-the-boundary force (vessel_water_stop_paper) and what that run gives; the project's kept coupling of
@@ -261,6 +270,7 @@ def bar_geometry(ds):
     return nx, ny, nz, float(ds.attrs["dx_cm"])
 
 
+@claim("mar-4.1-bar-inputs")
 def bar_inputs(ctx, e):
     """mar-4.1-bar-inputs: the bar run's E, nu, dx, block, pull against the page (the same unit conversions)."""
     ds = solid(ctx, "bar_tension_paper")
@@ -281,6 +291,7 @@ def bar_inputs(ctx, e):
         margin=f"largest relative difference {max(dev.values()):.2g} against {lim:g}")
 
 
+@claim("mar-4.1-bar-length")
 def bar_length(ctx, e):
     """mar-4.1-bar-length: 11 x 23.4 mm against 25 cm."""
     L = num(e, "particles_y") * num(e, "dx_mm") / 10.0
@@ -299,6 +310,7 @@ def bar_lengths(dx_cm, ny, stated_cm):
     return {f"{ny - 1} dx (held layers)": (ny - 1) * dx_cm, f"{ny} dx (extent)": ny * dx_cm, "stated": stated_cm}
 
 
+@claim("mar-4.1-stress-vs-hooke")
 def stress_vs_hooke(ctx, e):
     """mar-4.1-stress-vs-hooke: 1.4758 MPa against E delta / L for every length the text gives."""
     E = num(e, "E_GPa") * 1e9
@@ -318,6 +330,7 @@ def stress_vs_hooke(ctx, e):
         margin=f"smallest |error| {min(abs(x) for x in err.values()):.2%} against {lim:.1e}")
 
 
+@claim("mar-4.1-tension-hooke")
 def tension_hooke(ctx, e):
     """mar-4.1-tension-hooke: sigma_peak of the paper-variant bar over E delta / L (L = held layers, kept)."""
     lim = tol(e)
@@ -358,6 +371,7 @@ def necking_readings(dx_cm, nx, ny, pull_cm):
             "total / 5 dx / strain over 11 dx": (2.0, nx * dx_cm, pull_cm / (ny * dx_cm))}
 
 
+@claim("mar-4.1-necking-value")
 def necking_value(ctx, e):
     """mar-4.1-necking-value: lateral contraction per side at mid-length against 0.1329 um."""
     paper = num(e, "necking_um")
@@ -376,6 +390,7 @@ def necking_value(ctx, e):
                     "not enter (the per-side change is compared)")
 
 
+@claim("mar-4.1-poisson-arith")
 def poisson_arith(ctx, e):
     """mar-4.1-poisson-arith: eq. 17 inverted with the paper's 0.1329 um, per reading."""
     nx, ny, _ = (int(x) for x in num(e, "particles"))
@@ -395,6 +410,7 @@ def poisson_arith(ctx, e):
         sweep=[("necking_reading", k, abs(v / num(e, "nu_eq") - 1) <= lim) for k, v in nus.items()])
 
 
+@claim("mar-4.1-poisson-error-claim")
 def poisson_error_claim(ctx, e):
     """mar-4.1-poisson-error-claim: 0.34125 against 0.3 within the 5 x 5 cross-section's 20 %."""
     err = num(e, "nu_eq") / num(e, "nu") - 1
@@ -405,6 +421,7 @@ def poisson_error_claim(ctx, e):
                        margin=f"|error| {abs(err):.2%} against {lim:.0%}")
 
 
+@claim("mar-4.1-poisson-method")
 def poisson_method(ctx, e):
     """mar-4.1-poisson-method: the run's equivalent nu (eq. 17, kept reading) against its input nu."""
     lim = tol(e)
@@ -429,6 +446,7 @@ def poisson_method(ctx, e):
         + "; bar_grips: no grip makes the printed model neck (only clamped grips were run)")
 
 
+@claim("mar-4.1-compression-symmetric")
 def compression_symmetric(ctx, e):
     """mar-4.1-compression-symmetric: |sigma_peak compression / tension| = 1."""
     lim = tol(e)
@@ -449,6 +467,7 @@ def lateral_pair(ctx, v, e):
     return width_change_um(t), width_change_um(c), float(t.attrs["nu"]) * strain * d / UM
 
 
+@claim("mar-4.1-bulging-symmetric")
 def bulging_symmetric(ctx, e):
     """mar-4.1-bulging-symmetric: compression widens by the same distance as tension narrows."""
     floor, lim = tol(e, 0), tol(e, 1)
@@ -470,6 +489,7 @@ def bulging_symmetric(ctx, e):
                 else f"|ratio - 1| {abs(ratio - 1):.1e} against {lim:.1e}"))
 
 
+@claim("mar-4.1-neck-bulge")
 def neck_bulge(ctx, e):
     """mar-4.1-neck-bulge: tension narrows, compression widens (beyond the round-off floor)."""
     floor = tol(e)
@@ -487,6 +507,7 @@ def neck_bulge(ctx, e):
 # ---------------------------------------------------------------------------------- 4.2 shear
 
 
+@claim("mar-4.2-shear-inputs")
 def shear_inputs(ctx, e):
     """mar-4.2-shear-inputs: the shear run's free block, particle size and deflection against the page."""
     ds = solid(ctx, "shear_paper")
@@ -504,6 +525,7 @@ def shear_inputs(ctx, e):
         why="" if ok else "the run differs from the page", margin="copied inputs: equal or not")
 
 
+@claim("mar-4.2-height-arith")
 def height_arith(ctx, e):
     """mar-4.2-height-arith: 3 x 23.4 mm against 9.3619 cm."""
     H = num(e, "particles_y") * num(e, "dx_mm") / 10.0
@@ -515,6 +537,7 @@ def height_arith(ctx, e):
                        margin=f"|difference| {d:.4f} cm against {tol(e):g} cm")
 
 
+@claim("mar-4.2-g-arith")
 def g_arith(ctx, e):
     """mar-4.2-g-arith: eq. 18."""
     G = T.shear_modulus(num(e, "E_GPa"), num(e, "nu"))
@@ -525,6 +548,7 @@ def g_arith(ctx, e):
                        margin=f"|difference| {d:.1e} GPa against {tol(e):g} GPa")
 
 
+@claim("mar-4.2-gamma-arith")
 def gamma_arith(ctx, e):
     """mar-4.2-gamma-arith: the printed quotient."""
     g = num(e, "deflection_m") / num(e, "height_m")
@@ -534,6 +558,7 @@ def gamma_arith(ctx, e):
                        margin=f"|difference| {d:.1e} against {tol(e):g}")
 
 
+@claim("mar-4.2-tau-arith")
 def tau_arith(ctx, e):
     """mar-4.2-tau-arith: the printed product."""
     t = num(e, "G_Pa") * num(e, "gamma")
@@ -550,6 +575,7 @@ def tau_arith(ctx, e):
                                    f"|difference| {abs(exact - num(e, 'tau_Pa')):.0f} Pa")
 
 
+@claim("mar-4.2-error-arith")
 def error_arith(ctx, e):
     """mar-4.2-error-arith: 15.8993 / 15.5992 - 1 < 2 %."""
     err = num(e, "tau_num_MPa") / num(e, "tau_MPa") - 1
@@ -558,6 +584,7 @@ def error_arith(ctx, e):
                        margin=f"{err:.3%} against {tol(e):.0%}")
 
 
+@claim("mar-4.2-shear-num")
 def shear_num(ctx, e):
     """mar-4.2-shear-num: tau_peak of the paper-variant block over G delta / H (H of the run: held to moved)."""
     lim = tol(e)
@@ -583,6 +610,7 @@ def shear_num(ctx, e):
 # ---------------------------------------------------------------------------------- 4.3 Hertz
 
 
+@claim("mar-4.3-plate-dims")
 def plate_dims(ctx, e):
     """mar-4.3-plate-dims: 51 x 159 um and 10 x 159 um against 8 mm and 1.5 mm."""
     n = num(e, "plate")
@@ -598,6 +626,7 @@ def plate_dims(ctx, e):
                        margin=f"differences {d[0]:.3f}, {d[1]:.3f} mm against {lims[0]:g}, {lims[1]:g} mm")
 
 
+@claim("mar-4.3-inputs")
 def hertz_inputs(ctx, e):
     """mar-4.3-inputs: the Hertz run's disk, increments, plate and supports against the page."""
     ds = solid(ctx, "hertz_paper")
@@ -625,6 +654,7 @@ def hertz_inputs(ctx, e):
         margin="copied inputs: equal or not", sensitivity="hertz_increments: the interior depths are inferred (equal steps)")
 
 
+@claim("mar-4.3-ered-arith")
 def ered_arith(ctx, e):
     """mar-4.3-ered-arith: eq. 22."""
     Er = T.reduced_modulus(num(e, "E_GPa"), num(e, "nu"))
@@ -634,6 +664,7 @@ def ered_arith(ctx, e):
                        margin=f"|difference| {d:.1e} against {tol(e):g}")
 
 
+@claim("mar-4.3-ered-unit")
 def ered_unit(ctx, e):
     """mar-4.3-ered-unit: 207 GPa / 0.91 in MPa against the printed 227.4725 'MPa'."""
     Er = T.reduced_modulus(num(e, "E_GPa") * 1e9, num(e, "nu"))  # Pa
@@ -645,6 +676,7 @@ def ered_unit(ctx, e):
                        margin=f"|ratio - 1| {abs(ratio - 1):.3g} against {tol(e):g}")
 
 
+@claim("mar-4.3-chord-not-hertz")
 def chord_not_hertz(ctx, e):
     """mar-4.3-chord-not-hertz: eq. 24's chord against Hertz's sphere half-width sqrt(R delta)."""
     R = num(e, "radius_mm") * 1e-3
@@ -658,6 +690,7 @@ def chord_not_hertz(ctx, e):
                        margin=f"|ratio - 1| {np.abs(ratio - 1).min():.3f} against {tol(e):g}")
 
 
+@claim("mar-4.3-pmax-arith")
 def pmax_arith(ctx, e):
     """mar-4.3-pmax-arith: eqs. 24-25 at 26 and 49 um."""
     R = num(e, "radius_mm") * 1e-3
@@ -681,6 +714,7 @@ def load_exponents(R, d):
     return {"line contact x 159 um": n_line, "line contact per metre": n_line, "rigid sphere": 1.5}
 
 
+@claim("mar-4.3-load-arith")
 def load_arith(ctx, e):
     """mar-4.3-load-arith: the exponent of the paper's loads against the Hertz loads' exponents."""
     P, d = num(e, "loads_kN"), num(e, "depths_um") * 1e-6
@@ -733,13 +767,21 @@ def worst(x):
     return float(np.inf if np.isnan(x).any() else np.abs(x).max())
 
 
-def pmax_error(ctx, e):
-    """mar-4.3-pmax-error: peak contact pressure against eq. 25 at every depth, paper variant."""
+def hertz_judged(ctx, e, key):
+    """The Hertz paper-variant run judged on one error (key 'p': peak pressure, 'line': load; hertz_errors) in plane
+    strain: (tolerance, depths um, paper variant's errors, hooke's, paper's status, its increments at rest, the
+    judged errors, all within the tolerance)."""
     lim = tol(e)
     d, ep, st, conv = hertz_row(ctx, "hertz_paper", N_DEPTHS)
-    _, eh, sth, convh = hertz_row(ctx, "hertz_hooke", N_DEPTHS)
-    err = ep["plane strain"]["p"]
-    ok = worst(err) <= lim
+    eh = hertz_row(ctx, "hertz_hooke", N_DEPTHS)[1]
+    err = ep["plane strain"][key]
+    return lim, d, ep, eh, st, conv, err, worst(err) <= lim
+
+
+@claim("mar-4.3-pmax-error")
+def pmax_error(ctx, e):
+    """mar-4.3-pmax-error: peak contact pressure against eq. 25 at every depth, paper variant."""
+    lim, d, ep, eh, st, conv, err, ok = hertz_judged(ctx, e, "p")
     return measurement(
         f"paper variant: {fmt_list(err)} at {fmt_list(d, '{:g}')} um ({conv} of {N_DEPTHS} increments at rest, {st}); "
         f"hooke (completion): {fmt_list(eh['plane strain']['p'])}", ok,
@@ -751,13 +793,10 @@ def pmax_error(ctx, e):
                     "hertz_increments: only the exact circle and equal increments were run")
 
 
+@claim("mar-4.3-load-error")
 def load_error(ctx, e):
     """mar-4.3-load-error: the numerically integrated load against the Hertz line contact at every depth."""
-    lim = tol(e)
-    d, ep, st, conv = hertz_row(ctx, "hertz_paper", N_DEPTHS)
-    _, eh, _, _ = hertz_row(ctx, "hertz_hooke", N_DEPTHS)
-    err = ep["plane strain"]["line"]
-    ok = worst(err) <= lim
+    lim, d, ep, eh, st, _, err, ok = hertz_judged(ctx, e, "line")
     return measurement(
         f"paper variant: {fmt_list(err)} at {fmt_list(d, '{:g}')} um ({st}); hooke (completion): "
         f"{fmt_list(eh['plane strain']['line'])}", ok,
@@ -771,6 +810,7 @@ def load_error(ctx, e):
                     f"{worst(ep['plane stress']['line']):.1%}")
 
 
+@claim("mar-4.3-settled")
 def settled(ctx, e):
     """mar-4.3-settled: every increment of the paper variant comes to rest."""
     ds = solid(ctx, "hertz_paper")
@@ -800,6 +840,7 @@ def eq27_run(ctx, rid, lim):
                 f"{float(ds.attrs['dt_max_s']):.3g} s"), move
 
 
+@claim("mar-4.3-extremely-stable")
 def extremely_stable(ctx, e):
     """mar-4.3-extremely-stable: the paper variant stepped by eqs. 26-27 (undamped) stays stable."""
     lim = tol(e)
@@ -815,6 +856,7 @@ def extremely_stable(ctx, e):
                        sensitivity="; ".join(sens) + "; sound_speed: eq. 26's cap uses sqrt(E / rho) only")
 
 
+@claim("mar-4.3-eq27-guarantee")
 def eq27_guarantee(ctx, e):
     """mar-4.3-eq27-guarantee: no particle moves more than 0.1 dx in a step under eq. 27 stepping."""
     lim = tol(e)
@@ -829,6 +871,7 @@ def eq27_guarantee(ctx, e):
         margin=f"{move:.3g} dx against {lim:g} dx")
 
 
+@claim("mar-4.3-eq27-stability")
 def eq27_stability(ctx, e):
     """mar-4.3-eq27-stability: eq. 27 alone (no eq. 26 cap) keeps the model stable."""
     lim = tol(e)
@@ -848,6 +891,7 @@ def sound_speeds(E, nu, rho):
     return {"shear": np.sqrt(G / rho), "bar": np.sqrt(E / rho), "P-wave": np.sqrt(M / rho)}
 
 
+@claim("mar-4.3-dt-vs-eq26")
 def dt_vs_eq26(ctx, e):
     """mar-4.3-dt-vs-eq26: the stated 15-56 ns against eq. 26's longest permitted step."""
     dx = num(e, "dx_um") * 1e-6
@@ -865,6 +909,7 @@ def dt_vs_eq26(ctx, e):
         sensitivity="sound_speed: the inconsistency holds for all three speeds")
 
 
+@claim("mar-4.3-dt-stable")
 def dt_stable(ctx, e):
     """mar-4.3-dt-stable: the paper variant at fixed 15 ns and 56 ns (second increment)."""
     lim = tol(e)
@@ -884,6 +929,7 @@ def scale_radius_runs(e):
     return [r["id"].split(":", 1)[1] for r in e["runs"]]
 
 
+@claim("mar-4.3-scale-match")
 def scale_match(ctx, e):
     """mar-4.3-scale-match: peak pressure and load errors at the other disk radii (same plate)."""
     lp, ll = tol(e, 0), tol(e, 1)
@@ -906,6 +952,7 @@ def scale_match(ctx, e):
                                    "would repeat the kept radius's result by dimensional analysis)")
 
 
+@claim("mar-4.3-scale-contact-width")
 def scale_contact_width(ctx, e):
     """mar-4.3-scale-contact-width: sqrt(2 R delta) at 20 m against the plate's half-width."""
     R = num(e, "radius_m")
@@ -926,6 +973,7 @@ def scale_contact_width(ctx, e):
 # ---------------------------------------------------------------------------------- 4.4 pressure vessel
 
 
+@claim("mar-4.4-inputs")
 def vessel_inputs(ctx, e):
     """mar-4.4-inputs: the vessel runs' geometry, materials, initial pressure and step against the page."""
     w = solid(ctx, "vessel_water_particles")
@@ -958,6 +1006,7 @@ def vessel_inputs(ctx, e):
                                    "(not page text)")
 
 
+@claim("mar-4.4-atm")
 def atm(ctx, e):
     """mar-4.4-atm: 101,135 Pa against 1 atm = 101,325 Pa."""
     d = abs(num(e, "atm_Pa") - num(e, "p0_Pa"))
@@ -984,6 +1033,7 @@ def reached(ds, t):
     return float(ds["time"].values[-1]) >= t * (1 - 1e-9)
 
 
+@claim("mar-4.4-settle")
 def settle(ctx, e):
     """mar-4.4-settle: the paper's 400 x 146.8 ns against a quarter of the ring's breathing period."""
     lim = tol(e)
@@ -1015,6 +1065,7 @@ def settle(ctx, e):
                        sensitivity=sens, sweep=sweep)
 
 
+@claim("mar-4.4-stable")
 def vessel_stable(ctx, e):
     """mar-4.4-stable: the vessel with water, printed solid model: no escape, no move beyond 0.1 dx in a step."""
     lim = tol(e)
@@ -1037,6 +1088,7 @@ def vessel_stable(ctx, e):
         sensitivity="vessel_model: the water's h and viscosity were not swept", sweep=sweep)
 
 
+@claim("mar-4.4-outward")
 def outward(ctx, e):
     """mar-4.4-outward: every ring particle moves outward, at the paper's end and in the cycle mean."""
     lim = tol(e)
@@ -1080,6 +1132,7 @@ def quarter_halfranges(ds):
     return np.array(out)
 
 
+@claim("mar-4.4-pressure-stabilises")
 def pressure_stabilises(ctx, e):
     """mar-4.4-pressure-stabilises: the water pressure's fluctuation over the paper's 400 steps decays."""
     ds = solid(ctx, "vessel_water_particles")
@@ -1100,6 +1153,7 @@ def pressure_stabilises(ctx, e):
                        margin=f"last / first quarter {q[-1] / q[0]:.2f} against 1", sensitivity=sens, sweep=sweep)
 
 
+@claim("prj-floor-beam")
 def floor_beam(ctx, e):
     """prj-floor-beam: the elastic floor's mid-span deflection against beam theory under the same loads."""
     lim = tol(e)
@@ -1115,56 +1169,3 @@ def floor_beam(ctx, e):
                        why="" if ok else "the 5-layer lattice plate is stiffer than Euler-Bernoulli theory (second "
                                          "order in dx: -4.8 % with 10 layers)",
                        margin=f"worst |error| {max(abs(x) for x in errs):.1%} against {lim:.0%}")
-
-
-MEASURES = {
-    "mar-abs-stable": abs_stable,
-    "mar-abs-all-match": abs_all_match,
-    "mar-abs-tensile-solid": abs_tensile_solid,
-    "mar-3-eq15-rest-length": eq15_rest_length,
-    "mar-3-no-poisson": no_poisson,
-    "mar-3-shear-mechanism": shear_mechanism,
-    "mar-3-coupling": coupling,
-    "mar-4.1-bar-inputs": bar_inputs,
-    "mar-4.1-bar-length": bar_length,
-    "mar-4.1-stress-vs-hooke": stress_vs_hooke,
-    "mar-4.1-tension-hooke": tension_hooke,
-    "mar-4.1-necking-value": necking_value,
-    "mar-4.1-poisson-arith": poisson_arith,
-    "mar-4.1-poisson-error-claim": poisson_error_claim,
-    "mar-4.1-poisson-method": poisson_method,
-    "mar-4.1-compression-symmetric": compression_symmetric,
-    "mar-4.1-bulging-symmetric": bulging_symmetric,
-    "mar-4.1-neck-bulge": neck_bulge,
-    "mar-4.2-shear-inputs": shear_inputs,
-    "mar-4.2-height-arith": height_arith,
-    "mar-4.2-g-arith": g_arith,
-    "mar-4.2-gamma-arith": gamma_arith,
-    "mar-4.2-tau-arith": tau_arith,
-    "mar-4.2-error-arith": error_arith,
-    "mar-4.2-shear-num": shear_num,
-    "mar-4.3-plate-dims": plate_dims,
-    "mar-4.3-inputs": hertz_inputs,
-    "mar-4.3-ered-arith": ered_arith,
-    "mar-4.3-ered-unit": ered_unit,
-    "mar-4.3-chord-not-hertz": chord_not_hertz,
-    "mar-4.3-pmax-arith": pmax_arith,
-    "mar-4.3-load-arith": load_arith,
-    "mar-4.3-load-error": load_error,
-    "mar-4.3-pmax-error": pmax_error,
-    "mar-4.3-settled": settled,
-    "mar-4.3-extremely-stable": extremely_stable,
-    "mar-4.3-eq27-guarantee": eq27_guarantee,
-    "mar-4.3-eq27-stability": eq27_stability,
-    "mar-4.3-dt-vs-eq26": dt_vs_eq26,
-    "mar-4.3-dt-stable": dt_stable,
-    "mar-4.3-scale-match": scale_match,
-    "mar-4.3-scale-contact-width": scale_contact_width,
-    "mar-4.4-inputs": vessel_inputs,
-    "mar-4.4-atm": atm,
-    "mar-4.4-settle": settle,
-    "mar-4.4-stable": vessel_stable,
-    "mar-4.4-outward": outward,
-    "mar-4.4-pressure-stabilises": pressure_stabilises,
-    "prj-floor-beam": floor_beam,
-}

@@ -22,6 +22,16 @@ def read_runs(paths):
     return out
 
 
+def finish(fig, outputs, *panels):
+    """Label every panel (axes, legend location, Axes.set keywords; legend in 6 pt), lay the figure out and save
+    it to outputs [png, pdf]."""
+    for ax, loc, labels in panels:
+        ax.set(**labels)
+        ax.legend(fontsize=6, loc=loc)
+    fig.tight_layout()
+    save(fig, outputs)
+
+
 def _slice(ds, scale):
     """(ref x, y), (deformed x, y) of the middle z layer, displacements times scale [cm]."""
     k = ds["lattice_index"].values[:, 2]
@@ -82,18 +92,10 @@ def hertz_figure(config_path, runs, outputs):
         dep = ds["depth"].values * 1e4
         a.plot(dep[ok], ds["load"].values[ok] * 100 / 1e6, v.marker, color=v.colour, label=f"{var} variant: settled increments")
         b.plot(dep[ok], to_pa(ds["pmax"].values[ok]) / 1e9, v.marker, color=v.colour, label=f"{var} variant: settled increments")
-    a.set(xlabel="indentation delta [um]", ylabel="load per unit thickness [MN/m]", title="(a) total load")
-    b.set(xlabel="indentation delta [um]", ylabel="peak contact pressure [GPa]", title="(b) peak pressure")
-    a.legend(fontsize=6, loc="upper left")
-    b.legend(fontsize=6, loc="upper left")
-    fig.tight_layout()
-    save(fig, outputs)
-
-
-def bar_and_hertz(cfg, runs, outputs):
-    """Both figures (workflow entry point): outputs are the bar's [png, pdf], then Hertz's."""
-    bar_figure(cfg, runs, outputs[:2])
-    hertz_figure(cfg, runs, outputs[2:])
+    finish(fig, outputs, (a, "upper left", dict(xlabel="indentation delta [um]", ylabel="load per unit thickness [MN/m]",
+                                               title="(a) total load")),
+           (b, "upper left", dict(xlabel="indentation delta [um]", ylabel="peak contact pressure [GPa]",
+                                  title="(b) peak pressure")))
 
 
 def vessel_figure(config_path, runs, outputs):
@@ -176,16 +178,22 @@ def floor_figure(config_path, runs, outputs):
                label=f"beam theory, loads: {name}")
         b.plot(x, np.cumsum(ds["nodal_load"].values), color=colour, lw=1.2, label=name)
     a.invert_yaxis()
-    a.set(xlabel="x [cm]", ylabel="deflection (down) [mm]", title="(a) plate deflection, middle row")
-    b.set(xlabel="x [cm]", ylabel="floor load from x = 0 to x [N per cm thickness]",
-          title="(b) applied floor load, cumulative")
-    a.legend(fontsize=6, loc="upper center")
-    b.legend(fontsize=6, loc="upper left")
-    fig.tight_layout()
-    save(fig, outputs)
+    finish(fig, outputs, (a, "upper center", dict(xlabel="x [cm]", ylabel="deflection (down) [mm]",
+                                                 title="(a) plate deflection, middle row")),
+           (b, "upper left", dict(xlabel="x [cm]", ylabel="floor load from x = 0 to x [N per cm thickness]",
+                                  title="(b) applied floor load, cumulative")))
 
 
-def vessel_and_floor(cfg, runs, outputs):
-    """Both figures (workflow entry point): outputs are the vessel's [png, pdf], then the floor's."""
-    vessel_figure(cfg, runs, outputs[:2])
-    floor_figure(cfg, runs, outputs[2:])
+def pair_of(first, second):
+    """A workflow entry point (cfg: the settings file, runs, outputs) drawing two figures: outputs are first's
+    [png, pdf], then second's."""
+
+    def both(cfg, runs, outputs):
+        first(cfg, runs, outputs[:2])
+        second(cfg, runs, outputs[2:])
+
+    return both
+
+
+bar_and_hertz = pair_of(bar_figure, hertz_figure)
+vessel_and_floor = pair_of(vessel_figure, floor_figure)

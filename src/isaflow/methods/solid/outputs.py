@@ -1,7 +1,8 @@
 """Run files of the solid cases (netCDF, units on every variable, provenance, atomic write).
 
-The variables are built here, not by isaflow.runfile.to_dataset, because that one needs a tank
-and the solid cases have none (no walls, no liquid); provenance and the atomic write are runfile's.
+The variables every run file holds are isaflow.runfile.contract_variables'; the rest is built here, not by
+isaflow.runfile.to_dataset, because that one needs a tank and the solid cases have none (no walls, no
+liquid); provenance and the atomic write are runfile's.
 """
 
 import logging
@@ -19,26 +20,14 @@ from . import cases, settings, solve
 
 
 def to_dataset(r, config_path, started, finished):
-    """xarray Dataset of a solid contract.Result (variables as runfile.to_dataset names them)."""
+    """xarray Dataset of a solid contract.Result (runfile.contract_variables, and the case's own)."""
 
     def var(dims, data, units, long_name):
         return xr.Variable(dims, np.asarray(data), {"units": units, "long_name": long_name})
 
-    xy = ("particle", "xy")
-    data = {
-        "pos0": var(xy, r.pos0, "cm", "initial particle position x, y"),
-        "pos": var(xy, r.pos, "cm", "final particle position x, y"),
-        "weight": var(("particle",), r.weight, "N", "particle weight m g (dim 2: per cm thickness)"),
-        "contact_wall": var(("contact",), np.asarray(r.contact_wall, np.int32), "1", "wall index of wall contact"),
-        "contact_point": var(("contact", "xy"), r.contact_point, "cm", "contact point on the wall"),
-        "contact_force": var(("contact", "xy"), r.contact_force, "N", "force of the wall at the contact"),
-        "steps": var((), np.int64(r.steps), "1", "steps taken"),
-        "start_step": var((), np.int64(r.start_step), "1", "steps taken before this run"),
-        "wall_time": var((), r.wall_time, "s", "solver wall-clock time (compilation excluded)"),
-        "force_evals": var((), np.int64(r.force_evals), "1", "force evaluations"),
-        "residual": var((), r.residual, r.residual_units, f"final {r.residual_name}"),
-        "sim_time": var((), r.sim_time, "s", "physical time simulated"),
-    }
+    particles, rest = runfile.contract_variables(r)
+    data = {**particles, **rest, "sim_time": var((), r.sim_time, "s", "physical time simulated")}
+    data["weight"].attrs["long_name"] += " (dim 2: per cm thickness)"
     if not np.isfinite(r.residual):  # a fixed-length run (the vessel with water) has no stop test
         data["residual"].attrs["missing"] = "not applicable: the run has no stop test"
     for name, (dims, arr, units, long_name) in {**r.fields, **r.history}.items():

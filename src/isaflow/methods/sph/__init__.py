@@ -12,25 +12,16 @@ outcome -> contract.Result), ``analysis`` (measures, summary, claims, report),
 from .. import Method, Variant
 
 METHOD = Method(
-    name="sph",
+    name="sph", order=50, marker="s", tank=True,
     label="weakly compressible SPH",
-    paper="marko2017",
-    variants={
-        "wcsph": Variant("wcsph", "WCSPH: marko2017 eqs. 4, 9 with continuity density in place of eq. 6 (free "
-                                  "surface) + Tait EOS, artificial viscosity, Adami walls (completions from literature)",
-                         "tab:orange", "D"),
-        "wcsph_eq6": Variant("wcsph_eq6", "WCSPH with marko2017 eq. 6 literally (summed density, P >= 0; its surface "
-                                          "band reads low)", "tab:brown", "d"),
-        "delta_wc2": Variant("delta_wc2", "delta-SPH, Wendland C2: continuity density + density diffusion "
-                                          "(variant, not marko2017)", "tab:red", "v"),
-    },
-    marker="s",
-    paper_label="Marko et al. (2017), SPH liquid and Hooke's-law solid particles",
-    tank=True,
-    entry="isaflow.methods.sph.method",
-    checks="isaflow.methods.sph.checks",
-    values="isaflow.methods.sph.settings:VALUES",
-    settings="config/methods/sph.yaml",
-    report="results/report/50_sph.md",
-    timing="results/timing/50_sph.md",
+    paper="marko2017", paper_label="Marko et al. (2017), SPH liquid and Hooke's-law solid particles",
+    variants=(
+        Variant("wcsph", "WCSPH: marko2017 eqs. 4, 9 with continuity density in place of eq. 6 (free "
+                         "surface) + Tait EOS, artificial viscosity, Adami walls (completions from literature)",
+                "tab:orange", "D"),
+        Variant("wcsph_eq6", "WCSPH with marko2017 eq. 6 literally (summed density, P >= 0; its surface "
+                             "band reads low)", "tab:brown", "d"),
+        Variant("delta_wc2", "delta-SPH, Wendland C2: continuity density + density diffusion "
+                             "(variant, not marko2017)", "tab:red", "v"),
+    ),
 )

@@ -40,6 +40,7 @@ CHUNK = 1024  # particles per chunk of the per-particle loops (fixed: results do
  WALL_VISC, LJ_D, LJ_R0, NPAR) = range(19)
 # return codes of advance()
 OK, CROSSED, LEFT_BOX, NONFINITE = range(4)
+KERNELS, FORCES = range(2)  # the pair passes (_pair_pass)
 
 
 def list_pairs(x, nf, box, rc, walls, reach=0.0):
@@ -184,40 +185,35 @@ def force_range(lo, hi, x, v, rho, p_rho2, nf, pi, pj, par, fk, acc, wall_force)
         acc[run, 1] = sy
 
 
-@njit(**PJIT)
-def _kernel_par(col, x, v, rho, nf, pi, pj, par, wk, fk, out):
-    ncol = col.shape[0] - 1
-    for colour in range(2):
-        for cc in prange((ncol - colour + 1) // 2):
-            c = 2 * cc + colour
-            kernel_range(col[c], col[c + 1], x, v, rho, nf, pi, pj, par, wk, fk, out)
-
-
 @njit(**JIT)
-def _kernel_ser(col, x, v, rho, nf, pi, pj, par, wk, fk, out):
-    ncol = col.shape[0] - 1
-    for colour in range(2):
-        for cc in range((ncol - colour + 1) // 2):
-            c = 2 * cc + colour
-            kernel_range(col[c], col[c + 1], x, v, rho, nf, pi, pj, par, wk, fk, out)
+def _pass_range(which, lo, hi, x, v, rho, p_rho2, nf, pi, pj, par, wk, fk, out, acc, wall_force):
+    """Pairs lo..hi-1 of one pair pass: :func:`kernel_range` (KERNELS) or :func:`force_range` (FORCES)."""
+    if which == KERNELS:
+        kernel_range(lo, hi, x, v, rho, nf, pi, pj, par, wk, fk, out)
+    else:
+        force_range(lo, hi, x, v, rho, p_rho2, nf, pi, pj, par, fk, acc, wall_force)
 
 
 @njit(**PJIT)
-def _force_par(col, x, v, rho, p_rho2, nf, pi, pj, par, fk, acc, wall_force):
-    ncol = col.shape[0] - 1
-    for colour in range(2):
-        for cc in prange((ncol - colour + 1) // 2):
-            c = 2 * cc + colour
-            force_range(col[c], col[c + 1], x, v, rho, p_rho2, nf, pi, pj, par, fk, acc, wall_force)
+def _colour_par(which, colour, col, x, v, rho, p_rho2, nf, pi, pj, par, wk, fk, out, acc, wall_force):
+    """The columns of one colour (no two of them reach the same particle) in parallel."""
+    for cc in prange((col.shape[0] - colour) // 2):
+        c = 2 * cc + colour
+        _pass_range(which, col[c], col[c + 1], x, v, rho, p_rho2, nf, pi, pj, par, wk, fk, out, acc, wall_force)
 
 
 @njit(**JIT)
-def _force_ser(col, x, v, rho, p_rho2, nf, pi, pj, par, fk, acc, wall_force):
+def _pair_pass(which, threads, col, x, v, rho, p_rho2, nf, pi, pj, par, wk, fk, out, acc, wall_force):
+    """One pair pass (:func:`_pass_range`) over the cell columns col: the even columns, then the odd ones,
+    each column in list order; a colour's columns in parallel if threads > 1 (the same bits)."""
     ncol = col.shape[0] - 1
     for colour in range(2):
-        for cc in range((ncol - colour + 1) // 2):
-            c = 2 * cc + colour
-            force_range(col[c], col[c + 1], x, v, rho, p_rho2, nf, pi, pj, par, fk, acc, wall_force)
+        if threads > 1:
+            _colour_par(which, colour, col, x, v, rho, p_rho2, nf, pi, pj, par, wk, fk, out, acc, wall_force)
+        else:
+            for c in range(colour, ncol, 2):
+                _pass_range(which, col[c], col[c + 1], x, v, rho, p_rho2, nf, pi, pj, par, wk, fk, out, acc,
+                            wall_force)
 
 
 @njit(**JIT)
@@ -300,40 +296,33 @@ def state_forces(x, v, rho, p, nf, walls, par, lst, wk, fk, acc, wall_force, pan
     else:
         rate[:] = 0.0
         out = rate
+    _pair_pass(KERNELS, threads, col, x, v, rho, p_rho2, nf, pi, pj, par, wk, fk, out, acc, wall_force)
     if threads > 1:
-        _kernel_par(col, x, v, rho, nf, pi, pj, par, wk, fk, out)
         _particles_par(nf, nw, x, rho, rate, p, p_rho2, acc, par, update and not summation, pi, wrow, wpair, wk,
                        wall_force)
         _walls_par(nf, nw, x, rho, p, p_rho2, pi, wrow, wpair, wk, par, wall_force)
-        _force_par(col, x, v, rho, p_rho2, nf, pi, pj, par, fk, acc, wall_force)
     else:
-        _kernel_ser(col, x, v, rho, nf, pi, pj, par, wk, fk, out)
         liquid_range(0, nf, rho, rate, p, p_rho2, acc, par, update and not summation)
         wall_range(0, nw, x, rho, p, p_rho2, nf, pi, wrow, wpair, wk, par, wall_force)
-        _force_ser(col, x, v, rho, p_rho2, nf, pi, pj, par, fk, acc, wall_force)
+    _pair_pass(FORCES, threads, col, x, v, rho, p_rho2, nf, pi, pj, par, wk, fk, out, acc, wall_force)
     wall_repulsion(x, close, walls, panel0, npanel, par[LJ_D], par[LJ_R0], par[MASS], acc, panel_sum)
+
+
+@njit(**JIT)
+def _kick_range(lo, hi, v, acc, half):
+    """Particles lo..hi-1: v += half acc (a half kick, half = dt / 2); returns their sum of |v|^2 after it."""
+    s = 0.0
+    for a in range(lo, hi):
+        v[a, 0] += half * acc[a, 0]
+        v[a, 1] += half * acc[a, 1]
+        s += v[a, 0] * v[a, 0] + v[a, 1] * v[a, 1]
+    return s
 
 
 @njit(**PJIT)
 def _kick_par(nf, v, acc, half, part):
     for ch in prange((nf + CHUNK - 1) // CHUNK):
-        s = 0.0
-        for a in range(ch * CHUNK, min(nf, (ch + 1) * CHUNK)):
-            v[a, 0] += half * acc[a, 0]
-            v[a, 1] += half * acc[a, 1]
-            s += v[a, 0] * v[a, 0] + v[a, 1] * v[a, 1]
-        part[ch] = s
-
-
-@njit(**JIT)
-def _kick_ser(nf, v, acc, half, part):
-    for ch in range((nf + CHUNK - 1) // CHUNK):
-        s = 0.0
-        for a in range(ch * CHUNK, min(nf, (ch + 1) * CHUNK)):
-            v[a, 0] += half * acc[a, 0]
-            v[a, 1] += half * acc[a, 1]
-            s += v[a, 0] * v[a, 0] + v[a, 1] * v[a, 1]
-        part[ch] = s
+        part[ch] = _kick_range(ch * CHUNK, min(nf, (ch + 1) * CHUNK), v, acc, half)
 
 
 @njit(**JIT)
@@ -425,7 +414,8 @@ def advance(x, v, rho, p, nf, walls, box, grid_box, par, n_steps, xref, lst, wk,
             if threads > 1:
                 _kick_par(nf, v, acc, half, part)
             else:
-                _kick_ser(nf, v, acc, half, part)
+                for ch in range(nch):
+                    part[ch] = _kick_range(ch * CHUNK, min(nf, (ch + 1) * CHUNK), v, acc, half)
         elif threads > 1:
             _move_par(nf, x, v, acc, xref, half, dt, box, walls, lst[7], slack, finish, part, moved, cross, bad)
         else:

@@ -12,28 +12,15 @@ config/claims/merino_alonso2020.yaml).  A 1D static study: it writes its own tab
 from isaflow.methods import Method, Variant
 
 METHOD = Method(
-    name="sph1d",
+    name="sph1d", order=60, marker="v",
     label="truncated SPH hydrostatic column (1D, static linear system)",
-    paper="merino_alonso2020",
-    variants={
-        "symmetric_hydrostatic": Variant(
-            "symmetric_hydrostatic",
-            "symmetric gradient (p_i + p_j), mirror floor ghosts with hydrostatic pressure (our reading; not stated)",
-            "tab:blue", "o"),
-        "plain_hydrostatic": Variant(
-            "plain_hydrostatic",
-            "plain gradient (p_j), mirror floor ghosts with hydrostatic pressure (alternative reading)",
-            "tab:green", "s"),
-        "symmetric_equal": Variant(
-            "symmetric_equal",
-            "symmetric gradient (p_i + p_j), mirror floor ghosts with equal pressure (alternative reading)",
-            "tab:purple", "^"),
-    },
-    marker="v",
-    paper_label="Merino-Alonso et al. (2020), truncated SPH hydrostatics (abstract only)",
-    settings="config/methods/sph1d.yaml",
-    checks="isaflow.methods.sph1d.checks",
-    values="isaflow.methods.sph1d.settings:VALUES",
-    report="results/report/60_sph1d.md",
-    timing="results/timing/60_sph1d.md",
+    paper="merino_alonso2020", paper_label="Merino-Alonso et al. (2020), truncated SPH hydrostatics (abstract only)",
+    variants=(
+        Variant("symmetric_hydrostatic", "symmetric gradient (p_i + p_j), mirror floor ghosts with hydrostatic "
+                "pressure (our reading; not stated)", "tab:blue", "o"),
+        Variant("plain_hydrostatic", "plain gradient (p_j), mirror floor ghosts with hydrostatic pressure "
+                "(alternative reading)", "tab:green", "s"),
+        Variant("symmetric_equal", "symmetric gradient (p_i + p_j), mirror floor ghosts with equal pressure "
+                "(alternative reading)", "tab:purple", "^"),
+    ),
 )

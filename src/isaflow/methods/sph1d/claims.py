@@ -18,9 +18,11 @@ import pandas as pd
 from scipy import stats
 
 from ... import claims_registry
-from ...claims import Measurement
+from ...claims import Measurement, measure_table
 from ...inputs import InputError, load as load_yaml
 from . import closed_form, column, sweep
+
+MEASURES, claim = measure_table()  # {claim id: measure(ctx, entry)}, each measure entered by @claim(id)
 
 SWEEP = "sph1d:sweep"
 EXTENDED = "sph1d:sweep_n8192"  # the sweep to N = 8192 (registry input n_window): sensitivity only
@@ -126,6 +128,7 @@ def _window_text(ds):
 # --- the sweep's design and the linear system --------------------------------------------------------------
 
 
+@claim("mer-abs-setup")
 def measure_setup(ctx, entry):
     ds = ctx.run(SWEEP)
     n = ds.n.values
@@ -144,6 +147,7 @@ def measure_setup(ctx, entry):
         margin="exact rule (no threshold)")
 
 
+@claim("mer-abs-linear")
 def measure_linear(ctx, entry):
     tol = entry["tolerance"]["value"]
     ds = ctx.run(SWEEP)
@@ -172,6 +176,7 @@ def measure_linear(ctx, entry):
 # --- one neighbour per side ---------------------------------------------------------------------------------
 
 
+@claim("mer-abs-one-nb-explicit")
 def measure_one_nb_explicit(ctx, entry):
     tol = entry["tolerance"]["value"]
     ds = ctx.run(SWEEP)
@@ -225,10 +230,12 @@ def _judge_no_convergence(c, entry):
             f"{SHORT[worst]}: only {int(count[worst])} of {int(size[worst])} ratios do not converge")
 
 
+@claim("mer-abs-one-nb-no-convergence")
 def measure_one_nb_no_convergence(ctx, entry):
     return _judged(ctx, _judge_no_convergence, cases, entry)
 
 
+@claim("mer-abs-one-nb-residue")
 def measure_one_nb_residue(ctx, entry):
     large = entry["tolerance"]["value"]
     most = parameters(entry)["most"]
@@ -298,6 +305,7 @@ def _judge_cond_association(c, entry):
         "often than chance"
 
 
+@claim("mer-abs-cond-association")
 def measure_cond_association(ctx, entry):
     return _judged(ctx, _judge_cond_association, lambda ds, entry: limits(ds), entry)
 
@@ -319,6 +327,7 @@ def _judge_two_three_small(c, entry):
             f"only {100 * share:.0f} % of the cases settle to a small non-zero limit")
 
 
+@claim("mer-abs-two-three-small")
 def measure_two_three_small(ctx, entry):
     return _judged(ctx, _judge_two_three_small, cases, entry)
 
@@ -350,6 +359,7 @@ def _judge_c2_divergent_two(c, entry):
         "no two-neighbour ratio of Wendland C2 diverges"
 
 
+@claim("mer-abs-c2-divergent-two")
 def measure_c2_divergent_two(ctx, entry):
     return _judged(ctx, _judge_c2_divergent_two, cases, entry)
 
@@ -363,6 +373,7 @@ def _judge_c2_worst(c, entry):
         f"C2 has {n['wendland_c2']} divergent ratios, not more than C4 ({n['wendland_c4']}) and C6 ({n['wendland_c6']})"
 
 
+@claim("mer-abs-c2-worst")
 def measure_c2_worst(ctx, entry):
     return _judged(ctx, _judge_c2_worst, cases, entry)
 
@@ -379,22 +390,9 @@ def _judge_c2_illcond(c, entry):
     return ok, text, (f"share {share:.3f} against {share_min:g}" if len(div) else "needs one divergent C2 ratio"), why
 
 
+@claim("mer-abs-c2-illcond")
 def measure_c2_illcond(ctx, entry):
     return _judged(ctx, _judge_c2_illcond, cases, entry)
-
-
-MEASURES = {
-    "mer-abs-setup": measure_setup,
-    "mer-abs-linear": measure_linear,
-    "mer-abs-one-nb-explicit": measure_one_nb_explicit,
-    "mer-abs-one-nb-no-convergence": measure_one_nb_no_convergence,
-    "mer-abs-one-nb-residue": measure_one_nb_residue,
-    "mer-abs-cond-association": measure_cond_association,
-    "mer-abs-two-three-small": measure_two_three_small,
-    "mer-abs-c2-divergent-two": measure_c2_divergent_two,
-    "mer-abs-c2-worst": measure_c2_worst,
-    "mer-abs-c2-illcond": measure_c2_illcond,
-}
 
 
 def rule_of_file(path):
