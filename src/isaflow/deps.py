@@ -3,9 +3,9 @@
 The workflow gives every rule the files of :func:`closure` of the module it
 calls as inputs, so editing any module an output depends on (directly or
 through another module) reruns the rule.  Imports are read from the source
-(ast), anywhere in a module (also inside functions); the registry's method
-packages (its ``PACKAGES``) and literal ``import_module("isaflow...")`` calls
-count as imports.  A method's entry module is what the run rule adds itself.
+(ast), anywhere in a module (also inside functions); the sub-packages a
+registry finds itself (an ``__init__`` calling ``pkgutil.iter_modules(__path__)``)
+and literal ``import_module("isaflow...")`` calls count as imports.  A method's entry module is what the run rule adds itself.
 The JSON schemas beside a module count as its source.  Pure Python.
 """
 
@@ -58,11 +58,10 @@ def imports(path, by_name=True):
             found.add(mod)
             found.update(f"{mod}.{a.name}" for a in node.names)  # 'from . import x' imports module x
     if by_name:
-        for node in ast.walk(tree):  # a registry's PACKAGES = ("a", "b"): it imports isaflow.methods.a, ...
-            if isinstance(node, ast.Assign) and any(getattr(t, "id", "") == "PACKAGES" for t in node.targets):
-                found.update(f"{'.'.join(here)}.{c.value}" for c in getattr(node.value, "elts", [])
-                             if isinstance(c, ast.Constant))
         text = path.read_text()
+        if path.name == "__init__.py" and "pkgutil.iter_modules(__path__)" in text:  # a registry that imports
+            # every sub-package beside it (isaflow.methods): it imports isaflow.methods.a, ...
+            found.update(f"{'.'.join(here)}.{p.parent.name}" for p in sorted(path.parent.glob("*/__init__.py")))
         found.update(re.findall(r"""import_module\(\s*["'](isaflow\.[\w.]+)["']""", text))
     return frozenset(m for m in found if m.split(".")[0] == PACKAGE and module_file(m))
 

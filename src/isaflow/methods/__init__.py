@@ -6,10 +6,11 @@ so the workflow reads the registry while it is parsed.  A package declares only
 what is its own (label, paper, marker, variants, fragment number); its modules
 ``<package>.method``, ``.checks``, ``.settings:VALUES``, its settings file
 ``config/methods/<name>.yaml`` and fragments ``NN_<name>.md`` follow from its
-name (:class:`Method`).  Add a new method's
-package name to ``PACKAGES``; nothing outside ``methods/`` names a method or
-a variant: labels, colours, markers, papers, settings files, claims modules and
-report fragments all come from here.
+name (:class:`Method`).  The registry finds the packages itself
+(:data:`PACKAGES`: every sub-package defining ``METHOD``, in fragment order), so
+adding a method edits no file of the registry; nothing outside ``methods/``
+names a method or a variant: labels, colours, markers, papers, settings files,
+claims modules and report fragments all come from here.
 
 A *tank method* (``tank=True``) runs on the shared tanks: its ``entry``
 module provides ``check(tank, settings, start)``,
@@ -23,9 +24,8 @@ stability)`` and ``cost(tank, settings, particles) -> [isaflow.budget.Cost]``
 """
 
 import importlib
+import pkgutil
 from dataclasses import dataclass, field
-
-PACKAGES = ("isa", "sph", "mps", "sph1d", "solid")
 
 
 @dataclass(frozen=True)
@@ -116,3 +116,19 @@ def variant(method, name):
 def label(method, name):
     """Label of a method's variant, e.g. 'paper: x += du F / max|F| (section 3.3, literal)'."""
     return variant(method, name).label
+
+
+def _discover():
+    """Names of the method packages here: every sub-package whose ``__init__`` defines ``METHOD`` (named after
+    its package), ordered by ``Method.order`` (the place of its report fragment), then name."""
+    found = []
+    for info in pkgutil.iter_modules(__path__):
+        module = importlib.import_module(f"{__name__}.{info.name}") if info.ispkg else None
+        if module is not None and hasattr(module, "METHOD"):
+            if module.METHOD.name != info.name:
+                raise ValueError(f"{module.__file__}: METHOD.name '{module.METHOD.name}' is not its package's name")
+            found.append(module.METHOD)
+    return tuple(m.name for m in sorted(found, key=lambda m: (m.order, m.name)))
+
+
+PACKAGES = _discover()  # the registry's one list: isa, sph, mps, sph1d, solid (and any package added beside them)
