@@ -210,3 +210,41 @@ def test_the_robustness_figure_draws_every_input_a_fragile_method_result_flips_i
     assert robustness.judged_at([("10 dx (held)", True), ("11 dx", False)], "10 dx = 23.4 cm") == 0
     robustness.robustness_figure([table], [tmp_path / "f.png"])
     assert (tmp_path / "f.png").stat().st_size > 0
+
+
+def test_the_speed_targets_are_judged_from_the_settings_file(tmp_path):
+    """The benchmarks' fragment judges each speed target of config/methods/isa_workflow.yaml (speed_targets,
+    with its source) from the benchmark files: the same files meet a target set above them and miss one set
+    below; the compile-cache row misses when the second run found no cache."""
+    from isaflow.methods.isa.report import speed
+
+    f = {name: tmp_path / name for name in ("step.csv", "compile.csv", "memory.csv", "machine.txt", "output.csv",
+                                            "table1.csv", "table1.md")}
+    pd.DataFrame({"impl": ["numba"] * 3 + ["numpy"] * 3, "N": [10_000, 100_000, 1_000_000] * 2,
+                  "ns_per_particle_step": [18.0, 19.0, 19.5, 900.0, 950.0, 990.0]}).to_csv(f["step.csv"], index=False)
+    pd.DataFrame({"first_call_s": [20.0, 0.1], "cache_hits": [0, 12]}).to_csv(f["compile.csv"], index=False)
+    pd.DataFrame({"total_bytes_per_particle": [140.0]}).to_csv(f["memory.csv"], index=False)
+    f["machine.txt"].write_text("test machine\n")
+    pd.DataFrame({"setting": ["lean", "full"], "solver_s": [1.0, 1.1], "file_bytes": [1e5, 1e6]}).to_csv(
+        f["output.csv"], index=False)
+    pd.DataFrame({"ours_solver_s": [0.1, 1.0, 1.0, 2.0, 5.0, 10.0],
+                  "paper_time": ["5.0 sec", "1.5 min", "5.0 min", "15 min", "1.5 hr", "4.5 hr"]}).to_csv(f["table1.csv"],
+                                                                                                      index=False)
+    f["table1.md"].write_text("# Table 1\n| a |\n")
+    cfg = yaml.safe_load((Path(__file__).parents[1] / "config" / "methods" / "isa_workflow.yaml").read_text())
+    kept = {k: v["value"] for k, v in cfg["speed_targets"].items()}
+    assert all(v["source"].startswith("issue text: issue 4") for v in cfg["speed_targets"].values())
+
+    def judged(targets, compile_hits=12):
+        pd.DataFrame({"first_call_s": [20.0, 0.1], "cache_hits": [0, compile_hits]}).to_csv(f["compile.csv"], index=False)
+        out = tmp_path / "frag.md"
+        speed.timing_fragment(str(f["step.csv"]), str(f["compile.csv"]), str(f["memory.csv"]), str(f["machine.txt"]),
+                              str(f["output.csv"]), str(f["table1.csv"]), str(f["table1.md"]), [str(out)], targets)
+        rows = [r for r in out.read_text().splitlines() if r.startswith("| ") and ("meets" in r or "misses" in r)]
+        return ["misses" not in r for r in rows]
+
+    assert judged(kept) == [True, True, True, True, True, True, True]
+    strict = dict(kept, ns_per_particle_step=19.0, numpy_ratio=60.0, bytes_per_particle=100.0, growth_exponent=0.9,
+                  table1_solver_s=10.0)
+    assert judged(strict) == [False, False, False, False, True, False, True]
+    assert judged(kept, compile_hits=0)[4] is False

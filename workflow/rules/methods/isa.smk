@@ -427,6 +427,7 @@ use rule call as isa_timing with:
         "results/bench/10_isa.md",
     params:
         func="methods.isa.report.speed.timing_fragment",
+        kw={"targets": {k: v["value"] for k, v in ISA["speed_targets"].items()}},
     log:
         "logs/isa/report/timing.log",
 
