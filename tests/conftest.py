@@ -95,8 +95,8 @@ def box_walls(width=100.0, height=100.0):
 
 def settings_spec(spec):
     """An ISA settings mapping (config/methods/isa.yaml's dialect, one resolution 'r') of a scene mapping
-    (walls, particles, forces, solver as in methods.isa.scene.SCHEMA): lets a test run any scene through
-    isaflow.run, the path every run takes."""
+    (name, walls, vessels, particles, forces, solver with its variant, as methods.isa.scene.spec_of builds
+    it): lets a test run any scene through isaflow.run, the path every run takes."""
     src = "inferred: test scene"
     leaf = lambda v: {"value": v, "source": src}  # noqa: E731
     part, sol = spec["particles"], spec["solver"]
@@ -116,15 +116,33 @@ def settings_spec(spec):
     }
 
 
-def write_spec(tmp_path, spec, name="scene"):
-    """(tank path, settings path) of a scene mapping written as a tank and an ISA settings file."""
-    import yaml
-
+def tank_spec(spec):
+    """The tank mapping of a scene mapping (its walls and vessels; a liquid 10 cm deep)."""
     n = len(spec["particles"].get("points", [])) or 1
     tank = {"name": "test_tank", "walls": spec["walls"], "liquid": {"weight": spec["particles"]["weight"] * n,
                                                                      "depth": 10.0}}
     if spec.get("vessels"):
         tank["vessels"] = spec["vessels"]
+    return tank
+
+
+def scene_of(spec):
+    """A Scene of a scene mapping built in memory the way every run builds it: its settings validated and read
+    by the one settings loader (settings_spec), then methods.isa.scene.build."""
+    from isaflow import inputs, settings as S, tank as T
+    from isaflow.methods.isa.settings import VALUES
+
+    mapping = settings_spec(spec)
+    inputs.validate(mapping, S.file_schema(VALUES), "<test settings>")
+    s = S.load("<test settings>", VALUES, spec["solver"]["variant"], "r", spec=mapping)
+    return scene.build(T.Tank("<test tank>", tank_spec(spec), ""), s, spec["solver"]["variant"])
+
+
+def write_spec(tmp_path, spec, name="scene"):
+    """(tank path, settings path) of a scene mapping written as a tank and an ISA settings file."""
+    import yaml
+
+    tank = tank_spec(spec)
     tp, sp = tmp_path / f"{name}_tank.yaml", tmp_path / f"{name}_settings.yaml"
     tp.write_text(yaml.safe_dump(tank))
     sp.write_text(yaml.safe_dump(settings_spec(spec)))

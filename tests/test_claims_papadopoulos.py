@@ -17,7 +17,7 @@ from isaflow.methods.isa import forces as F
 from isaflow.methods.isa import replay, scene, solver
 from isaflow.methods.isa.settings import overdamped_dt
 
-from conftest import BOX, L_B, L_P, R_B, R_P, ROOT, TINY, run_isa
+from conftest import BOX, L_B, L_P, R_B, R_P, ROOT, TINY, run_isa, scene_of
 from test_metrics import lattice_run
 
 PAPER = "papadopoulos2016"
@@ -212,8 +212,8 @@ def test_critical_damping_does_not_overshoot_and_weak_damping_does():
 def test_overdamped_ends_at_rest_at_the_capped_equilibrium():
     """Four particles of the coarse lattice in a 20 cm box: the overdamped run's kinetic energy decays to rest
     (the project's criterion) and it ends within 1e-3 cm of the capped update's equilibrium (both at 0.1 N)."""
-    cap = scene.from_spec(TINY)
-    od = scene.from_spec({**TINY, "solver": {**TINY["solver"], "variant": "overdamped", "zeta": 1.0,
+    cap = scene_of(TINY)
+    od = scene_of({**TINY, "solver": {**TINY["solver"], "variant": "overdamped", "zeta": 1.0,
                                              "lambda_max": 3000.0, "max_steps": 200000,
                                              "history": {"every": 10}}})
     pos0, weight, _, _ = scene.initial_state(cap)

@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from conftest import ROOT, TINY, settings_spec, vessel, write_spec
+from conftest import ROOT, TINY, scene_of, settings_spec, vessel, write_spec
 
 from isaflow import cli, methods, runfile
 
@@ -497,7 +497,7 @@ def test_a_run_started_at_its_step_limit_computes_its_forces_once(tmp_path):
     from isaflow.methods.isa import scene as scenes
     from isaflow.methods.isa import solver
 
-    sc = scenes.from_spec(TINY)
+    sc = scene_of(TINY)
     pos0, weight, _, _ = scenes.initial_state(sc)
     res = solver.solve(sc, pos0, weight, start_step=TINY["solver"]["max_steps"])
     assert res.steps == TINY["solver"]["max_steps"] and res.force_evals == 1

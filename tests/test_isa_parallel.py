@@ -18,7 +18,7 @@ import numba
 import numpy as np
 import pytest
 
-from conftest import coarse_lattice, vessel
+from conftest import coarse_lattice, scene_of, vessel
 
 from isaflow.core import neighbours as NB
 from isaflow.methods.isa import relax as R
@@ -160,7 +160,7 @@ SETTINGS = str(ROOT / "config" / "methods" / "isa.yaml")
 
 @pytest.mark.parametrize("variant", ["paper", "fire"])
 def test_solve_records_its_threads_and_gives_the_same_run_on_one_and_two(variant):
-    sc = S.from_spec({**TINY, "solver": {**TINY["solver"], "variant": variant,
+    sc = scene_of({**TINY, "solver": {**TINY["solver"], "variant": variant,
                                          **({"du": 0.1} if variant == "fire" else {})}})
     pos0, weight, _, _ = S.initial_state(sc)
     one = solver.solve(sc, pos0, weight, threads=1)

@@ -9,7 +9,7 @@ import pytest
 from isaflow import runfile
 from isaflow.methods.isa import tables
 
-from conftest import BOX, OUTCOMES as ALL, TINY, run_spec, vessel
+from conftest import BOX, OUTCOMES as ALL, TINY, run_spec, scene_of, vessel
 from isaflow.core import geometry as GEO
 from isaflow.methods.isa import relax as R
 
@@ -89,7 +89,7 @@ def test_escaped_through_a_gap_leaves_the_bounding_box():
     walls = [BOX[0], {"name": "floor_a", "from": [0, 0], "to": [8, 0]},
              {"name": "floor_b", "from": [12, 0], "to": [20, 0]}, BOX[2]]
     spec = scene(walls=walls, particles={"weight": 1.0e5, "points": [[10.0, 5.0]]}, solver={"du": 0.1})
-    sc = scenes.from_spec(spec)
+    sc = scene_of(spec)
     pos0, weight, start, _ = scenes.initial_state(sc)
     res = solver.solve(sc, pos0, weight, start_step=start)
     assert res.status == "escaped"

@@ -1,24 +1,22 @@
 """An ISA scene: a tank, the ISA settings of one resolution and an update rule, as one problem.
 
 :func:`build` assembles the scene's mapping (walls and vessels of the tank,
-particles, force laws and solver settings of config/methods/isa.yaml) and
-validates it against ``scene.schema.json`` before anything large is
-allocated (methods.isa.budget).  Units: length cm, force N.  An error names
-the settings file (or the tank) and the field.
+particles, force laws and solver settings of config/methods/isa.yaml) from a
+validated tank (isaflow.tank) and settings read by the one settings loader
+(isaflow.settings, against methods.isa.settings.VALUES), so nothing is validated
+twice; it checks only what neither can: the particles against the walls
+(before anything large is allocated, methods.isa.budget).  Units: length cm,
+force N.  An error names the settings file (or the tank) and the field.
 """
 
 import hashlib
 import json
 from dataclasses import dataclass, field
-from importlib import resources
 
 import numpy as np
 
-from ... import inputs
 from ...inputs import InputError
 from ...tank import check_positions, check_walls
-
-SCHEMA = json.loads(resources.files("isaflow.methods.isa").joinpath("scene.schema.json").read_text())
 
 SceneError = InputError  # invalid scene, tank or settings: the message names the file and the field
 
@@ -188,18 +186,7 @@ def build(tank, settings, variant, start=None):
 
     Raises InputError naming the settings file and the field.
     """
-    spec = spec_of(tank, settings, variant, start)
-    path = settings.path
-    inputs.validate(spec, SCHEMA, path)
-    scene = Scene(path, spec, tank.text)
-    _check_geometry(scene)
-    return scene
-
-
-def from_spec(spec, path="<spec>"):
-    """Validated Scene of a scene mapping (tests and small studies build scenes in memory)."""
-    inputs.validate(spec, SCHEMA, path)
-    scene = Scene(path, spec, "")
+    scene = Scene(settings.path, spec_of(tank, settings, variant, start), tank.text)
     _check_geometry(scene)
     return scene
 
