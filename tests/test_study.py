@@ -20,7 +20,7 @@ from isaflow.methods.isa.settings import VALUES, fire_dt_max, settings
 
 from conftest import ISA_SETTINGS, ROOT
 
-STUDY = yaml.safe_load((ROOT / "config" / "methods" / "isa_study.yaml").read_text())["study"]
+STUDY = S.plain(yaml.safe_load((ROOT / "config" / "methods" / "isa_study.yaml").read_text()))["study"]
 SPEC = S.read(ISA_SETTINGS, VALUES)
 CI_CONFIG = ROOT / "tests" / "data" / "study_ci.yaml"
 

@@ -58,10 +58,10 @@ def summary(*targets):
 
 
 def table1_runs():
-    from isaflow import inputs
+    from isaflow import inputs, settings
 
-    _, schema = inputs.read_yaml(ROOT / "workflow" / "schemas" / "isa_workflow.schema.yaml", "schema")
-    table = inputs.load(ROOT / "config" / "methods" / "isa_workflow.yaml", schema, "isa workflow")[1]["table1"]
+    path = ROOT / "config" / "methods" / "isa_workflow.yaml"
+    table = settings.plain(inputs.read_yaml(path, "isa workflow")[1])["table1"]
     return {run for row in table for run in row["chain"]}
 
 

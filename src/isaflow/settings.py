@@ -201,6 +201,48 @@ def read(path, values, what="settings", extra=None):
     return inputs.load(path, file_schema(values, extra), what)[1]
 
 
+def plain(node):
+    """The values of a settings mapping: every ``{value, source}`` leaf replaced by its value."""
+    if isinstance(node, dict):
+        return node["value"] if set(node) == {"value", "source"} else {k: plain(v) for k, v in node.items()}
+    return [plain(v) for v in node] if isinstance(node, list) else node
+
+
+def values_of(schema, leaves):
+    """{dotted key: value schema} of the properties of a JSON schema (a mapping) at the dotted paths ``leaves``
+    ('a.*': every property of a), local '$ref's inlined: the VALUES of a settings file whose values that schema
+    describes (e.g. the ISA workflow's sections, workflow/schemas/)."""
+    defs = schema.get("$defs", {})
+
+    def inline(node):
+        if isinstance(node, dict):
+            if set(node) == {"$ref"} and node["$ref"].startswith("#/$defs/"):
+                return inline(defs[node["$ref"].split("/")[-1]])
+            return {k: inline(v) for k, v in node.items()}
+        return [inline(v) for v in node] if isinstance(node, list) else node
+
+    def at(path):
+        node = schema
+        for part in path.split(".") if path else []:
+            node = inline(node)["properties"][part]
+        return inline(node)
+
+    out = {}
+    for leaf in leaves:
+        if leaf.endswith("*"):
+            base = leaf[:-1].rstrip(".")
+            out.update({f"{base}.{k}" if base else k: v for k, v in at(base)["properties"].items()})
+        else:
+            out[leaf] = at(leaf)
+    return out
+
+
+def read_values(path, values, what="settings"):
+    """The plain values (:func:`plain`) of a settings file whose every value is sourced and which holds nothing
+    else (no variants, resolutions or runs), read and checked by the one loader."""
+    return plain(read(path, values, what))
+
+
 def load(path, values, variant=None, resolution=None, overrides=(), what="settings", extra=None, spec=None):
     """Settings of a file for one variant and resolution, then overrides (see module docstring).
 

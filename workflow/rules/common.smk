@@ -59,6 +59,18 @@ def read_config(path, schema):
         refuse(err)
 
 
+def read_sourced(path, schema, leaves):
+    """The plain values of a workflow settings file in the settings dialect (every value {value, source}; the
+    one loader, isaflow.settings): the schema (workflow/schemas/) gives the values at the dotted paths leaves."""
+    from isaflow import settings as _settings
+
+    try:
+        _, schema_spec = _inputs.read_yaml(os.path.join(workflow.basedir, "workflow", "schemas", schema), "schema")
+        return _settings.read_values(path, _settings.values_of(schema_spec, leaves), "workflow settings")
+    except _inputs.InputError as err:
+        refuse(err)
+
+
 config.update(read_config("config/config.yaml", "config.schema.yaml"))
 REGISTRY = _methods.registry()
 TANK_METHODS = [name for name, m in REGISTRY.items() if m.tank]

@@ -14,8 +14,10 @@ try:
     _ISA_SPEC = _isa_settings.read(ISA_SETTINGS, _ISA_VALUES, "isa settings")
 except _inputs.InputError as _err:
     refuse(_err)  # noqa: F821 (common.smk)
-ISA = read_config(ISA_WORKFLOW_CFG, "isa_workflow.schema.yaml")
-STUDY = read_config(ISA_STUDY_CFG, "isa_study.schema.yaml")["study"]
+# every value of these two files is sourced ({value, source}, the settings dialect); the schemas give the values
+ISA = read_sourced(ISA_WORKFLOW_CFG, "isa_workflow.schema.yaml", ["figures", "inferred", "overdamped", "fig10_sweeps",
+                   "calibration", "paper", "flow", "table1", "speed_targets.*"])
+STUDY = read_sourced(ISA_STUDY_CFG, "isa_study.schema.yaml", ["study.*"])["study"]
 for _v in [ISA["calibration"]["variant"],
            *(v for b in STUDY["error_runtime"]["blocks"] for v in b["variants"]), *STUDY["stability_map"]["variants"]]:
     if _v not in REGISTRY["isa"].variants:
@@ -427,7 +429,7 @@ use rule call as isa_timing with:
         "results/bench/10_isa.md",
     params:
         func="methods.isa.report.speed.timing_fragment",
-        kw={"targets": {k: v["value"] for k, v in ISA["speed_targets"].items()}},
+        kw={"targets": ISA["speed_targets"]},
     log:
         "logs/isa/report/timing.log",
 

@@ -3,6 +3,7 @@
 import pandas as pd
 from ....report import md_table, write
 from ....inputs import read_yaml
+from ....settings import plain
 
 RUN_IDS = ("run ids: `flow_incomplete` (application 3: from `single_coarse`'s state to step 100,000), "
            "`flow_complete` (application 4: continues it), `_capped` the named variant that reaches f_tol, "
@@ -13,7 +14,7 @@ RUN_IDS = ("run ids: `flow_incomplete` (application 3: from `single_coarse`'s st
 
 def flow_section(metrics, config, outputs):
     """results/report/20_flow.md: every flow run's outcome, what is left behind and the second vessel's surface."""
-    cfg = read_yaml(config)[1]
+    cfg = plain(read_yaml(config)[1])  # the values of the sourced file
     runs = [r for chain in cfg["flow"]["chains"].values() for r in chain[1:]] + list(cfg["flow"]["sensitivity"])
     m = pd.read_csv(metrics).set_index("run")
     t = m.loc[[r for r in dict.fromkeys(runs) if r in m.index]]

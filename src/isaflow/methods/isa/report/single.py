@@ -4,6 +4,7 @@ import pandas as pd
 from ..metrics import tolerances
 from ....report import md_table, write
 from ....inputs import read_yaml
+from ....settings import plain
 
 RUN_IDS = ("run ids: `single_coarse` (180 particles, lattice a = 10 cm) and `single_refined` (684, a = 5 cm) run "
            "the paper's update x += du F / max|F| (section 3.3, literally); the suffix `_capped` names the variant "
@@ -14,7 +15,7 @@ RUN_IDS = ("run ids: `single_coarse` (180 particles, lattice a = 10 cm) and `sin
 def single_section(metrics, calibration, config, outputs):
     """results/report/10_single.md, docs/tables/single_tolerances.csv, docs/tables/calibration.csv."""
     md, tol_csv, cal_csv = outputs
-    cfg = read_yaml(config)[1]
+    cfg = plain(read_yaml(config)[1])  # the values of the sourced file
     m = pd.read_csv(metrics).set_index("run")
     runs = [r for r in m.index if r.startswith("single_")]
     t = m.loc[runs]

@@ -11,6 +11,7 @@ from ..plan import VARIANTS
 from ..tables import recommend, resolution_table
 from ....report import md_table, write
 from ....inputs import read_yaml
+from ....settings import plain
 
 
 
@@ -36,7 +37,7 @@ def report_section(errors, fire_ratio, fire_grid, stability_map, cases, study_co
     """results/report/30_study.md (+ docs/tables/study_recommendation.csv, study_cases.csv): error against
     work, FIRE's force evaluations, the stability map and the extreme cases, with no timing in the text."""
     md, rec_csv, cases_csv = outputs
-    study = read_yaml(study_config)[1]["study"]
+    study = plain(read_yaml(study_config)[1])["study"]  # the values of the sourced file
     targets = targets or study["error_runtime"]["targets"]
     err = pd.read_csv(errors)
     fr = pd.read_csv(fire_ratio)
