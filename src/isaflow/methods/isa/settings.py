@@ -1,8 +1,9 @@
 """ISA settings: the values of config/methods/isa.yaml (:data:`VALUES`, read by isaflow.settings)
-and the solver settings of a scene with every default resolved here, once (cm, N).
+and the solver settings of a scene, the derived ones computed here, once (cm, N).
 
-A scene's ``solver`` block gives the update rule and its numbers; anything it
-leaves out is filled in by :func:`settings`.  This module imports no numerics
+A scene's ``solver`` block gives the update rule and its numbers (every one
+from the settings file); :func:`settings` derives those left null (f_ref,
+dt_max, skin, the overdamped step) from the force laws.  This module imports no numerics
 (the workflow reads the values while it is parsed).
 """
 
@@ -54,7 +55,6 @@ VALUES = {
 # stiffness: both come from the Gershgorin bound lambda_max <= 2 k_b + 12 k_p
 # (two walls, six neighbours) of the stiffness matrix.
 PAIR_NEIGHBOURS = 6
-DEFAULTS = {"chunk": 1000, "stop_on_cycle": True, "accept": ["converged"], "history": {}}
 SKIN_FRACTION = 0.3  # neighbour-list skin as a fraction of the pair range l_pu
 
 
@@ -99,13 +99,13 @@ def settings(scene):
     """{name: value} of every solver setting of an ISA scene, defaults resolved.
 
     Keys: variant, du (cm), f_tol (N), max_steps, f_ref (N), dt_max (s),
-    skin (cm), chunk, stop_on_cycle, accept, history, the force laws
+    skin (cm), chunk, stop_on_cycle, history, the force laws
     wall_l_u, wall_r_u, pair_l_u, pair_r_u (cm, N) and their exponents wall_p,
     pair_p (LAW_EXPONENT), and the overdamped variant's zeta (1), lambda_max
     (N/cm), dt (s) and damping c = 2 zeta sqrt(m lambda_max) [N s/cm] of a
     particle of the scene's weight (m = w / g).
     """
-    s = {**DEFAULTS, **scene.spec["solver"]}
+    s = scene.spec["solver"]  # every value from the settings file (VALUES); only the derived ones are computed here
     wall_l_u, wall_r_u = scene.law("wall")
     pair_l_u, pair_r_u = scene.law("pair")
     k_wall, k_pair = wall_r_u / wall_l_u, pair_r_u / pair_l_u
@@ -118,7 +118,7 @@ def settings(scene):
         f_ref=float(s.get("f_ref", f_ref_default(du, k_wall, k_pair))),
         dt_max=float(s.get("dt_max", fire_dt_max(k_wall, k_pair))),
         skin=float(s.get("skin", SKIN_FRACTION * pair_l_u)), chunk=int(s["chunk"]),
-        stop_on_cycle=bool(s["stop_on_cycle"]), accept=list(s["accept"]), history=dict(s["history"]),
+        stop_on_cycle=bool(s["stop_on_cycle"]), history=dict(s["history"]),
         wall_l_u=wall_l_u, wall_r_u=wall_r_u, pair_l_u=pair_l_u, pair_r_u=pair_r_u,
         wall_p=LAW_EXPONENT[scene.spec["forces"]["wall"]["law"]], pair_p=LAW_EXPONENT[scene.spec["forces"]["pair"]["law"]],
         zeta=zeta, lambda_max=lam, dt=dt, damping=2 * zeta * math.sqrt(weight / G * lam),

@@ -402,7 +402,7 @@ def _solve(scene, pos0, weight, start_step, progress, state, rest_depth, threads
     sim_time = float("nan")
     part, wall, point, cforce = contacts(pos, walls, s)
     dynamic = ("zeta", "lambda_max", "dt", "damping")
-    params = {k: v for k, v in s.items() if k not in ("accept", "history", "variant", "stop_on_cycle")
+    params = {k: v for k, v in s.items() if k not in ("history", "variant", "stop_on_cycle")
               and (overdamped or k not in dynamic)}
     params.update(cycle_period=int(period), stop_on_cycle=int(s["stop_on_cycle"]), nonfinite_particle=int(bad_particle),
                   max_step_move=max_step_move)
