@@ -3,11 +3,10 @@
 Each method lives in its own sub-package ``isaflow.methods.<name>`` whose
 ``__init__`` defines ``METHOD`` (a :class:`Method`) and imports nothing heavy,
 so the workflow reads the registry while it is parsed.  A package declares only
-what is its own (label, paper, marker, variants, fragment number); its modules
+what is its own (label, paper, marker, variants, its place `order`); its modules
 ``<package>.method``, ``.checks``, ``.settings:VALUES``, its settings file
-``config/methods/<name>.yaml`` and fragments ``NN_<name>.md`` follow from its
-name (:class:`Method`).  The registry finds the packages itself
-(:data:`PACKAGES`: every sub-package defining ``METHOD``, in fragment order), so
+``config/methods/<name>.yaml`` follow from its name (:class:`Method`).  The registry finds the packages itself
+(:data:`PACKAGES`: every sub-package defining ``METHOD``, by ``order``), so
 adding a method edits no file of the registry; nothing outside ``methods/``
 names a method or a variant: labels, colours, markers, papers, settings files,
 claims modules and report fragments all come from here.
@@ -39,7 +38,7 @@ class Variant:
 
 @dataclass(frozen=True)
 class Method:
-    """A method as its package declares it: its own name, labels, paper, marker, variants and fragment number;
+    """A method as its package declares it: its own name, labels, paper, marker, variants and place (order);
     the modules and files every method has in the same places follow from the name (:meth:`__post_init__`)."""
 
     name: str
@@ -49,22 +48,19 @@ class Method:
     marker: str = "o"  # where methods share a figure
     variants: dict = field(default_factory=dict)  # name -> Variant (given as Variants, keyed by their names)
     tank: bool = False  # runs on the shared tanks through isaflow.run
-    order: int = 0  # NN of the method's report and timing fragments (their place in the report)
+    order: int = 0  # its place in the registry (and the number of its report fragments, results/report/NN_*.md)
     entry: str = ""  # module with check / solve / warm_up / REFERENCES (tank methods): <package>.method
     checks: str = ""  # pure-Python checks, plausible(tank, settings, stability) and cost(...): <package>.checks
     values: str = ""  # "module:attribute" of the settings values schema: <package>.settings:VALUES
     settings: str = ""  # default settings file, relative to the project root: config/methods/<name>.yaml
-    report: str = ""  # the method's report fragment: results/report/NN_<name>.md
-    timing: str = ""  # its timing fragment: results/timing/NN_<name>.md
 
     def __post_init__(self):
         """Variants keyed by their names; every module or file not given, at its place for the package's name."""
         variants = self.variants.values() if isinstance(self.variants, dict) else self.variants
         object.__setattr__(self, "variants", {v.name: v for v in variants})
-        package, fragment = f"{__name__}.{self.name}", f"{self.order:02d}_{self.name}.md"
+        package = f"{__name__}.{self.name}"
         places = dict(entry=f"{package}.method" if self.tank else "", checks=f"{package}.checks",
-                      values=f"{package}.settings:VALUES", settings=f"config/methods/{self.name}.yaml",
-                      report=f"results/report/{fragment}", timing=f"results/timing/{fragment}")
+                      values=f"{package}.settings:VALUES", settings=f"config/methods/{self.name}.yaml")
         for key, place in places.items():
             if not getattr(self, key):
                 object.__setattr__(self, key, place)
