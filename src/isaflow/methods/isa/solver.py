@@ -1,4 +1,4 @@
-"""Drive the compiled relaxation in chunks: progress, history, outcome -> contract.Result.
+"""ISA's stepper for driver.drive: the compiled relaxation in chunks, its history and outcomes -> contract.Result.
 
 The three update rules run relax.relax_resume; the overdamped variant (not the paper's) runs
 dynamics.overdamped_resume, whose ``converged`` also needs the liquid at rest (config/rest.yaml).
@@ -15,7 +15,7 @@ from contextlib import contextmanager
 import numba
 import numpy as np
 
-from ... import rest as REST
+from ... import driver, rest as REST
 from ...contract import Result, wall_resultants
 from ...core.geometry import bounding_box, outside_box
 from ...core.units import G
@@ -248,7 +248,7 @@ def solve(scene, pos0, weight, start_step=0, progress=None, state=None, rest_dep
     """Relax ``pos0`` (N, 2) cm with per-particle ``weight`` (N,) N under an ISA scene.
 
     start_step: steps already taken (a continued run counts from there up to
-    solver.max_steps).  progress(step, fmax) is called after each chunk.
+    solver.max_steps).  progress(step, fmax) is called every driver.LOG_EVERY s of wall time.
     rest_depth: depth h [cm] of the rest criterion's e = KE / (W h) (overdamped variant only).
     state: {STATE_VARS name: array} of the run this one continues (same
     scene dynamics), or None for a fresh start; with it the continued run
@@ -264,174 +264,215 @@ def solve(scene, pos0, weight, start_step=0, progress=None, state=None, rest_dep
         return _solve(scene, pos0, weight, start_step, progress, state, rest_depth, threads)
 
 
-def _solve(scene, pos0, weight, start_step, progress, state, rest_depth, threads):
-    s = settings(scene)
-    walls = np.ascontiguousarray(scene.walls, float)
-    box = bounding_box(walls)
-    vessels = [(v["name"], v["x"]) for v in scene.spec.get("vessels", [])]
-    pos = np.array(pos0, float, copy=True, order="C")
-    weight = np.ascontiguousarray(weight, float)
-    force = np.zeros_like(pos)
-    chunk = s["chunk"]
-    newton = s["variant"] == "newton_lm"
-    restored = state is not None and not newton  # newton keeps no state between runs (restart.py)
-    vel = np.array(state["state_vel"], float, order="C") if restored else np.zeros_like(pos)
-    pos_build = np.array(state["state_pos_build"], float, order="C") if restored else pos.copy()
-    overdamped = RULES[s["variant"]] == D.OVERDAMPED
-    kernel = np.array([float(state[k]) for k in ("state_moved", "state_fire_dt", "state_fire_alpha",
-                                                 "state_fire_n_pos")] + [0.0]) if restored else np.zeros(5)
-    if overdamped and not restored:
-        kernel[2] = -1.0  # no quiet stretch yet
-    t_start = float(kernel[1]) if overdamped else 0.0  # this run's clock at its start (a continued run's chain time)
-    rest_cfg = REST.load() if overdamped else None
-    e_norm = float(np.sum(weight)) * float(rest_depth)
-    if overdamped and not e_norm > 0:
-        raise ValueError(f"overdamped variant: the rest criterion needs a positive liquid depth (got {rest_depth})")
-    ke_buf = np.zeros(chunk) if overdamped else None
-    max_step_move = 0.0
-    recent = np.array(state["state_recent_fmax"], float) if restored else np.zeros(0)
-    resume = restored and start_step % chunk != 0  # inside a chunk: continue its list and FIRE state
-    chunk_start = np.array(state["state_chunk_start"], float) if resume else pos.copy()
-    buf = np.zeros(chunk)
-    hist = _History(s["history"], len(walls), vessels)
-    snap_every = max(1, round((s["max_steps"] - start_step) / max(hist.n_snap, 1) / chunk))
-    memo = ChunkMemo() if not (s["stop_on_cycle"] or overdamped or newton) else None
-    nstate = np.zeros(2)  # newton: (mu, nu) between chunks
-    counts = np.zeros(4, np.int64)  # newton: Hessian assemblies, CG iterations, refused crossings, evaluations
-    warm_up(threads)
-    step = start_step
-    status, message, period, bad_particle = "step_limit", "", 0, -1
-    evals = 0
-    t0 = time.perf_counter()
-    n_chunk = 0
-    while True:
+class _Stepper:
+    """ISA relaxation for driver.drive: one advance is one compiled chunk (steps up to the next multiple of
+    solver.chunk, counted from the chain's start); arguments as solve's."""
+
+    def __init__(self, scene, pos0, weight, start_step, state, rest_depth, threads):
+        self.scene, self.pos0, self.start_step = scene, pos0, start_step
+        self.rest_depth, self.threads = rest_depth, threads
+        self.s = s = settings(scene)
+        self.walls = walls = np.ascontiguousarray(scene.walls, float)
+        self.box = bounding_box(walls)
+        vessels = [(v["name"], v["x"]) for v in scene.spec.get("vessels", [])]
+        self.pos = pos = np.array(pos0, float, copy=True, order="C")
+        self.weight = weight = np.ascontiguousarray(weight, float)
+        self.force = np.zeros_like(pos)
+        self.chunk = chunk = s["chunk"]
+        self.newton = newton = s["variant"] == "newton_lm"
+        restored = state is not None and not newton  # newton keeps no state between runs (restart.py)
+        self.vel = np.array(state["state_vel"], float, order="C") if restored else np.zeros_like(pos)
+        self.pos_build = np.array(state["state_pos_build"], float, order="C") if restored else pos.copy()
+        self.overdamped = overdamped = RULES[s["variant"]] == D.OVERDAMPED
+        self.kernel = np.array([float(state[k]) for k in ("state_moved", "state_fire_dt", "state_fire_alpha",
+                                                          "state_fire_n_pos")] + [0.0]) if restored else np.zeros(5)
+        if overdamped and not restored:
+            self.kernel[2] = -1.0  # no quiet stretch yet
+        # this run's clock at its start (a continued run's chain time)
+        self.t0 = float(self.kernel[1]) if overdamped else 0.0
+        self.rest_cfg = REST.load() if overdamped else None
+        self.e_norm = float(np.sum(weight)) * float(rest_depth)
+        if overdamped and not self.e_norm > 0:
+            raise ValueError(f"overdamped variant: the rest criterion needs a positive liquid depth (got {rest_depth})")
+        self.ke_buf = np.zeros(chunk) if overdamped else None
+        self.max_step_move = 0.0
+        self.recent = np.array(state["state_recent_fmax"], float) if restored else np.zeros(0)
+        self.resume = restored and start_step % chunk != 0  # inside a chunk: continue its list and FIRE state
+        self.chunk_start = np.array(state["state_chunk_start"], float) if self.resume else pos.copy()
+        self.buf = np.zeros(chunk)
+        self.hist = _History(s["history"], len(walls), vessels)
+        self.snap_every = max(1, round((s["max_steps"] - start_step) / max(self.hist.n_snap, 1) / chunk))
+        self.memo = ChunkMemo() if not (s["stop_on_cycle"] or overdamped or newton) else None
+        self.nstate = np.zeros(2)  # newton: (mu, nu) between chunks
+        self.counts = np.zeros(4, np.int64)  # newton: Hessian assemblies, CG iterations, refused crossings, evaluations
+        warm_up(threads)
+        self.step = start_step
+        self.period, self.bad_particle = 0, -1
+        self.evals = 0
+        self.n_chunk = 0
+        self.fmax_last = np.nan  # max|F| before the chunk's last step
+        self.quiet_end = False  # the last advance took no step and stopped: nothing to record
+
+    def _fmax(self):
+        return float(np.abs(self.force).max()) if len(self.force) else 0.0
+
+    def advance(self):
+        """One chunk and the outcome checks of its end: (status, message) or None."""
+        s, pos, vel, kernel, force, buf = self.s, self.pos, self.vel, self.kernel, self.force, self.buf
+        step, chunk, resume, memo = self.step, self.chunk, self.resume, self.memo
         # chunks end on multiples of `chunk` counted from the chain's start, so
         # a run continued from a state file repeats an uninterrupted run exactly
         n = min(chunk - step % chunk, s["max_steps"] - step) if step < s["max_steps"] else 0
         origin = step - step % chunk if resume else step  # history strides count from here
         if not resume:
-            chunk_start = pos.copy()
-        if overdamped:
+            self.chunk_start = pos.copy()
+        if self.overdamped:
+            rc = self.rest_cfg
             done, code, crossing = D.overdamped_resume(
-                pos, vel, weight, walls, box, s["wall_l_u"], s["wall_r_u"], s["pair_l_u"], s["pair_r_u"], s["dt"],
-                s["zeta"], s["lambda_max"], G, s["f_tol"], rest_cfg["energy_ratio"], e_norm, rest_cfg["window"], n,
-                s["skin"], force, buf, ke_buf, pos_build, kernel, resume, s["wall_p"], s["pair_p"],
+                pos, vel, self.weight, self.walls, self.box, s["wall_l_u"], s["wall_r_u"], s["pair_l_u"],
+                s["pair_r_u"], s["dt"], s["zeta"], s["lambda_max"], G, s["f_tol"], rc["energy_ratio"], self.e_norm,
+                rc["window"], n, s["skin"], force, buf, self.ke_buf, self.pos_build, kernel, resume, s["wall_p"],
+                s["pair_p"],
             )
-            evals += done + 1
-        elif newton:
+            self.evals += done + 1
+        elif self.newton:
             done, code, crossing = NW.newton_resume(
-                pos, weight, walls, box, s["wall_l_u"], s["wall_r_u"], s["pair_l_u"], s["pair_r_u"], s["f_tol"], n,
-                s["skin"], force, buf, nstate, counts)
-            evals = int(counts[3])  # the chunk's first evaluation and every trial step
+                pos, self.weight, self.walls, self.box, s["wall_l_u"], s["wall_r_u"], s["pair_l_u"], s["pair_r_u"],
+                s["f_tol"], n, s["skin"], force, buf, self.nstate, self.counts)
+            self.evals = int(self.counts[3])  # the chunk's first evaluation and every trial step
             code = {NW.CONVERGED: R.CONVERGED, NW.NONFINITE: R.NONFINITE, NW.STALLED: NW.STALLED}.get(code, R.RUNNING)
         else:
-            state_arrays = (pos, vel, pos_build, kernel, force)
+            state_arrays = (pos, vel, self.pos_build, kernel, force)
             key = memo.key(state_arrays, n) if memo is not None and not resume else None
             out = memo.get(key, state_arrays, buf) if key is not None else None
             if out is None:
                 out = R.relax_resume(
-                    pos, vel, weight, walls, box, s["wall_l_u"], s["wall_r_u"], s["pair_l_u"], s["pair_r_u"],
-                    RULES[s["variant"]], s["du"], s["f_ref"], s["dt_max"], s["f_tol"], n, s["skin"], force, buf,
-                    pos_build, kernel, resume, threads, s["wall_p"], s["pair_p"],
+                    pos, vel, self.weight, self.walls, self.box, s["wall_l_u"], s["wall_r_u"], s["pair_l_u"],
+                    s["pair_r_u"], RULES[s["variant"]], s["du"], s["f_ref"], s["dt_max"], s["f_tol"], n, s["skin"],
+                    force, buf, self.pos_build, kernel, resume, self.threads, s["wall_p"], s["pair_p"],
                 )
                 if key is not None:
                     memo.put(key, state_arrays, buf, out)
             done, code, crossing = out
-            evals += done + 1  # one evaluation per step taken, plus the chunk's initial one
-        resume = False
-        if not newton:
-            max_step_move = max(max_step_move, float(kernel[4]))
+            self.evals += done + 1  # one evaluation per step taken, plus the chunk's initial one
+        self.resume = False
+        if not self.newton:
+            self.max_step_move = max(self.max_step_move, float(kernel[4]))
         h = buf[:done]
-        if hist.every:
-            hist.steps(step, h, origin, ke_buf[:done] if overdamped else None)
-        step += done
-        n_chunk += 1
-        recent = np.concatenate([recent, h])[-2000:]
+        if self.hist.every:
+            self.hist.steps(step, h, origin, self.ke_buf[:done] if self.overdamped else None)
+        self.step = step = step + done
+        self.n_chunk += 1
+        self.recent = np.concatenate([self.recent, h])[-2000:]
+        self.fmax_last = float(h[-1]) if done else np.nan
+        self.quiet_end = False
         if n == 0:  # started at or past max_steps: forces evaluated once, nothing moved
-            if code != R.NONFINITE and np.abs(force).max(initial=0.0) < s["f_tol"]:
-                status = "converged"
             if code != R.NONFINITE:
-                break
-        hist.chunk(step, pos, s, walls, hist.n_snap and n_chunk % snap_every == 0)
-        if progress:
-            progress(step, float(h[-1]) if done else np.nan)
+                self.quiet_end = True
+                if np.abs(force).max(initial=0.0) < s["f_tol"]:
+                    return "converged", ""
+                return "step_limit", self.limit_message()
         if code == R.CONVERGED:
-            status = "converged"
-            break
+            return "converged", ""
         if code == R.NONFINITE:
-            status = "nonfinite"
-            bad_particle = crossing
-            message = (f"non-finite position of particle {crossing} at step {step}"
-                       if not np.isfinite(pos[crossing]).all() else f"non-finite forces at step {step}")
-            break
+            self.bad_particle = crossing
+            return "nonfinite", (f"non-finite position of particle {crossing} at step {step}"
+                                 if not np.isfinite(pos[crossing]).all() else f"non-finite forces at step {step}")
         if code == R.CROSSED:
-            i, w = divmod(crossing, walls.shape[0])
-            status = "escaped"
-            message = (f"particle {i} at ({pos[i, 0]:.4g}, {pos[i, 1]:.4g}) cm would cross wall "
-                       f"'{scene.wall_names[w]}' at step {step}; step refused, run stopped")
-            break
-        if newton and code == NW.STALLED:
-            message = (f"max|F| = {np.abs(force).max():.4g} N >= f_tol = {s['f_tol']:g} N after {step} steps: no step "
-                       f"lowers the energy (Levenberg-Marquardt mu {nstate[0]:.3g} N/cm)")
-            break
-        out = outside_box(pos, box)
+            i, w = divmod(crossing, self.walls.shape[0])
+            return "escaped", (f"particle {i} at ({pos[i, 0]:.4g}, {pos[i, 1]:.4g}) cm would cross wall "
+                               f"'{self.scene.wall_names[w]}' at step {step}; step refused, run stopped")
+        if self.newton and code == NW.STALLED:
+            return "step_limit", (f"max|F| = {np.abs(force).max():.4g} N >= f_tol = {s['f_tol']:g} N after {step} "
+                                  f"steps: no step lowers the energy (Levenberg-Marquardt mu "
+                                  f"{self.nstate[0]:.3g} N/cm)")
+        out = outside_box(pos, self.box)
         if out.any():
-            status = "escaped"
-            message = f"{out.sum()} particle(s) left the walls' bounding box by step {step}"
-            break
-        if s["stop_on_cycle"] and not (overdamped or newton):
-            period = detect_cycle(recent)
+            return "escaped", f"{out.sum()} particle(s) left the walls' bounding box by step {step}"
+        if s["stop_on_cycle"] and not (self.overdamped or self.newton):
+            period = detect_cycle(self.recent)
             # a cycle returns to its states: the net move over the chunk stays
             # within a few du, unlike a slow drift with a periodic max|F|
-            if period and np.abs(pos - chunk_start).max() > 2 * period * s["du"]:
+            if period and np.abs(pos - self.chunk_start).max() > 2 * period * s["du"]:
                 period = 0
+            self.period = period
             if period:
-                tail = recent[-CYCLE_WINDOW:]
-                status = "cycle"
-                message = (f"max|F| repeats with period {period} steps between {tail.min():.4g} and "
-                           f"{tail.max():.4g} N (f_tol {s['f_tol']:g} N) by step {step}")
-                break
-        if step >= s["max_steps"]:
-            break
-    wall_time = time.perf_counter() - t0
-    fmax = float(np.abs(force).max()) if len(force) else 0.0
-    if status == "step_limit" and not message:
-        message = f"max|F| = {fmax:.4g} N >= f_tol = {s['f_tol']:g} N after {step} steps"
-    elif status == "converged":
-        message = f"max|F| = {fmax:.4g} N < f_tol = {s['f_tol']:g} N after {step} steps"
-    sim_time = float("nan")
-    part, wall, point, cforce = contacts(pos, walls, s)
-    dynamic = ("zeta", "lambda_max", "dt", "damping")
-    params = {k: v for k, v in s.items() if k not in ("history", "variant", "stop_on_cycle")
-              and (overdamped or k not in dynamic)}
-    params.update(cycle_period=int(period), stop_on_cycle=int(s["stop_on_cycle"]), nonfinite_particle=int(bad_particle),
-                  max_step_move=max_step_move)
-    if overdamped:
-        sim_time = float(kernel[1])
-        ke = 0.5 * float(np.sum(weight / G * np.sum(vel * vel, axis=1)))
-        at_rest = kernel[2] >= 0 and sim_time - kernel[2] >= rest_cfg["window"] - 1e-12
-        params.update(rest_energy_ratio=rest_cfg["energy_ratio"], rest_window=rest_cfg["window"], rest_depth=rest_depth,
-                      final_energy_ratio=ke / e_norm, start_time=t_start,
-                      time_to_rest=max(float(kernel[2]) - t_start, 0.0) if at_rest else float("nan"),
-                      particle_mass=float(weight[0] / G) if len(weight) else float("nan"))
+                tail = self.recent[-CYCLE_WINDOW:]
+                return "cycle", (f"max|F| repeats with period {period} steps between {tail.min():.4g} and "
+                                 f"{tail.max():.4g} N (f_tol {s['f_tol']:g} N) by step {step}")
+        return None
+
+    def record(self):
+        """Wall resultants, vessel counts and snapshots at the chunk's end (no rest samples: None)."""
+        if not self.quiet_end:
+            hist = self.hist
+            hist.chunk(self.step, self.pos, self.s, self.walls, hist.n_snap and self.n_chunk % self.snap_every == 0)
+        return None
+
+    def spent(self):
+        return self.step >= self.s["max_steps"]
+
+    def limit_message(self, monitor=None):
+        return f"max|F| = {self._fmax():.4g} N >= f_tol = {self.s['f_tol']:g} N after {self.step} steps"
+
+    def rest_message(self, monitor):
+        raise AssertionError("ISA is never judged by the rest monitor (the overdamped variant's test is compiled)")
+
+    def progress(self, monitor=None):
+        return f"step {self.step:>9d}  max|F| = {self.fmax_last:.4g} N"
+
+    def result(self, run):
+        """contract.Result of the run (method 'isa', variant = the update rule; fields hold STATE_VARS)."""
+        s, pos, vel, weight, kernel, force = self.s, self.pos, self.vel, self.weight, self.kernel, self.force
+        walls = self.walls
+        overdamped, newton, memo, rest_cfg, e_norm = self.overdamped, self.newton, self.memo, self.rest_cfg, self.e_norm
+        step, rest_depth, t_start, pos_build, hist = self.step, self.rest_depth, self.t0, self.pos_build, self.hist
+        status, message = run.status, run.message
+        fmax = self._fmax()
         if status == "converged":
-            message += (f", at rest (e = KE / (W h) < {rest_cfg['energy_ratio']:g} since t = {kernel[2]:.4g} s); "
-                        f"t = {sim_time:.4g} s")
-        else:
-            message += f"; t = {sim_time:.4g} s, e = {ke / e_norm:.3g}"
-    if newton:
-        pos_build = pos.copy()
-        params.update(hessian_assemblies=int(counts[0]), cg_iterations=int(counts[1]), refused_steps=int(counts[2]))
-    if memo is not None:
-        params["replayed_chunks"] = memo.replayed
-    params["threads"] = threads
-    fields = {"force": (("particle", "xy"), force, "N", "final out-of-balance force on particle"),
-              "contact_particle": (("contact",), part.astype(np.int32), "1", "particle index of wall contact")}
-    fields.update(_state_fields(vel, pos_build, chunk_start, kernel, recent))
-    return Result(
-        method="isa", variant=s["variant"], pos0=np.array(pos0, float), pos=pos, weight=weight,
-        contact_wall=wall, contact_point=point, contact_force=cforce, status=status, message=message,
-        steps=step, start_step=start_step, wall_time=wall_time, force_evals=evals, residual=fmax,
-        residual_name="max|F|", residual_units="N", sim_time=sim_time,
-        history=hist.variables(len(pos)), fields=fields, params=params,
-    )
+            message = f"max|F| = {fmax:.4g} N < f_tol = {s['f_tol']:g} N after {step} steps"
+        sim_time = float("nan")
+        part, wall, point, cforce = contacts(pos, walls, s)
+        dynamic = ("zeta", "lambda_max", "dt", "damping")
+        params = {k: v for k, v in s.items() if k not in ("history", "variant", "stop_on_cycle")
+                  and (overdamped or k not in dynamic)}
+        params.update(cycle_period=int(self.period), stop_on_cycle=int(s["stop_on_cycle"]),
+                      nonfinite_particle=int(self.bad_particle), max_step_move=self.max_step_move)
+        if overdamped:
+            sim_time = float(kernel[1])
+            ke = 0.5 * float(np.sum(weight / G * np.sum(vel * vel, axis=1)))
+            at_rest = kernel[2] >= 0 and sim_time - kernel[2] >= rest_cfg["window"] - 1e-12
+            params.update(rest_energy_ratio=rest_cfg["energy_ratio"], rest_window=rest_cfg["window"],
+                          rest_depth=rest_depth,
+                          final_energy_ratio=ke / e_norm, start_time=t_start,
+                          time_to_rest=max(float(kernel[2]) - t_start, 0.0) if at_rest else float("nan"),
+                          particle_mass=float(weight[0] / G) if len(weight) else float("nan"))
+            if status == "converged":
+                message += (f", at rest (e = KE / (W h) < {rest_cfg['energy_ratio']:g} since t = {kernel[2]:.4g} s); "
+                            f"t = {sim_time:.4g} s")
+            else:
+                message += f"; t = {sim_time:.4g} s, e = {ke / e_norm:.3g}"
+        if newton:
+            pos_build = pos.copy()
+            c = self.counts
+            params.update(hessian_assemblies=int(c[0]), cg_iterations=int(c[1]), refused_steps=int(c[2]))
+        if memo is not None:
+            params["replayed_chunks"] = memo.replayed
+        params["threads"] = self.threads
+        fields = {"force": (("particle", "xy"), force, "N", "final out-of-balance force on particle"),
+                  "contact_particle": (("contact",), part.astype(np.int32), "1", "particle index of wall contact")}
+        fields.update(_state_fields(vel, pos_build, self.chunk_start, kernel, self.recent))
+        return Result(
+            method="isa", variant=s["variant"], pos0=np.array(self.pos0, float), pos=pos, weight=weight,
+            contact_wall=wall, contact_point=point, contact_force=cforce, status=status, message=message,
+            steps=step, start_step=self.start_step, wall_time=run.wall_time, force_evals=self.evals, residual=fmax,
+            residual_name="max|F|", residual_units="N", sim_time=sim_time,
+            history=hist.variables(len(pos)), fields=fields, params=params,
+        )
+
+
+def _solve(scene, pos0, weight, start_step, progress, state, rest_depth, threads):
+    """Build the stepper (kernels warmed) and drive it (driver.drive) -> contract.Result; arguments as solve's."""
+    stepper = _Stepper(scene, pos0, weight, start_step, state, rest_depth, threads)
+    log = (lambda line: progress(stepper.step, stepper.fmax_last)) if progress else None
+    return driver.drive(stepper, None, log)

@@ -3,7 +3,8 @@
 Per step (model.py, numba, every particle loop a gather run in parallel): neighbour list, explicit step,
 collision model, penetration guard (walls.reflect: a move across a wall line mirrored back), free surface and
 source term, pressure equation (pressure.py), pressure correction, particle shifting, penetration guard,
-wall-crossing check.  The step loop runs in Python around compiled stages.
+wall-crossing check.  The step loop runs in Python around compiled stages, one step per advance of a stepper
+run by driver.drive.
 Rest: isaflow.rest (one criterion for every dynamic method).  Units: cm, N, s; pressure N/cm^2
 (2D, per cm of thickness).
 """
@@ -20,13 +21,11 @@ os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 import numba
 import numpy as np
 
-from isaflow import rest
+from isaflow import driver, rest
 from isaflow.contract import Result
 from isaflow.core import units
 
 from . import boundary, model, pressure
-
-LOG_EVERY = 20.0  # s of wall time between progress lines (a log line at least every 30 s)
 
 
 def vessels(tank):
@@ -306,190 +305,229 @@ def solve(tank, cfg, variant, spacing, t_end, probes, start=None, snapshots=0, l
         numba.set_num_threads(before)
 
 
-def _solve(tank, cfg, variant, l0, t_end, probes, start, snapshots, log, threads, rest_cfg):
-    xr, floor = first_vessel(tank)
-    if start is None:
-        fpos, step0, t0 = boundary.liquid_block(xr, floor, tank.depth, l0), 0, 0.0
-        fvel = np.zeros_like(fpos)
-        depth0 = rows_depth(tank, l0)
-        origin = "lattice at rest"
-    else:
-        fpos, fvel = np.asarray(start["pos"], float), np.asarray(start["vel"], float)
-        step0, t0 = int(start["steps"]), float(start["sim_time"])
-        depth0 = float(start.get("initial_depth", rows_depth(tank, l0)))
-        origin = str(start.get("origin", "given state"))
-    s = State(tank, cfg, l0, fpos, fvel)
-    pos0 = s.pos[: s.nf].copy()
-    dt0 = time_step(tank, l0, cfg["time.courant"])
-    vcfl = cfg["time.velocity_courant"]
-    nsteps = int(np.ceil(t_end / dt0 - 1e-9))  # steps at the base time step
-    every = max(1, int(round(cfg["time.sample_interval"] / dt0)))
-    sample_dt = every * dt0  # s between samples (every base steps, as many shorter ones as it takes)
-    snap_times = list(np.linspace(0.0, nsteps * dt0, snapshots)[1:]) if snapshots else []
-    tol = 1e-6 * dt0
-    elapsed, next_sample, dt_min, short_steps = 0.0, sample_dt, dt0, 0
-    monitor = rest.Monitor(rest_cfg["energy_ratio"], rest_cfg["window"])
-    probes = np.asarray(probes, float).reshape(-1, 2)
-    rec = {k: [] for k in ("time", "pair", "panel", "probe", "rms", "vmax", "energy", "count", "resid", "iters", "surf")}
-    snaps, snap_t = [], []
-    fail_tol = cfg["pressure.rtol"] * cfg["pressure.fail_factor"]
-    status, message, max_resid, iters = None, "", 0.0, []
-    timers = np.zeros(3)
-    p_means = collections.deque(maxlen=int(np.ceil(cfg["time.average_window"] / sample_dt)) + 2)  # (t, interval mean)
-    wall0 = time.perf_counter()
-    last_log = wall0
-    k = 0
-    while elapsed < nsteps * dt0 - tol:
-        k += 1
+class _Stepper:
+    """MPS on a tank for driver.drive: one advance is one step (its time step dt0, or shorter by the velocity
+    Courant condition), a diagnostic sample every time.sample_interval s of simulated time."""
+
+    def __init__(self, tank, cfg, variant, l0, t_end, probes, start, snapshots, threads):
+        self.tank, self.cfg, self.variant, self.l0, self.t_end, self.threads = tank, cfg, variant, l0, t_end, threads
+        xr, floor = first_vessel(tank)
+        if start is None:
+            fpos, self.step0, self.t0 = boundary.liquid_block(xr, floor, tank.depth, l0), 0, 0.0
+            fvel = np.zeros_like(fpos)
+            self.depth0 = rows_depth(tank, l0)
+            self.origin = "lattice at rest"
+        else:
+            fpos, fvel = np.asarray(start["pos"], float), np.asarray(start["vel"], float)
+            self.step0, self.t0 = int(start["steps"]), float(start["sim_time"])
+            self.depth0 = float(start.get("initial_depth", rows_depth(tank, l0)))
+            self.origin = str(start.get("origin", "given state"))
+        self.s = s = State(tank, cfg, l0, fpos, fvel)
+        self.pos0 = s.pos[: s.nf].copy()
+        self.dt0 = dt0 = time_step(tank, l0, cfg["time.courant"])
+        self.vcfl = cfg["time.velocity_courant"]
+        self.nsteps = nsteps = int(np.ceil(t_end / dt0 - 1e-9))  # steps at the base time step
+        every = max(1, int(round(cfg["time.sample_interval"] / dt0)))
+        self.sample_dt = sample_dt = every * dt0  # s between samples (every base steps, as many shorter ones as it takes)
+        self.snap_times = list(np.linspace(0.0, nsteps * dt0, snapshots)[1:]) if snapshots else []
+        self.tol = 1e-6 * dt0
+        self.elapsed, self.next_sample, self.dt_min, self.short_steps = 0.0, sample_dt, dt0, 0
+        self.probes = np.asarray(probes, float).reshape(-1, 2)
+        self.rec = {k: [] for k in ("time", "pair", "panel", "probe", "rms", "vmax", "energy", "count", "resid",
+                                    "iters", "surf")}
+        self.snaps, self.snap_t = [], []
+        self.fail_tol = cfg["pressure.rtol"] * cfg["pressure.fail_factor"]
+        self.status, self.max_resid, self.iters = None, 0.0, []
+        self.timers = np.zeros(3)
+        # (t, interval mean)
+        self.p_means = collections.deque(maxlen=int(np.ceil(cfg["time.average_window"] / sample_dt)) + 2)
+        self.k = 0
+        self.t = self.t0
+        self.resid = self.its = None
+
+    def advance(self):
+        """One step; (status, message) if it failed (nonfinite, escaped, solver_failed), else None."""
+        s, l0, dt0, step0 = self.s, self.l0, self.dt0, self.step0
+        self.k += 1
+        k = self.k
         dt = dt0
-        if vcfl > 0.0:  # Courant condition on the largest liquid speed: u_max dt / l0 <= vcfl
+        if self.vcfl > 0.0:  # Courant condition on the largest liquid speed: u_max dt / l0 <= vcfl
             umax = float(np.sqrt(np.max((s.vel[: s.nf] ** 2).sum(1), initial=0.0)))
-            if umax * dt0 > vcfl * l0:
-                dt = vcfl * l0 / umax
-                dt_min = min(dt_min, dt)
-                short_steps += 1
-        bad, resid, its = step(s, dt, variant, cfg, timers)
-        max_resid = max(max_resid, resid)
-        iters.append(its)
-        elapsed += dt
-        t = t0 + elapsed
+            if umax * dt0 > self.vcfl * l0:
+                dt = self.vcfl * l0 / umax
+                self.dt_min = min(self.dt_min, dt)
+                self.short_steps += 1
+        bad, resid, its = step(s, dt, self.variant, self.cfg, self.timers)
+        self.resid, self.its = resid, its
+        self.max_resid = max(self.max_resid, resid)
+        self.iters.append(its)
+        self.elapsed += dt
+        self.t = self.t0 + self.elapsed
+        status = None
         if bad[0] == 1:
             status, message = "nonfinite", f"step {step0 + k}: particle {bad[1]} has a non-finite position or velocity"
         elif bad[0] == 2:
-            status, message = ("escaped", f"step {step0 + k}: particle {bad[1]} crossed wall '{tank.wall_names[bad[2]]}' "
-                                          f"(more than {s.graze_depth:.3g} cm past it)")
+            status, message = ("escaped", f"step {step0 + k}: particle {bad[1]} crossed wall "
+                                          f"'{self.tank.wall_names[bad[2]]}' (more than {s.graze_depth:.3g} cm past it)")
         elif bad[0] == 3:
             x, y = s.pos[bad[1]]
             vx, vy = s.vel[bad[1]]
             where = "over the top" if y > s.escape_box[3] + s.graze_depth else "through a side or the bottom"
-            status, message = "escaped", (f"step {step0 + k}: particle {bad[1]} left the walls' bounding box by more than "
-                                          f"{s.graze_depth:.3g} cm ({where}: at ({x:.1f}, {y:.1f}) cm, velocity "
+            status, message = "escaped", (f"step {step0 + k}: particle {bad[1]} left the walls' bounding box by more "
+                                          f"than {s.graze_depth:.3g} cm ({where}: at ({x:.1f}, {y:.1f}) cm, velocity "
                                           f"({vx:.0f}, {vy:.0f}) cm/s)")
-        elif bad[0] == 4 or not resid <= fail_tol:
-            status, message = "solver_failed", (f"step {step0 + k}: pressure solve residual {resid:.3g} > {fail_tol:.3g} "
-                                                f"after {its} iterations {s.solve_error}").strip()
-        at_rest = False
-        last = elapsed >= nsteps * dt0 - tol
-        if elapsed >= next_sample - tol or status or last:
-            while next_sample <= elapsed + tol:
-                next_sample += sample_dt
+        elif bad[0] == 4 or not resid <= self.fail_tol:
+            status, message = "solver_failed", (f"step {step0 + k}: pressure solve residual {resid:.3g} > "
+                                                f"{self.fail_tol:.3g} after {its} iterations {s.solve_error}").strip()
+        self.status = status
+        return (status, message) if status else None
+
+    def spent(self):
+        return self.elapsed >= self.nsteps * self.dt0 - self.tol
+
+    def record(self):
+        """A diagnostic sample when one is due (and at the run's last step); position snapshots.
+        Returns (t, e) of the sample for the rest monitor, or None."""
+        s, rec, t, tol = self.s, self.rec, self.t, self.tol
+        sample = None
+        if self.elapsed >= self.next_sample - tol or self.status or self.spent():
+            while self.next_sample <= self.elapsed + tol:
+                self.next_sample += self.sample_dt
             v = s.vel[: s.nf]
             speed2 = (v**2).sum(1)
-            e = rest.energy_ratio(0.5 * speed2.sum() * s.weight / units.G, s.weight * s.nf, depth0)
-            at_rest = monitor.update(t, e)
+            e = rest.energy_ratio(0.5 * speed2.sum() * s.weight / units.G, s.weight * s.nf, self.depth0)
+            sample = t, e
             rec["time"].append(t)
             pair, panel, p_mean = s.take_means()
             rec["pair"].append(pair)
             rec["panel"].append(panel)
-            p_means.append((t, p_mean))
-            rec["probe"].append(model.probe_pressure(s.pos, s.p, s.kind, probes, s.re_n))
+            self.p_means.append((t, p_mean))
+            rec["probe"].append(model.probe_pressure(s.pos, s.p, s.kind, self.probes, s.re_n))
             rec["rms"].append(np.sqrt(speed2.mean()))
             rec["vmax"].append(np.sqrt(speed2.max()))
             rec["energy"].append(e)
-            rec["count"].append(_vessel_counts(s.pos[: s.nf], tank))
-            rec["resid"].append(resid)
-            rec["iters"].append(its)
+            rec["count"].append(_vessel_counts(s.pos[: s.nf], self.tank))
+            rec["resid"].append(self.resid)
+            rec["iters"].append(self.its)
             rec["surf"].append(int(s.surf[: s.nf].sum()))
-        if snap_times and elapsed >= snap_times[0] - 0.5 * dt0:
-            snap_times.pop(0)
-            snaps.append(s.pos[: s.nf].copy())
-            snap_t.append(t)
-        if status:
-            break
-        if at_rest:
-            status = "converged"
-            message = (f"step {step0 + k}: t = {t:.3f} s, at rest: kinetic energy / (W h) below "
-                       f"{monitor.limit:g} since t = {monitor.time_to_rest():.3f} s ({monitor.window:g} s window)")
-            break
-        now = time.perf_counter()
-        if now - last_log > LOG_EVERY:
-            log(f"mps {variant} l0={l0:g} cm: step {k}, t = {t:.3f} s of {t0 + nsteps * dt0:.3f} s, rms speed "
-                f"{rec['rms'][-1] if rec['rms'] else 0:.3g} cm/s, e = {monitor.last:.3g}")
-            last_log = now
-    wall = time.perf_counter() - wall0
-    rms = float(np.sqrt((s.vel[: s.nf] ** 2).sum(1).mean()))
-    times = np.array(rec["time"])
-    e_mean, e_max = rest.window_stats(times, np.array(rec["energy"]), monitor.window)
-    rms_window = rest.speed_at(e_mean, depth0)  # rms speed of the window's mean kinetic energy
-    if status is None:
-        status = "step_limit"
-        message = (f"step {step0 + k}: t = {t0 + elapsed:.3f} s (time limit), kinetic energy / (W h) over the last "
-                   f"{monitor.window:g} s: mean {e_mean:.3g}, max {e_max:.3g} (rms speed {rms_window:.3g} cm/s; rest: below "
-                   f"{monitor.limit:g} for {monitor.window:g} s)")
-    t_rest = monitor.time_to_rest() - t0 if status == "converged" else np.nan
-    pairwise = s.grad_mode in model.PAIRWISE  # momentum exchange is defined: the pair forces are the contacts
-    panels = np.array(rec["pair" if pairwise else "panel"])
-    window = times >= times[-1] - cfg["time.average_window"] + 1e-12
-    hist = {
-        "hist_time": (("sample",), times, "s", "time of sample"),
-        "hist_panel_force": (("sample", "contact", "xy"), panels, "N",
-                             "force of each wall panel on the liquid, the contacts' reading: " + ("pair forces (hist_pair_force)"
-                             if pairwise else "panel pressures (hist_panel_pressure_force; this gradient's pair terms are "
-                             "not antisymmetric, so they are no momentum exchange)")),
-        "hist_pair_force": (("sample", "contact", "xy"), np.array(rec["pair"]), "N",
-                            "force of each wall panel's boundary particles on the liquid: the wall-liquid pair terms of "
-                            "the pressure gradient (pair-force reading, model.wall_forces), mean over the steps since the "
-                            "previous sample (momentum exchanged / interval)"),
-        "hist_panel_pressure_force": (("sample", "contact", "xy"), np.array(rec["panel"]), "N",
-                                      "force of each wall panel on the liquid: first-row wall pressure times the wall "
-                                      "length it faces (panel reading), mean over the steps since the previous sample"),
-        "hist_probe_pressure": (("sample", "probe"), np.array(rec["probe"]).reshape(len(times), -1), "N cm-2", "pressure at fixed probe",
-                                {"missing": "no liquid particle within the probe's radius (a dry probe)"}),
-        "hist_rms_speed": (("sample",), np.array(rec["rms"]), "cm s-1", "rms speed of the liquid particles"),
-        "hist_max_speed": (("sample",), np.array(rec["vmax"]), "cm s-1", "largest liquid particle speed"),
-        "hist_energy_ratio": (("sample",), np.array(rec["energy"]), "1", "kinetic energy / (W h), isaflow.rest"),
-        "hist_vessel_count": (("sample", "vessel"), np.array(rec["count"]), "1", "particles per vessel"),
-        "hist_solve_residual": (("sample",), np.array(rec["resid"]), "1", "relative residual of the pressure solve"),
-        "hist_solve_iterations": (("sample",), np.array(rec["iters"]), "1", "iterations of the pressure solve"),
-        "hist_surface_count": (("sample",), np.array(rec["surf"]), "1", "liquid particles on the free surface"),
-        "probe_point": (("probe", "xy"), probes, "cm", "pressure probe position"),
-        "in_window": (("sample",), window.astype(np.int8), "1", "1 if the sample is in the averaging window"),
-    }
-    if snaps:
-        hist["snap_time"] = (("snapshot",), np.array(snap_t), "s", "time of position snapshot")
-        hist["snap_pos"] = (("snapshot", "particle", "xy"), np.array(snaps), "cm", "liquid particle positions at snapshot")
-    p_window = [q for tq, q in p_means if tq >= times[-1] - cfg["time.average_window"] + 1e-12]
-    fields = {
-        "pressure": (("particle",), s.p[: s.nf].copy(), "N cm-2", "pressure of each liquid particle at the end"),
-        "pressure_mean": (("particle",), np.mean(p_window, axis=0), "N cm-2",
-                          "pressure of each liquid particle, mean over the steps of the averaging window (the pressure "
-                          "alternates from step to step)"),
-        "velocity": (("particle", "xy"), s.vel[: s.nf].copy(), "cm s-1", "velocity of each liquid particle at the end"),
-    }
-    nb = np.bincount(s.kind, minlength=3)
-    rows_note = (f"depth rounded to whole rows: {depth0:.4g} cm (tank {tank.depth:g} cm), weight held at {tank.weight:g} N"
-                 if abs(depth0 - tank.depth) > 1e-9 else "none")
-    params = {
-        "source_term": variant, "spacing_cm": l0, "dt_s": dt0, "velocity_courant": vcfl, "min_dt_s": dt_min,
-        "short_steps": short_steps, "rho0_N_s2_cm4": s.rho0, "particle_weight_N": s.weight,
-        "re_density_cm": s.re_n, "re_gradient_cm": s.re_g, "re_laplacian_cm": s.re_l, "re_surface_cm": s.re_s,
-        "n0_density": s.n0_n, "n0_laplacian": s.n0_l, "n0_gradient": s.n0_g, "n0_surface": s.n0_s,
-        "gradient_norm": s.n_grad, "relaxation_scope": cfg["model.relaxation_scope"],
-        "lambda_cm2": s.lam, "beta": cfg["model.beta"], "relaxation": cfg["model.relaxation"],
-        "sound_speed_cm_s": cfg["model.sound_speed"], "surface_pressure": cfg["model.surface_pressure"],
-        "gradient_model": cfg["model.gradient"], "shifting": cfg["model.shifting"],
-        "pressure_laplacian": cfg["model.pressure_laplacian"], "divergence_model": cfg["model.divergence"],
-        "ecs": int(cfg["model.ecs"]),
-        "surface_distribution": cfg["model.surface_distribution"], "kinematic_viscosity_cm2_s": cfg["model.kinematic_viscosity"],
-        "gamma_mixed": cfg["model.gamma_mixed"], "courant": cfg["time.courant"], "pressure_solver": cfg["pressure.solver"],
-        "pressure_rtol": cfg["pressure.rtol"], "max_solve_residual": max_resid, "mean_solve_iterations": float(np.mean(iters)),
-        "average_window_s": cfg["time.average_window"], "time_limit_s": float(t_end), "wall_particles": int(nb[model.WALL]),
-        "dummy_particles": int(nb[model.DUMMY]), "thin_walls": ",".join(n for n, f in zip(tank.wall_names, s.thin_mask) if f) or "none",
-        "time_predict_s": timers[0], "time_solve_s": timers[1], "time_correct_s": timers[2], "list_builds": s.builds,
-        "collision_distance_cm": cfg["model.collision_distance"] * l0, "restitution": cfg["model.restitution"],
-        "settings_file": cfg.path, "panel_length": cfg["walls.panel_length"], "graze_depth_cm": s.graze_depth,
-        "graze_steps": s.grazes, "deepest_graze_cm": s.deepest_graze, "wall_reflect": int(cfg["walls.reflect"]),
-        "reflect_steps": s.reflect_steps, "reflected_particles": s.reflections, "escapes": int(status == "escaped"),
-        "threads": threads, "start_state": origin,
-        "layer_pitch": l0, "held_weight": float(s.weight * s.nf), "initial_depth": depth0, "tank_difference": rows_note,
-        "rest_energy_ratio": monitor.limit, "rest_window": monitor.window, "rest_depth_cm": depth0,
-        "time_to_rest": t_rest, "final_energy_ratio": monitor.last, "final_rms_speed_cm_s": rms,
-        "window_energy_ratio_mean": e_mean, "window_energy_ratio_max": e_max, "window_rms_speed_cm_s": rms_window,
-        "wall_load_reading": "pair forces" if pairwise else "panel pressures",
-    }
-    return Result(
-        method="mps", variant=variant, pos0=pos0, pos=s.pos[: s.nf].copy(), weight=np.full(s.nf, s.weight),
-        contact_wall=s.panel_wall, contact_point=s.panel_centre, contact_force=panels[window].mean(0),
-        status=status, message=message, steps=step0 + k, start_step=step0, wall_time=wall, force_evals=k,
-        residual=rms_window, residual_name=f"rms speed over the last {monitor.window:g} s", residual_units="cm s-1", sim_time=t0 + elapsed,
-        history=hist, fields=fields, params=params)
+        if self.snap_times and self.elapsed >= self.snap_times[0] - 0.5 * self.dt0:
+            self.snap_times.pop(0)
+            self.snaps.append(s.pos[: s.nf].copy())
+            self.snap_t.append(t)
+        return sample
+
+    def rest_message(self, monitor):
+        return (f"step {self.step0 + self.k}: t = {self.t:.3f} s, at rest: kinetic energy / (W h) below "
+                f"{monitor.limit:g} since t = {monitor.time_to_rest():.3f} s ({monitor.window:g} s window)")
+
+    def _window_energy(self, monitor):
+        """(mean e, max e, rms speed [cm/s] of the mean) over the last rest window of samples."""
+        e_mean, e_max = rest.window_stats(np.array(self.rec["time"]), np.array(self.rec["energy"]), monitor.window)
+        return e_mean, e_max, rest.speed_at(e_mean, self.depth0)  # rms speed of the window's mean kinetic energy
+
+    def limit_message(self, monitor):
+        e_mean, e_max, rms_window = self._window_energy(monitor)
+        return (f"step {self.step0 + self.k}: t = {self.t0 + self.elapsed:.3f} s (time limit), kinetic energy / (W h) "
+                f"over the last {monitor.window:g} s: mean {e_mean:.3g}, max {e_max:.3g} (rms speed "
+                f"{rms_window:.3g} cm/s; rest: below {monitor.limit:g} for {monitor.window:g} s)")
+
+    def progress(self, monitor):
+        rec = self.rec
+        return (f"mps {self.variant} l0={self.l0:g} cm: step {self.k}, t = {self.t:.3f} s of "
+                f"{self.t0 + self.nsteps * self.dt0:.3f} s, rms speed {rec['rms'][-1] if rec['rms'] else 0:.3g} cm/s, "
+                f"e = {monitor.last:.3g}")
+
+    def result(self, run):
+        """contract.Result of the run."""
+        s, cfg, tank, rec, l0, t0, k = self.s, self.cfg, self.tank, self.rec, self.l0, self.t0, self.k
+        variant, threads, depth0, origin, probes = self.variant, self.threads, self.depth0, self.origin, self.probes
+        dt0, vcfl, dt_min, short_steps, t_end = self.dt0, self.vcfl, self.dt_min, self.short_steps, self.t_end
+        snaps, snap_t, p_means, max_resid, iters = self.snaps, self.snap_t, self.p_means, self.max_resid, self.iters
+        timers, pos0, elapsed, step0 = self.timers, self.pos0, self.elapsed, self.step0
+        status, message, wall, monitor = run.status, run.message, run.wall_time, run.monitor
+        rms = float(np.sqrt((s.vel[: s.nf] ** 2).sum(1).mean()))
+        times = np.array(rec["time"])
+        e_mean, e_max, rms_window = self._window_energy(monitor)
+        t_rest = run.time_to_rest
+        pairwise = s.grad_mode in model.PAIRWISE  # momentum exchange is defined: the pair forces are the contacts
+        panels = np.array(rec["pair" if pairwise else "panel"])
+        window = times >= times[-1] - cfg["time.average_window"] + 1e-12
+        hist = {
+            "hist_time": (("sample",), times, "s", "time of sample"),
+            "hist_panel_force": (("sample", "contact", "xy"), panels, "N",
+                                 "force of each wall panel on the liquid, the contacts' reading: " + ("pair forces (hist_pair_force)"
+                                 if pairwise else "panel pressures (hist_panel_pressure_force; this gradient's pair terms are "
+                                 "not antisymmetric, so they are no momentum exchange)")),
+            "hist_pair_force": (("sample", "contact", "xy"), np.array(rec["pair"]), "N",
+                                "force of each wall panel's boundary particles on the liquid: the wall-liquid pair terms of "
+                                "the pressure gradient (pair-force reading, model.wall_forces), mean over the steps since the "
+                                "previous sample (momentum exchanged / interval)"),
+            "hist_panel_pressure_force": (("sample", "contact", "xy"), np.array(rec["panel"]), "N",
+                                          "force of each wall panel on the liquid: first-row wall pressure times the wall "
+                                          "length it faces (panel reading), mean over the steps since the previous sample"),
+            "hist_probe_pressure": (("sample", "probe"), np.array(rec["probe"]).reshape(len(times), -1), "N cm-2", "pressure at fixed probe",
+                                    {"missing": "no liquid particle within the probe's radius (a dry probe)"}),
+            "hist_rms_speed": (("sample",), np.array(rec["rms"]), "cm s-1", "rms speed of the liquid particles"),
+            "hist_max_speed": (("sample",), np.array(rec["vmax"]), "cm s-1", "largest liquid particle speed"),
+            "hist_energy_ratio": (("sample",), np.array(rec["energy"]), "1", "kinetic energy / (W h), isaflow.rest"),
+            "hist_vessel_count": (("sample", "vessel"), np.array(rec["count"]), "1", "particles per vessel"),
+            "hist_solve_residual": (("sample",), np.array(rec["resid"]), "1", "relative residual of the pressure solve"),
+            "hist_solve_iterations": (("sample",), np.array(rec["iters"]), "1", "iterations of the pressure solve"),
+            "hist_surface_count": (("sample",), np.array(rec["surf"]), "1", "liquid particles on the free surface"),
+            "probe_point": (("probe", "xy"), probes, "cm", "pressure probe position"),
+            "in_window": (("sample",), window.astype(np.int8), "1", "1 if the sample is in the averaging window"),
+        }
+        if snaps:
+            hist["snap_time"] = (("snapshot",), np.array(snap_t), "s", "time of position snapshot")
+            hist["snap_pos"] = (("snapshot", "particle", "xy"), np.array(snaps), "cm", "liquid particle positions at snapshot")
+        p_window = [q for tq, q in p_means if tq >= times[-1] - cfg["time.average_window"] + 1e-12]
+        fields = {
+            "pressure": (("particle",), s.p[: s.nf].copy(), "N cm-2", "pressure of each liquid particle at the end"),
+            "pressure_mean": (("particle",), np.mean(p_window, axis=0), "N cm-2",
+                              "pressure of each liquid particle, mean over the steps of the averaging window (the pressure "
+                              "alternates from step to step)"),
+            "velocity": (("particle", "xy"), s.vel[: s.nf].copy(), "cm s-1", "velocity of each liquid particle at the end"),
+        }
+        nb = np.bincount(s.kind, minlength=3)
+        rows_note = (f"depth rounded to whole rows: {depth0:.4g} cm (tank {tank.depth:g} cm), weight held at {tank.weight:g} N"
+                     if abs(depth0 - tank.depth) > 1e-9 else "none")
+        params = {
+            "source_term": variant, "spacing_cm": l0, "dt_s": dt0, "velocity_courant": vcfl, "min_dt_s": dt_min,
+            "short_steps": short_steps, "rho0_N_s2_cm4": s.rho0, "particle_weight_N": s.weight,
+            "re_density_cm": s.re_n, "re_gradient_cm": s.re_g, "re_laplacian_cm": s.re_l, "re_surface_cm": s.re_s,
+            "n0_density": s.n0_n, "n0_laplacian": s.n0_l, "n0_gradient": s.n0_g, "n0_surface": s.n0_s,
+            "gradient_norm": s.n_grad, "relaxation_scope": cfg["model.relaxation_scope"],
+            "lambda_cm2": s.lam, "beta": cfg["model.beta"], "relaxation": cfg["model.relaxation"],
+            "sound_speed_cm_s": cfg["model.sound_speed"], "surface_pressure": cfg["model.surface_pressure"],
+            "gradient_model": cfg["model.gradient"], "shifting": cfg["model.shifting"],
+            "pressure_laplacian": cfg["model.pressure_laplacian"], "divergence_model": cfg["model.divergence"],
+            "ecs": int(cfg["model.ecs"]),
+            "surface_distribution": cfg["model.surface_distribution"], "kinematic_viscosity_cm2_s": cfg["model.kinematic_viscosity"],
+            "gamma_mixed": cfg["model.gamma_mixed"], "courant": cfg["time.courant"], "pressure_solver": cfg["pressure.solver"],
+            "pressure_rtol": cfg["pressure.rtol"], "max_solve_residual": max_resid, "mean_solve_iterations": float(np.mean(iters)),
+            "average_window_s": cfg["time.average_window"], "time_limit_s": float(t_end), "wall_particles": int(nb[model.WALL]),
+            "dummy_particles": int(nb[model.DUMMY]), "thin_walls": ",".join(n for n, f in zip(tank.wall_names, s.thin_mask) if f) or "none",
+            "time_predict_s": timers[0], "time_solve_s": timers[1], "time_correct_s": timers[2], "list_builds": s.builds,
+            "collision_distance_cm": cfg["model.collision_distance"] * l0, "restitution": cfg["model.restitution"],
+            "settings_file": cfg.path, "panel_length": cfg["walls.panel_length"], "graze_depth_cm": s.graze_depth,
+            "graze_steps": s.grazes, "deepest_graze_cm": s.deepest_graze, "wall_reflect": int(cfg["walls.reflect"]),
+            "reflect_steps": s.reflect_steps, "reflected_particles": s.reflections, "escapes": int(status == "escaped"),
+            "threads": threads, "start_state": origin,
+            "layer_pitch": l0, "held_weight": float(s.weight * s.nf), "initial_depth": depth0, "tank_difference": rows_note,
+            "rest_energy_ratio": monitor.limit, "rest_window": monitor.window, "rest_depth_cm": depth0,
+            "time_to_rest": t_rest, "final_energy_ratio": monitor.last, "final_rms_speed_cm_s": rms,
+            "window_energy_ratio_mean": e_mean, "window_energy_ratio_max": e_max, "window_rms_speed_cm_s": rms_window,
+            "wall_load_reading": "pair forces" if pairwise else "panel pressures",
+        }
+        return Result(
+            method="mps", variant=variant, pos0=pos0, pos=s.pos[: s.nf].copy(), weight=np.full(s.nf, s.weight),
+            contact_wall=s.panel_wall, contact_point=s.panel_centre, contact_force=panels[window].mean(0),
+            status=status, message=message, steps=step0 + k, start_step=step0, wall_time=wall, force_evals=k,
+            residual=rms_window, residual_name=f"rms speed over the last {monitor.window:g} s", residual_units="cm s-1", sim_time=t0 + elapsed,
+            history=hist, fields=fields, params=params)
+
+
+def _solve(tank, cfg, variant, l0, t_end, probes, start, snapshots, log, threads, rest_cfg):
+    """Set up the run (_Stepper) and drive it (driver.drive) -> contract.Result; arguments as solve's."""
+    stepper = _Stepper(tank, cfg, variant, l0, t_end, probes, start, snapshots, threads)
+    return driver.drive(stepper, rest_cfg, log)

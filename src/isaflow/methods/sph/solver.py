@@ -1,4 +1,4 @@
-"""Run WCSPH on a tank: set up, advance the compiled loop in chunks, classify -> contract.Result.
+"""Run WCSPH on a tank: set up, and a stepper of compiled chunks for driver.drive -> contract.Result.
 
 Outcomes: ``converged`` (the liquid is at rest by isaflow.rest, the one criterion of every
 dynamic method: e = KE / (W h) below its ratio for its window), ``step_limit`` (the run's
@@ -19,7 +19,7 @@ import time
 import numba
 import numpy as np
 
-from ... import rest as R
+from ... import driver, rest as R
 from ...contract import Result
 from ...core import smoothing
 from ...core.geometry import bounding_box
@@ -212,155 +212,192 @@ def _panels(walls, length, owner, face, wpos, force, dx, dy):
     return tuple(np.concatenate(a) for a in out)
 
 
-def _run(tank, s, resolution, start, on_wall, t_max, log, threads=1):
-    st = setup(tank, s, resolution, start, on_wall)
-    nf, nw = len(st["pos"]), len(st["wpos"])
-    x = np.concatenate([st["pos"], st["wpos"]])
-    v, par = st["vel"].copy(), st["par"]
-    rho = np.concatenate([st["rho"], np.full(nw, st["rho_ref"])])
-    p = np.zeros(nf + nw)
-    walls = tank.walls
-    # the vessels are open at the top: a splash may rise above the walls and fall back in (Tank.escape_box)
-    wall_box = bounding_box(walls)
-    box = np.asarray(tank.escape_box(), float)
-    rc = 2 * st["h"] + par[K.SKIN]
-    # the cell grid depends on the tank and the lattice only, so a continuation builds the same lists
-    lo, hi = np.minimum(wall_box[:2], st["wpos"].min(0)) - rc, np.maximum(wall_box[2:], st["wpos"].max(0)) + rc
-    grid_box = np.array([lo[0], lo[1], hi[0], hi[1]])
-    xref = st["xref"]
-    lst = K.list_pairs(np.concatenate([xref, st["wpos"]]), nf, grid_box, rc, walls, K.reach_of(par))
-    wk, fk = np.empty(len(lst[0])), np.empty(len(lst[0]))
-    acc = np.zeros((nf, 2))
-    wall_force, force_sum = np.zeros((nw, 2)), np.zeros((nw, 2))
-    pw, pc, _, _ = wall_panels(walls, s["panel_length"])
-    npanel = np.bincount(pw, minlength=len(walls)).astype(np.int64)
-    panel0 = np.concatenate([[0], np.cumsum(npanel)[:-1]]).astype(np.int64)
-    panel_sum = np.zeros((len(pw), 2))
-    K.evaluate(x, v, rho, p, nf, walls, par, lst, wk, fk, acc, wall_force, panel0, npanel, panel_sum, threads)
-    if st["acc"] is not None:  # the viscosity took the half-step velocities: the run's own accelerations
-        acc[:] = st["acc"]
-    diag = np.zeros(4)
-    flow = len(tank.spec.get("vessels", [])) > 1
-    t_max = t_max or (s["t_max_flow"] if flow else s["t_max_single"])
-    dt = st["dt"]
-    n_total = max(1, int(round(t_max / dt)))
-    n_chunk = max(1, int(round(s["chunk_time"] / dt)))
-    rest_cfg = R.load()
-    monitor = R.Monitor(rest_cfg["energy_ratio"], rest_cfg["window"])
-    held = st["mass"] * G * nf
-    n_window = max(1, int(math.ceil(rest_cfg["window"] / (n_chunk * dt))))
-    window, lj_window = collections.deque(maxlen=n_window), collections.deque(maxlen=n_window)
-    vessels = vessels_of(tank)
-    rec = collections.defaultdict(list)
-    snaps = sorted(s["snapshot_times"])
-    t0, step0 = st["t0"], st["step0"]
-    done_total, builds, status, message = 0, 0, None, ""
-    ke = 0.5 * st["mass"] * float(np.sum(v * v))
-    started = last_log = time.perf_counter()
-    while status is None:
-        t = t0 + done_total * dt
-        while snaps and snaps[0] <= done_total * dt + 0.5 * dt:
-            rec["snap_time"].append(t)
-            rec["snap_pos"].append(x[:nf].copy())
-            snaps.pop(0)
-        n = min(n_chunk, n_total - done_total)
-        force_sum[:] = 0.0
-        panel_sum[:] = 0.0
-        code, done, lst, wk, fk = K.advance(x, v, rho, p, nf, walls, box, grid_box, par, n, xref, lst, wk, fk, acc,
-                                            wall_force, force_sum, panel0, npanel, panel_sum, diag, threads)
-        done_total += done
-        builds += int(diag[2])
-        t = t0 + done_total * dt
+class _Stepper:
+    """WCSPH on a tank for driver.drive: one advance is one compiled chunk (kernels.advance) of chunk_time s."""
+
+    def __init__(self, tank, s, resolution, start, on_wall, t_max, threads, rest_cfg):
+        self.tank, self.s, self.resolution, self.start, self.on_wall = tank, s, resolution, start, on_wall
+        self.threads, self.rest_cfg = threads, rest_cfg
+        self.st = st = setup(tank, s, resolution, start, on_wall)
+        self.nf, self.nw = nf, nw = len(st["pos"]), len(st["wpos"])
+        self.x = np.concatenate([st["pos"], st["wpos"]])
+        self.v, self.par = st["vel"].copy(), st["par"]
+        self.rho = np.concatenate([st["rho"], np.full(nw, st["rho_ref"])])
+        self.p = np.zeros(nf + nw)
+        self.walls = walls = tank.walls
+        # the vessels are open at the top: a splash may rise above the walls and fall back in (Tank.escape_box)
+        wall_box = bounding_box(walls)
+        self.box = np.asarray(tank.escape_box(), float)
+        rc = 2 * st["h"] + self.par[K.SKIN]
+        # the cell grid depends on the tank and the lattice only, so a continuation builds the same lists
+        lo, hi = np.minimum(wall_box[:2], st["wpos"].min(0)) - rc, np.maximum(wall_box[2:], st["wpos"].max(0)) + rc
+        self.grid_box = np.array([lo[0], lo[1], hi[0], hi[1]])
+        self.xref = st["xref"]
+        self.lst = K.list_pairs(np.concatenate([self.xref, st["wpos"]]), nf, self.grid_box, rc, walls,
+                                K.reach_of(self.par))
+        self.wk, self.fk = np.empty(len(self.lst[0])), np.empty(len(self.lst[0]))
+        self.acc = np.zeros((nf, 2))
+        self.wall_force, self.force_sum = np.zeros((nw, 2)), np.zeros((nw, 2))
+        pw, pc, _, _ = wall_panels(walls, s["panel_length"])
+        self.npanel = np.bincount(pw, minlength=len(walls)).astype(np.int64)
+        self.panel0 = np.concatenate([[0], np.cumsum(self.npanel)[:-1]]).astype(np.int64)
+        self.panel_sum = np.zeros((len(pw), 2))
+        K.evaluate(self.x, self.v, self.rho, self.p, nf, walls, self.par, self.lst, self.wk, self.fk, self.acc,
+                   self.wall_force, self.panel0, self.npanel, self.panel_sum, threads)
+        if st["acc"] is not None:  # the viscosity took the half-step velocities: the run's own accelerations
+            self.acc[:] = st["acc"]
+        self.diag = np.zeros(4)
+        self.flow = len(tank.spec.get("vessels", [])) > 1
+        self.t_max = t_max or (s["t_max_flow"] if self.flow else s["t_max_single"])
+        self.dt = dt = st["dt"]
+        self.n_total = max(1, int(round(self.t_max / dt)))
+        self.n_chunk = max(1, int(round(s["chunk_time"] / dt)))
+        self.held = st["mass"] * G * nf
+        n_window = max(1, int(math.ceil(rest_cfg["window"] / (self.n_chunk * dt))))
+        self.window, self.lj_window = collections.deque(maxlen=n_window), collections.deque(maxlen=n_window)
+        self.vessels = vessels_of(tank)
+        self.rec = collections.defaultdict(list)
+        self.snaps = sorted(s["snapshot_times"])
+        self.t0, self.step0 = st["t0"], st["step0"]
+        self.done_total, self.builds = 0, 0
+        self.ke = 0.5 * st["mass"] * float(np.sum(self.v * self.v))
+        self.t = self.t0
+        self.started = time.perf_counter()
+
+    def _rms(self):
+        return math.sqrt(2 * self.ke / (self.st["mass"] * self.nf))
+
+    def advance(self):
+        """One chunk; (status, message) if the kernel stopped on a particle, else None."""
+        x, nf, dt = self.x, self.nf, self.dt
+        t = self.t0 + self.done_total * dt
+        while self.snaps and self.snaps[0] <= self.done_total * dt + 0.5 * dt:
+            self.rec["snap_time"].append(t)
+            self.rec["snap_pos"].append(x[:nf].copy())
+            self.snaps.pop(0)
+        n = min(self.n_chunk, self.n_total - self.done_total)
+        self.force_sum[:] = 0.0
+        self.panel_sum[:] = 0.0
+        code, done, self.lst, self.wk, self.fk = K.advance(
+            x, self.v, self.rho, self.p, nf, self.walls, self.box, self.grid_box, self.par, n, self.xref, self.lst,
+            self.wk, self.fk, self.acc, self.wall_force, self.force_sum, self.panel0, self.npanel, self.panel_sum,
+            self.diag, self.threads)
+        self.done_total += done
+        self.builds += int(self.diag[2])
+        self.t = t = self.t0 + self.done_total * dt
         if done:
-            window.append(force_sum / done)
-            lj_window.append(panel_sum / done)
-            ke = diag[1]
-        at_rest = monitor.update(t, R.energy_ratio(ke, held, st["depth0"]))
-        rec["sample_time"].append(t)
-        rec["sample_vrms"].append(diag[0])
-        rec["sample_kinetic"].append(ke)
-        per_wall = np.zeros((len(walls), 2))
-        np.add.at(per_wall, st["owner"], window[-1] if window else 0.0)
+            self.window.append(self.force_sum / done)
+            self.lj_window.append(self.panel_sum / done)
+            self.ke = self.diag[1]
+        if code == K.OK:
+            return None
+        what = {K.CROSSED: "would cross a wall", K.LEFT_BOX: "left the walls' bounding box (open max_drop above)",
+                K.NONFINITE: "became non-finite"}[code]
+        k = int(self.diag[3])
+        return CODES[code], (f"particle {k}, at ({x[k, 0]:.4g}, {x[k, 1]:.4g}) cm, {what} at step "
+                             f"{self.step0 + self.done_total} (t = {t:.4g} s)")
+
+    def record(self):
+        """The chunk's diagnostic sample; returns (t, e) for the rest monitor."""
+        st, rec, x, nf = self.st, self.rec, self.x, self.nf
+        sample = self.t, R.energy_ratio(self.ke, self.held, st["depth0"])
+        rec["sample_time"].append(self.t)
+        rec["sample_vrms"].append(self.diag[0])
+        rec["sample_kinetic"].append(self.ke)
+        per_wall = np.zeros((len(self.walls), 2))
+        np.add.at(per_wall, st["owner"], self.window[-1] if self.window else 0.0)
         rec["sample_wall_resultant"].append(per_wall)
         rec["sample_vessel_weight"].append([st["mass"] * G * np.count_nonzero((x[:nf, 0] >= a) & (x[:nf, 0] < b))
-                                            for _, (a, b) in vessels])
-        steps = step0 + done_total
-        rms = math.sqrt(2 * ke / (st["mass"] * nf))
-        if code != K.OK:
-            status = CODES[code]
-            what = {K.CROSSED: "would cross a wall", K.LEFT_BOX: "left the walls' bounding box (open max_drop above)",
-                    K.NONFINITE: "became non-finite"}[code]
-            k = int(diag[3])
-            message = f"particle {k}, at ({x[k, 0]:.4g}, {x[k, 1]:.4g}) cm, {what} at step {steps} (t = {t:.4g} s)"
-        elif at_rest:
-            status = "converged"
-            message = (f"at rest: e = KE / (W h) < {rest_cfg['energy_ratio']:g} for {rest_cfg['window']:g} s from "
-                       f"t = {monitor.time_to_rest():.4g} s, reached at t = {t:.4g} s (step {steps}); rms speed "
-                       f"{rms:.3g} cm/s")
-        elif done_total >= n_total:
-            status = "step_limit"
-            message = (f"time limit {t_max:g} s reached at t = {t:.4g} s (step {steps}), not at rest: e = "
-                       f"{monitor.last:.3g}, rms speed {rms:.3g} cm/s")
+                                            for _, (a, b) in self.vessels])
+        return sample
+
+    def spent(self):
+        return self.done_total >= self.n_total
+
+    def rest_message(self, monitor):
+        return (f"at rest: e = KE / (W h) < {self.rest_cfg['energy_ratio']:g} for {self.rest_cfg['window']:g} s from "
+                f"t = {monitor.time_to_rest():.4g} s, reached at t = {self.t:.4g} s (step "
+                f"{self.step0 + self.done_total}); rms speed {self._rms():.3g} cm/s")
+
+    def limit_message(self, monitor):
+        return (f"time limit {self.t_max:g} s reached at t = {self.t:.4g} s (step {self.step0 + self.done_total}), "
+                f"not at rest: e = {monitor.last:.3g}, rms speed {self._rms():.3g} cm/s")
+
+    def progress(self, monitor):
         now = time.perf_counter()
-        if now - last_log > 20.0:
-            log(f"sph: t = {t:.3f} s ({done_total * dt:.3f} / {t_max:g} s of this run), step {steps}, rms speed "
-                f"{rms:.3g} cm/s, {nf} particles, {(now - started) / max(done_total, 1) / nf * 1e9:.0f} ns/particle-step")
-            last_log = now
-    wall_time = time.perf_counter() - started
-    mean_force = np.mean(np.array(window), axis=0) if window else np.zeros((nw, 2))
-    cw, cp, cf, side = _panels(walls, s["panel_length"], st["owner"], st["face"], st["wpos"], mean_force,
-                               st["dx"], st["dy"])
-    if lj_window:  # the safety net's panel forces, with the front faces' panels
-        front = np.flatnonzero(side == 0)
-        cf[front] += np.mean(np.array(lj_window), axis=0)
-    x0, x1, floor_y = first_vessel(tank)
-    left = int(np.count_nonzero((x[:nf, 0] >= x0) & (x[:nf, 0] < x1)))
-    history = {
-        "sample_time": (("sample",), np.array(rec["sample_time"]), "s", "chain time at the end of the diagnostic chunk"),
-        "sample_vrms": (("sample",), np.array(rec["sample_vrms"]), VELOCITY, "largest rms liquid speed in the chunk"),
-        "sample_kinetic": (("sample",), np.array(rec["sample_kinetic"]), "N cm", "kinetic energy at the chunk's end"),
-        "sample_wall_resultant": (("sample", "wall", "xy"), np.array(rec["sample_wall_resultant"]), "N",
-                                  "force of each wall on the liquid, mean over the chunk"),
-        "sample_vessel_weight": (("sample", "vessel"), np.array(rec["sample_vessel_weight"]), "N",
-                                 "weight of the liquid in each vessel"),
-        "snap_time": (("snapshot",), np.array(rec["snap_time"]), "s", "chain time of the position snapshot"),
-        "snap_pos": (("snapshot", "particle", "xy"), np.array(rec["snap_pos"]).reshape(-1, nf, 2), "cm",
-                     "liquid particle positions"),
-        "contact_side": (("contact",), side.astype(np.int8), "1",
-                         "wall face of the panel: 0 its front (left, liquid side), 1 its back (thin dividing wall)"),
-    }
-    fields = {
-        "pressure": (("particle",), p[:nf].copy(), "N cm-2", "particle pressure (equation of state)"),
-        "density": (("particle",), rho[:nf].copy(), DENSITY_2D, "particle density"),
-        "velocity": (("particle", "xy"), v.copy(), VELOCITY, "particle velocity"),
-        "list_pos": (("particle", "xy"), xref.copy(), "cm",
-                     "positions at the last pair-list build (a continuation rebuilds the list there)"),
-        "acceleration": (("particle", "xy"), acc.copy(), "cm s-2",
-                         "acceleration at the end (its viscosity took the half-step velocities; a continuation "
-                         "starts from it)"),
-    }
-    params = {f"sph_{k}": (str(v_) if isinstance(v_, (bool, list)) else v_) for k, v_ in s.items()}
-    initial_depth = st["depth0"]
-    diff = [f"weakly compressible: the column holds {held:g} N compressed to its hydrostatic density, its "
-            f"surface {initial_depth:.4g} cm (tank {tank.depth:g} cm)"] if start is None else [
-            f"continues a run whose initial depth was {initial_depth:.4g} cm (tank {tank.depth:g} cm)"]
-    if abs(held - tank.weight) > 1e-9 * tank.weight:
-        diff.append(f"weight held {held:g} N (tank {tank.weight:g} N)")
-    params.update(
-        liquid_depth=tank.depth, first_vessel_width=float(x1 - x0), cell_dx=st["dx"], cell_dy=st["dy"],
-        smoothing_length=st["h"], sound_speed=st["c0"], dt=dt, particle_mass=st["mass"], rho_ref=st["rho_ref"],
-        wall_particles=nw, two_faced_walls=", ".join(n for n, f in zip(tank.wall_names, P.wet_back(walls, vessels))
-                                                     if f and flow) or "none",
-        t_max=t_max, panel_length=s["panel_length"], load_window=len(window) * n_chunk * dt,
-        resolution=str(resolution) if start is None else "continued", on_wall=str(bool(on_wall)),
-        threads=int(threads), layer_pitch=st["dy"], held_weight=held, initial_depth=initial_depth,
-        tank_difference="; ".join(diff), rest_energy_ratio=rest_cfg["energy_ratio"], rest_window=rest_cfg["window"],
-        time_to_rest=monitor.time_to_rest() - t0 if status == "converged" else math.nan, start_time=t0,
-        final_energy_ratio=monitor.last, final_rms_speed=math.sqrt(2 * ke / (st["mass"] * nf)),
-        particles_left=left, list_builds=builds)
-    return Result(
-        method="sph", variant="custom", pos0=st["pos"], pos=x[:nf].copy(), weight=np.full(nf, st["mass"] * G),
-        contact_wall=cw, contact_point=cp, contact_force=cf, status=status, message=message,
-        steps=step0 + done_total, start_step=step0, wall_time=wall_time, force_evals=done_total + 1,
-        residual=math.sqrt(2 * ke / (st["mass"] * nf)), residual_name="rms speed", residual_units=VELOCITY,
-        sim_time=t0 + done_total * dt, history=history, fields=fields, params=params)
+        return (f"sph: t = {self.t:.3f} s ({self.done_total * self.dt:.3f} / {self.t_max:g} s of this run), step "
+                f"{self.step0 + self.done_total}, rms speed {self._rms():.3g} cm/s, {self.nf} particles, "
+                f"{(now - self.started) / max(self.done_total, 1) / self.nf * 1e9:.0f} ns/particle-step")
+
+    def result(self, run):
+        """contract.Result of the run (variant 'custom'; solve() names it)."""
+        st, s, tank, walls, x, nf, nw = self.st, self.s, self.tank, self.walls, self.x, self.nf, self.nw
+        p, rho, v, acc, xref, dt = self.p, self.rho, self.v, self.acc, self.xref, self.dt
+        window, lj_window, rec, rest_cfg = self.window, self.lj_window, self.rec, self.rest_cfg
+        held, ke = self.held, self.ke
+        t0, step0, done_total, n_chunk, t_max = self.t0, self.step0, self.done_total, self.n_chunk, self.t_max
+        start, resolution, on_wall, flow, vessels = self.start, self.resolution, self.on_wall, self.flow, self.vessels
+        status, message, wall_time, monitor = run.status, run.message, run.wall_time, run.monitor
+        mean_force = np.mean(np.array(window), axis=0) if window else np.zeros((nw, 2))
+        cw, cp, cf, side = _panels(walls, s["panel_length"], st["owner"], st["face"], st["wpos"], mean_force,
+                                   st["dx"], st["dy"])
+        if lj_window:  # the safety net's panel forces, with the front faces' panels
+            front = np.flatnonzero(side == 0)
+            cf[front] += np.mean(np.array(lj_window), axis=0)
+        x0, x1, floor_y = first_vessel(tank)
+        left = int(np.count_nonzero((x[:nf, 0] >= x0) & (x[:nf, 0] < x1)))
+        history = {
+            "sample_time": (("sample",), np.array(rec["sample_time"]), "s", "chain time at the end of the diagnostic chunk"),
+            "sample_vrms": (("sample",), np.array(rec["sample_vrms"]), VELOCITY, "largest rms liquid speed in the chunk"),
+            "sample_kinetic": (("sample",), np.array(rec["sample_kinetic"]), "N cm", "kinetic energy at the chunk's end"),
+            "sample_wall_resultant": (("sample", "wall", "xy"), np.array(rec["sample_wall_resultant"]), "N",
+                                      "force of each wall on the liquid, mean over the chunk"),
+            "sample_vessel_weight": (("sample", "vessel"), np.array(rec["sample_vessel_weight"]), "N",
+                                     "weight of the liquid in each vessel"),
+            "snap_time": (("snapshot",), np.array(rec["snap_time"]), "s", "chain time of the position snapshot"),
+            "snap_pos": (("snapshot", "particle", "xy"), np.array(rec["snap_pos"]).reshape(-1, nf, 2), "cm",
+                         "liquid particle positions"),
+            "contact_side": (("contact",), side.astype(np.int8), "1",
+                             "wall face of the panel: 0 its front (left, liquid side), 1 its back (thin dividing wall)"),
+        }
+        fields = {
+            "pressure": (("particle",), p[:nf].copy(), "N cm-2", "particle pressure (equation of state)"),
+            "density": (("particle",), rho[:nf].copy(), DENSITY_2D, "particle density"),
+            "velocity": (("particle", "xy"), v.copy(), VELOCITY, "particle velocity"),
+            "list_pos": (("particle", "xy"), xref.copy(), "cm",
+                         "positions at the last pair-list build (a continuation rebuilds the list there)"),
+            "acceleration": (("particle", "xy"), acc.copy(), "cm s-2",
+                             "acceleration at the end (its viscosity took the half-step velocities; a continuation "
+                             "starts from it)"),
+        }
+        params = {f"sph_{k}": (str(v_) if isinstance(v_, (bool, list)) else v_) for k, v_ in s.items()}
+        initial_depth = st["depth0"]
+        diff = [f"weakly compressible: the column holds {held:g} N compressed to its hydrostatic density, its "
+                f"surface {initial_depth:.4g} cm (tank {tank.depth:g} cm)"] if start is None else [
+                f"continues a run whose initial depth was {initial_depth:.4g} cm (tank {tank.depth:g} cm)"]
+        if abs(held - tank.weight) > 1e-9 * tank.weight:
+            diff.append(f"weight held {held:g} N (tank {tank.weight:g} N)")
+        params.update(
+            liquid_depth=tank.depth, first_vessel_width=float(x1 - x0), cell_dx=st["dx"], cell_dy=st["dy"],
+            smoothing_length=st["h"], sound_speed=st["c0"], dt=dt, particle_mass=st["mass"], rho_ref=st["rho_ref"],
+            wall_particles=nw, two_faced_walls=", ".join(n for n, f in zip(tank.wall_names, P.wet_back(walls, vessels))
+                                                         if f and flow) or "none",
+            t_max=t_max, panel_length=s["panel_length"], load_window=len(window) * n_chunk * dt,
+            resolution=str(resolution) if start is None else "continued", on_wall=str(bool(on_wall)),
+            threads=int(self.threads), layer_pitch=st["dy"], held_weight=held, initial_depth=initial_depth,
+            tank_difference="; ".join(diff), rest_energy_ratio=rest_cfg["energy_ratio"], rest_window=rest_cfg["window"],
+            time_to_rest=run.time_to_rest, start_time=t0,
+            final_energy_ratio=monitor.last, final_rms_speed=math.sqrt(2 * ke / (st["mass"] * nf)),
+            particles_left=left, list_builds=self.builds)
+        return Result(
+            method="sph", variant="custom", pos0=st["pos"], pos=x[:nf].copy(), weight=np.full(nf, st["mass"] * G),
+            contact_wall=cw, contact_point=cp, contact_force=cf, status=status, message=message,
+            steps=step0 + done_total, start_step=step0, wall_time=wall_time, force_evals=done_total + 1,
+            residual=math.sqrt(2 * ke / (st["mass"] * nf)), residual_name="rms speed", residual_units=VELOCITY,
+            sim_time=t0 + done_total * dt, history=history, fields=fields, params=params)
+
+
+def _run(tank, s, resolution, start, on_wall, t_max, log, threads=1):
+    """Set up the run (setup) and drive it (driver.drive) -> contract.Result; arguments as solve's."""
+    rest_cfg = R.load()
+    return driver.drive(_Stepper(tank, s, resolution, start, on_wall, t_max, threads, rest_cfg), rest_cfg, log)
