@@ -76,7 +76,7 @@ def measure(sizes, variants, reps):
     load0 = os.getloadavg()[0]
     rows = []
     for variant in variants:
-        s = S.resolve(S.load(), variant)
+        s = S.resolve(S.read_file(), variant)
         for n in sizes:
             a, nw = state(tank, s, n)
             steps = max(10, int(2.5e6 / a["nf"]))  # about 0.3 s a chunk on one thread

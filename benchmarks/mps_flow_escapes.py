@@ -48,7 +48,7 @@ def main(args):
     rows = []
     for res in ("dx5.56", "dx3.45"):
         for variant in ("standard", "hattori", "mixed"):
-            cfg = settings.load(CFG, variant=variant, resolution=res, overrides=overrides)
+            cfg = settings.resolved(CFG, variant=variant, resolution=res, overrides=overrides)
             l0 = cfg["resolution.spacing"]
             w0 = time.perf_counter()
             single = solver.solve(load_tank(ROOT / "config" / "tanks" / "single.yaml"), cfg, variant, l0,

@@ -52,7 +52,7 @@ RUNS = {  # name: (isaflow command line or python code, numba threads)
     "sph1d": ("import numpy as np\n"
               "from isaflow.methods.sph1d import pipeline, settings, sweep\n"
               "getattr(pipeline, 'jit', None) and pipeline.jit.use('sph1d')\n"
-              "s = settings.load('config/methods/sph1d.yaml')\n"
+              "s = settings.checked_values('config/methods/sph1d.yaml')\n"
               "s['n'], s['ratios'] = [32, 64], s['ratios'][::25]\n"
               "np.save(OUT + '.npy', sweep.run_sweep(s)['error'].values)\n"
               "open(OUT, 'w').write('done')", 2),

@@ -46,7 +46,7 @@ def before_issue_30(variant=None, resolution=None, overrides=()):
     from isaflow import settings as S
 
     old = S.read(CFG, settings.VALUES)["runs"]["kog_standard_dx5.56"]["set"]
-    return settings.load(CFG, variant, resolution, old).with_overrides(list(overrides))
+    return settings.resolved(CFG, variant, resolution, old).with_overrides(list(overrides))
 
 
 def interior(pos, margin):
@@ -201,7 +201,7 @@ def closed_box_kinetic_energy(gradient, steps=1500, L=50.0, l0=2.5):
     walls = [{"name": "left", "from": [0, L], "to": [0, 0]}, {"name": "floor", "from": [0, 0], "to": [L, 0]},
              {"name": "right", "from": [L, 0], "to": [L, L]}, {"name": "lid", "from": [L, L], "to": [0, L]}]
     tank = Tank("box", {"name": "box", "walls": walls, "liquid": {"weight": 1000.0, "depth": L}}, "")
-    cfg = settings.load(CFG, overrides=[f"model.gradient={gradient}", "model.kinematic_viscosity=0"])
+    cfg = settings.resolved(CFG, overrides=[f"model.gradient={gradient}", "model.kinematic_viscosity=0"])
     fluid = boundary.liquid_block((0.0, L), 0.0, L, l0)
     vel = np.random.default_rng(1).normal(0.0, 1.0, fluid.shape)
     vel -= vel.mean(0)
@@ -342,7 +342,7 @@ def manual_step(l0=5.0, seed=0, dt=1e-3, nu=7.0):
 
     nu = 7 cm^2/s: a viscosity large enough that the viscous term shows in the balance."""
     tank = load_tank(TANK)
-    cfg = settings.load(CFG).with_overrides(**{"model.collision_distance": 0.0})
+    cfg = settings.resolved(CFG).with_overrides(**{"model.collision_distance": 0.0})
     rng = np.random.default_rng(seed)
     fluid = boundary.liquid_block((0.0, 100.0), 0.0, 50.0, l0)
     fluid = fluid + rng.normal(0, 0.05 * l0, fluid.shape)
@@ -463,7 +463,7 @@ def test_compiled_cg_matches_a_direct_solve_and_is_the_same_serial_and_parallel(
 def test_failed_pressure_solve_is_reported_with_its_residual():
     """One CG iteration cannot reach rtol 1e-12: the run stops as solver_failed, naming the residual."""
     tank = load_tank(TANK)
-    cfg = settings.load(CFG).with_overrides(**{"pressure.maxiter": 1, "pressure.rtol": 1e-12})
+    cfg = settings.resolved(CFG).with_overrides(**{"pressure.maxiter": 1, "pressure.rtol": 1e-12})
     r = solver.solve(tank, cfg, "standard", 10.0, 0.01, cfg["probes.single"], threads=1)
     assert r.status == "solver_failed" and "residual" in r.message and r.steps <= 2
 
@@ -539,7 +539,7 @@ def test_no_particle_sees_across_a_thin_wall():
     l0 = COARSE
     left = boundary.liquid_block((100 - 4 * l0, 100.0), 30.0, 4 * l0, l0)
     right = left + [4 * l0, 0.0]
-    s = solver.State(tank, settings.load(CFG), l0, np.concatenate([left, right]), np.zeros((2 * len(left), 2)))
+    s = solver.State(tank, settings.resolved(CFG), l0, np.concatenate([left, right]), np.zeros((2 * len(left), 2)))
     s.neighbours(s.pos)
     d = s.distances(s.pos)
     pairs = {(i, int(s.nbr[k])) for i in range(len(s.pos)) for k in range(s.start[i], s.start[i + 1]) if np.isfinite(d[k])}
@@ -563,7 +563,7 @@ def test_thin_wall_visibility_is_that_of_the_current_positions():
     l0 = COARSE
     left = np.array([[100.0 - 0.6 * l0, 40.0]])
     right = np.array([[100.0 + 0.1 * l0, 40.0]])
-    s = solver.State(tank, settings.load(CFG), l0, np.concatenate([left, right]), np.zeros((2, 2)))
+    s = solver.State(tank, settings.resolved(CFG), l0, np.concatenate([left, right]), np.zeros((2, 2)))
     s.neighbours(s.pos)
     row = slice(s.start[1], s.start[2])
     assert not np.isfinite(s.distances(s.pos)[row][s.nbr[row] == 0]).any()  # across the wall at the build
@@ -633,7 +633,7 @@ def test_below_the_thin_wall_end_the_face_particles_are_seen_only_through_the_wa
     sees that row too (counted twice with the liquid there).  A particle beside the wall sees its face's
     particles either way, and never the other face's."""
     tank = load_tank(FLOWS[1])
-    cfg = settings.load(CFG, overrides=[f"walls.thin_line_of_sight={'true' if line_of_sight else 'false'}"])
+    cfg = settings.resolved(CFG, overrides=[f"walls.thin_line_of_sight={'true' if line_of_sight else 'false'}"])
     l0 = COARSE
     pos = np.array([[100.0 - 0.2 * l0, 20.0 - 0.3 * l0], [100.0 - 0.5 * l0, 40.0]])
     s = solver.State(tank, cfg, l0, pos, np.zeros((2, 2)))
@@ -660,7 +660,7 @@ def drop(tank, wall, side, variant, l0, rows=4):
     row would have reached the wall at that speed, plus as long again.  A splash over a wall's top end is not
     what this tests (the escape box is opened 1 m upwards).  Returns (first bad step (kind, particle, wall) or
     None, final velocities (N, 2) cm/s, outward unit normal of the face)."""
-    cfg = settings.load(CFG)
+    cfg = settings.resolved(CFG)
     walls = tank.walls
     a, b = walls[wall, :2], walls[wall, 2:]
     t = (b - a) / np.hypot(*(b - a))
@@ -707,7 +707,7 @@ def test_drop_test_no_particle_crosses_any_wall(variant):
 @pytest.fixture(scope="module")
 def column_runs():
     tank = load_tank(TANK)
-    cfg = settings.load(CFG).with_overrides(**{"time.average_window": 0.1})
+    cfg = settings.resolved(CFG).with_overrides(**{"time.average_window": 0.1})
     return {v: solver.solve(tank, cfg, v, COARSE, 0.3, cfg["probes.single"], threads=1) for v in VARIANTS}
 
 
@@ -735,7 +735,7 @@ def test_side_wall_load_of_the_column_is_hydrostatic(l0):
     load (7.7 % and 4.8 % at l0 = 5.56 and 3.45 cm; the depth rounded to whole rows, -0.38 % and -0.12 %,
     is inside it)."""
     tank = load_tank(TANK)
-    cfg = settings.load(CFG)
+    cfg = settings.resolved(CFG)
     r = solver.solve(tank, cfg, "standard", l0, 0.3, cfg["probes.single"], threads=1)
     h = r.history
     t = h["hist_time"][1]
@@ -784,7 +784,7 @@ def rest_runs(tmp_path_factory):
     tank = load_tank(TANK)
     out = {}
     for v, res in REST_CASES:
-        cfg = settings.load(CFG, variant=v, resolution=res)
+        cfg = settings.resolved(CFG, variant=v, resolution=res)
         l0 = cfg["resolution.spacing"]
         r = solver.solve(tank, cfg, v, l0, cfg["time.single_time"], cfg["probes.single"], threads=1)
         path = tmp_path_factory.mktemp("rest") / f"{v}_{res}.nc"
@@ -839,7 +839,7 @@ def test_every_flow_runs_without_an_escape():
     particle crossing the dividing wall's line beside its lower end) is recreated step by step in
     test_a_particle_beside_the_thin_wall_end_does_not_change_side_within_a_step; all 12 flows for 8 s (every
     one runs without an escape with the defaults, about 10 minutes): benchmarks/mps_flow_escapes.py."""
-    cfg = settings.load(CFG, variant="hattori", resolution="dx3.45")  # the run's spacing as the settings state it
+    cfg = settings.resolved(CFG, variant="hattori", resolution="dx3.45")  # the run's spacing as the settings state it
     l0 = cfg["resolution.spacing"]
     single = solver.solve(load_tank(TANK), cfg, "hattori", l0, cfg["time.single_time"], cfg["probes.single"], threads=1)
     start = dict(pos=single.pos, vel=single.fields["velocity"][1], steps=single.steps, sim_time=single.sim_time,
@@ -858,7 +858,7 @@ def test_one_and_two_threads_give_the_same_run_bit_for_bit():
     if numba.config.NUMBA_NUM_THREADS < 2:
         pytest.skip("numba has a single thread here")
     tank = load_tank(FLOWS[0])
-    cfg = settings.load(CFG)
+    cfg = settings.resolved(CFG)
     runs = [solver.solve(tank, cfg, "mixed", COARSE, 0.05, cfg["probes.flow"], threads=t) for t in (1, 2)]
     assert [r.params["threads"] for r in runs] == [1, 2]
     a, b = runs
@@ -872,7 +872,7 @@ def test_a_continued_run_matches_the_straight_run():
     clock, positions equal to round-off (1e-9 cm; the continuation builds its own neighbour lists, whose rows
     may list the same neighbours in another order)."""
     tank = load_tank(TANK)
-    cfg = settings.load(CFG)
+    cfg = settings.resolved(CFG)
     probes = cfg["probes.single"]
     dt = solver.time_step(tank, COARSE, cfg["time.courant"])
     n = 30
@@ -894,11 +894,11 @@ def test_bad_settings_name_file_and_field(tmp_path):
     text = CFG.read_text().replace("beta:", "betta:")
     bad.write_text(text)
     with pytest.raises(SceneError, match=r"mps.yaml: field '\(top level\)'|mps.yaml: field 'model'"):
-        settings.load(bad)
+        settings.resolved(bad)
     with pytest.raises(SceneError, match="model.beta"):
-        settings.load(CFG, overrides=["model.beta=1.5"])
+        settings.resolved(CFG, overrides=["model.beta=1.5"])
     with pytest.raises(SceneError, match="no such setting"):
-        settings.load(CFG, overrides=["model.nope=1"])
+        settings.resolved(CFG, overrides=["model.nope=1"])
 
 
 def test_stiff_cases_change_only_their_setting():
@@ -906,12 +906,12 @@ def test_stiff_cases_change_only_their_setting():
     no relaxation, a start on the floor) besides its shorter time limit."""
     from isaflow import settings as S
 
-    cfg = settings.load(CFG)
+    cfg = settings.resolved(CFG)
     runs = S.read(CFG, settings.VALUES)["runs"]
     changed = {}
     for case in ("large_dt", "small_re", "no_relaxation", "on_wall"):
         decl = runs[f"stiff_{case}"]
-        new = settings.load(CFG, decl["variant"], decl["resolution"], decl["set"])
+        new = settings.resolved(CFG, decl["variant"], decl["resolution"], decl["set"])
         changed[case] = sorted(k for k in cfg if new[k] != cfg[k] and k not in ("time.single_time", "resolution.spacing"))
     assert changed == {"large_dt": ["time.courant"], "small_re": ["model.re_density", "model.re_gradient",
                                                                   "model.re_laplacian", "model.re_surface"],

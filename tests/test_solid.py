@@ -16,7 +16,7 @@ from isaflow.methods.solid import claims, lattice, settings, solve, theory
 from isaflow.inputs import InputError as SceneError
 
 CFG_PATH = Path(__file__).parents[1] / "config/methods/solid.yaml"
-CFG = settings.load(CFG_PATH)
+CFG = settings.checked_values(CFG_PATH)
 MAT = C._material(CFG)
 
 
@@ -156,7 +156,7 @@ def test_settings_reject_unknown_key(tmp_path):
     bad = tmp_path / "solid.yaml"
     bad.write_text(CFG_PATH.read_text().replace("  nu: {value: 0.3,", "  nuu: {value: 0.3,"))
     with pytest.raises(SceneError, match=r"solid.yaml: field 'material'"):
-        settings.load(bad)
+        settings.checked_values(bad)
 
 
 def test_claims_table(tmp_path):

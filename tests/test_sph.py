@@ -40,7 +40,7 @@ def _cloud(n=200, seed=3):
     rng = np.random.default_rng(seed)
     x = rng.uniform(0, 20, (n, 2))
     v = rng.normal(0, 30, (n, 2))
-    s = S.resolve(S.load(), "wcsph")
+    s = S.resolve(S.read_file(), "wcsph")
     h = 2.0
     par = solver.pack(s, h, 1e-3, 1e-3 * solver.lattice_density_sum(0, h, 1.5, 1.5), 500.0, 1e-4, 0)
     box = np.array([-1.0, -1.0, 21.0, 21.0])
@@ -348,7 +348,7 @@ def test_settings_reject_unknown_keys(tmp_path):
     bad = tmp_path / "sph.yaml"
     bad.write_text(text)
     with pytest.raises(SceneError, match=r"sph.yaml: field 'settings'"):
-        S.load(bad)
+        S.read_file(bad)
 
 
 # ---- the periodic block (methods.sph.block): the tensile-instability test of marko2017 sections 1-2 ----
@@ -358,7 +358,7 @@ from isaflow.methods.sph import block  # noqa: E402
 
 def _block(**kw):
     """Settings of a periodic n180 block: the wcsph variant with the block's settings (kw overrides)."""
-    s = S.resolve(S.load(), "wcsph")
+    s = S.resolve(S.read_file(), "wcsph")
     s.update(domain="periodic_block", negative_pressure="keep", perturbation=0.0, stretch=0.0, t_max_block=0.05)
     s.update(kw)
     return s

@@ -118,13 +118,13 @@ def test_neighbours_per_side():
 
 
 def test_settings_reject_unknown_keys(tmp_path):
-    good = settings.load("config/methods/sph1d.yaml")
+    good = settings.checked_values("config/methods/sph1d.yaml")
     assert good["ratios"][0] == 0.51 and good["ratios"][-1] == 3.0
     text = open("config/methods/sph1d.yaml").read().replace("classify:", "classify:\n  bogus: {value: 1, source: 'x'}")
     bad = tmp_path / "bad.yaml"
     bad.write_text(text)
     with pytest.raises(SceneError, match=r"bad.yaml: field 'classify'"):
-        settings.load(bad)
+        settings.checked_values(bad)
 
 
 def test_behaviour_classes():

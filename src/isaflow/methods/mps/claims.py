@@ -39,7 +39,7 @@ def _file(path):
 def run_settings(ds):
     """The MPS settings of a run file: its settings file, variant and resolution, and the run's own 'set'
     overrides when its id is declared there (isaflow.settings.Settings)."""
-    cfg = settings.load(_file(ds.attrs["settings_file"]), variant=ds.attrs["variant"],
+    cfg = settings.resolved(_file(ds.attrs["settings_file"]), variant=ds.attrs["variant"],
                         resolution=ds.attrs["resolution"])
     decl = cfg.runs().get(str(ds.attrs.get("run_id", "")), {})
     return cfg.with_overrides(decl.get("set", {}), what="run") if decl.get("set") else cfg

@@ -67,7 +67,7 @@ def warm_up(threads=None):
                                                       {"name": "r", "from": [20, 0], "to": [20, 20]}],
                             "liquid": {"weight": 10.0, "depth": 10.0}}, "")
     for variant in ("standard", "hattori", "mixed"):
-        cfg = S.load(variant=variant, resolution=None, overrides={"resolution.spacing": 2.0})
+        cfg = S.resolved(variant=variant, resolution=None, overrides={"resolution.spacing": 2.0})
         solver.solve(tank, cfg, variant, 2.0, 3e-3, np.array([[10.0, 5.0]]), log=lambda msg: None, threads=threads)
 
 

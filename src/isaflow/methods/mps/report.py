@@ -248,7 +248,7 @@ def write(summary, cfg, outputs):
     """outputs = [report fragment, timing fragment, docs/tables/mps_single.csv] from the summary table and the
     settings file."""
     df = pd.read_csv(summary, keep_default_na=True)
-    cfg_ = settings.load(cfg)
+    cfg_ = settings.resolved(cfg)
     for p in outputs:
         Path(p).parent.mkdir(parents=True, exist_ok=True)
     Path(outputs[0]).write_text(fragment(df, cfg_) + "\n")

@@ -58,6 +58,6 @@ VALUES = {
 }
 
 
-def load(path=DEFAULT_PATH, variant=None, resolution=None, overrides=()):
+def resolved(path=DEFAULT_PATH, variant=None, resolution=None, overrides=()):
     """Resolved settings (isaflow.settings.Settings, 'group.key' -> value); InputError naming file and field."""
     return S.load(path, VALUES, variant, resolution, overrides, what="MPS settings")

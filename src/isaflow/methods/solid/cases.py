@@ -1,7 +1,7 @@
 """The section-4 cases of marko2017 as solid runs: bar (tension, compression), shear, Hertz.
 
 Each ``run_<case>(cfg, variant)`` builds the particles from the settings
-(settings.load), relaxes them to rest and returns a contract.Result whose
+(settings.checked_values), relaxes them to rest and returns a contract.Result whose
 history holds the case's measured numbers (SI-free: cm, N, s; stresses N/cm^2).
 """
 

@@ -1,6 +1,6 @@
 """What makes the solid method's settings plausible, and what its cases will cost (pure Python).
 
-The checks of every method (isaflow.preflight.check; settings.load calls it, so
+The checks of every method (isaflow.preflight.check; settings.checked_values calls it, so
 every run and the workflow while it is parsed): :func:`plausible` refuses
 materials no solid has, a tolerance below double-precision round-off, a Hertz
 disk pressed through its plate, a vessel time step over the lattice's step

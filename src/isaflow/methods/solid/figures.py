@@ -42,7 +42,7 @@ def _slice(ds, scale):
 
 def bar_figure(config_path, runs, outputs, variant="hooke"):
     """Fig. 1 analogue: bar unloaded, in tension, in compression, and the shear block; middle z layer."""
-    cfg = settings.load(config_path)
+    cfg = settings.checked_values(config_path)
     scale = cfg["bar"]["exaggeration"]
     runs = read_runs(runs)
     fig, axes = plt.subplots(1, 4, figsize=(10, 4.6), sharey=True, gridspec_kw={"width_ratios": [1, 1, 1, 2.2]})
@@ -73,7 +73,7 @@ def bar_figure(config_path, runs, outputs, variant="hooke"):
 
 def hertz_figure(config_path, runs, outputs):
     """Fig. 3 analogue: (a) load per unit thickness and (b) peak contact pressure against indentation."""
-    cfg = settings.load(config_path)
+    cfg = settings.checked_values(config_path)
     hz = cfg["hertz"]
     E, nu = cfg["material"]["E_GPa"] * 1e9, cfg["material"]["nu"]
     Er, R = T.reduced_modulus(E, nu), hz["radius_mm"] * 1e-3
@@ -102,7 +102,7 @@ def vessel_figure(config_path, runs, outputs):
     """Fig. 7 analogue: (a) the ring's inner-wall radial displacement against time (undamped, from rest)
     per variant, the settled value, Lame's and the paper's 58.7 us; (b) the SPH water's mean pressure
     (variant water_particles); (c) the settled ring (pressure_load)."""
-    cfg = settings.load(config_path)
+    cfg = settings.checked_values(config_path)
     vs = {var: d for (case, var), d in read_runs(runs).items() if case == "vessel"}
     fig, (a, b, c) = plt.subplots(1, 3, figsize=(13, 4.4), gridspec_kw={"width_ratios": [1.6, 1.1, 1]})
     one = lambda ds, k: float(ds[k].values.ravel()[0])  # noqa: E731

@@ -69,7 +69,7 @@ def write_run(config_path, case, variant, out, loads=None):
     """Run one case/variant from the settings file and write its run file to out."""
     jit.use("solid")  # this process's kernels: the solid's cache generation (core.jit)
     log = logging.getLogger("isaflow.solid")
-    cfg = settings.load(config_path)
+    cfg = settings.checked_values(config_path)
     solve.warmup()
     started, t0 = runfile.now(), time.perf_counter()
     r = cases.run_case(cfg, case, variant, loads=loads)

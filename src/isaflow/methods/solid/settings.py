@@ -42,17 +42,12 @@ SECTIONS = {
 VALUES = {f"{sec}.{k}": v for sec, fields in SECTIONS.items() for k, v in fields.items()}
 
 
-def load(path):
+def checked_values(path):
     """{section: {key: value}} of a settings file, values as written (sources dropped); plausibility and the
     cost of every case checked (isaflow.preflight)."""
     s = S.load(path, VALUES, what="solid settings")
     preflight.check("solid", None, s)
     return s.tree()
-
-
-def load_with_sources(path):
-    """The validated file as written: {section: {key: {value, source}}}."""
-    return S.read(path, VALUES, "solid settings")
 
 
 def material_units(mat):
@@ -65,7 +60,7 @@ def claim_run_ids(config_path):
     every hertz.scale_radii_mm disk, eqs. 26-27 stepping (paper, hooke) and eq. 27 alone, the bar in sustained
     tension at every bar_long strain x step (the kept pair named bar_tension_long), the vessel with water under
     the printed solid model, with the project's coupling and with the paper's (stop at the boundary)."""
-    c = load(config_path)
+    c = checked_values(config_path)
     radii = [f"{r:g}mm" if r < 1000 else f"{r / 1000:g}m" for r in c["hertz"]["scale_radii_mm"]]
     lg = c["bar_long"]
     sweep = [f"bar_tension_long_e{100 * e:g}_dt{d:g}_paper" for e in lg["strain_sweep"] for d in lg["dt_sweep"]

@@ -47,7 +47,7 @@ VALUES = {**{f"settings.{k}": v for k, v in SETTINGS.items()},
           "resolution.on_wall": {"type": "boolean"}}
 
 
-def load(path=DEFAULT_PATH):
+def read_file(path=DEFAULT_PATH):
     """The validated settings file as written (InputError naming the file and the field)."""
     return S.read(path, VALUES, "SPH settings")
 

@@ -155,7 +155,7 @@ def warm_up(threads=1):
                                                       {"name": "r", "from": [4, 0], "to": [4, 4]}],
                             "liquid": {"weight": 1.0, "depth": 2.0}}, "")
     for variant in ("summation", "continuity"):
-        s = S.resolve(S.load(), "wcsph")
+        s = S.resolve(S.read_file(), "wcsph")
         s.update(density=variant, chunk_time=0.001)
         _run(tank, s, {"spacing": 1.0}, None, False, 0.002, lambda *a: None, threads)
 
@@ -173,7 +173,7 @@ def solve(tank, variant="wcsph", resolution=None, overrides=None, start=None, on
     vessels); threads: numba threads of the pair passes (results do not depend
     on it; recorded in params['threads']).
     """
-    s = S.resolve(S.load(settings_path), variant, overrides, settings_path)
+    s = S.resolve(S.read_file(settings_path), variant, overrides, settings_path)
     res = _run(tank, s, resolution or {"particles": 180}, start, on_wall, t_max, log, set_threads(threads))
     res.variant = variant
     return res

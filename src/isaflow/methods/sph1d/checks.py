@@ -1,6 +1,6 @@
 """What makes the 1D truncated-SPH sweep plausible, and what it will cost (pure Python).
 
-The checks of every method (isaflow.preflight.check; settings.load calls it, so
+The checks of every method (isaflow.preflight.check; settings.checked_values calls it, so
 every run and the workflow while it is parsed): :func:`plausible` refuses a
 sweep without a reading (variant) to solve, a ratio range h/dx that is empty or
 outside what the sweep can mean (up to 10: 20 neighbours per side), too few N

@@ -32,7 +32,7 @@ def run_sweep(settings_path, outputs, resolution=None):
     jit.use("sph1d")  # this process's kernels: the 1D method's cache generation (core.jit)
     handler = _logging()
     try:
-        s = settings.load(settings_path, resolution)
+        s = settings.checked_values(settings_path, resolution)
         started = runfile.now()
         ds = sweep.run_sweep(s)
         ds.attrs.update(started=started, finished=runfile.now(),
@@ -69,7 +69,7 @@ def make_figures(settings_path, sweep_nc, cases_csv, outputs, surface_nc=None, r
     out = {name: outputs[2 * k:2 * k + 2] for k, name in enumerate(FIGURES)}
     handler = _logging()
     try:
-        s = settings.load(settings_path)
+        s = settings.checked_values(settings_path)
         default = list(s["variants"])[0]
         figures.error_vs_n(sweep_nc, cases_csv, default, out["error_vs_n"])
         figures.maps(sweep_nc, cases_csv, default, out["maps"])
@@ -92,7 +92,7 @@ def make_report(settings_path, sweep_nc, cases_csv, summary_csv, registry, outpu
     fragment_md, timing_md = outputs
     handler = _logging()
     try:
-        s = settings.load(settings_path)
+        s = settings.checked_values(settings_path)
         cases, summary = pd.read_csv(cases_csv), pd.read_csv(summary_csv)
         variants = list(s["variants"])
         band, round_off = claims.rule_of_file(registry)

@@ -27,7 +27,7 @@ VALUES = {
 }
 
 
-def load(path, resolution=None):
+def checked_values(path, resolution=None):
     """{name: value} of a settings file (with its ``resolutions`` entry ``resolution`` applied, e.g. the longer
     N range of the sweep to N = 8192), checked (isaflow.preflight: the defaults and every resolution); adds
     'variants' ({name: {gradient, floor}}), 'ratios' (array of h/dx), 'path' and 'resolution'."""

@@ -26,7 +26,7 @@ PROGRESS_S = 20.0  # a progress line at least this often
 
 
 def run_sweep(s):
-    """Solve every case of settings s (settings.load); Dataset with units on every variable."""
+    """Solve every case of settings s (settings.checked_values); Dataset with units on every variable."""
     variants, kernels, ratios, ns = list(s["variants"]), s["kernels"], s["ratios"], s["n"]
     height, rho_g, gap = s["column"]["height"], s["column"]["rho_g"], float(s["surface"])
     err = np.full((len(variants), len(kernels), len(ratios), len(ns)), np.nan)
