@@ -222,7 +222,6 @@ def test_the_speed_targets_are_judged_from_the_settings_file(tmp_path):
                                             "table1.csv", "table1.md")}
     pd.DataFrame({"impl": ["numba"] * 3 + ["numpy"] * 3, "N": [10_000, 100_000, 1_000_000] * 2,
                   "ns_per_particle_step": [18.0, 19.0, 19.5, 900.0, 950.0, 990.0]}).to_csv(f["step.csv"], index=False)
-    pd.DataFrame({"first_call_s": [20.0, 0.1], "cache_hits": [0, 12]}).to_csv(f["compile.csv"], index=False)
     pd.DataFrame({"total_bytes_per_particle": [140.0]}).to_csv(f["memory.csv"], index=False)
     f["machine.txt"].write_text("test machine\n")
     pd.DataFrame({"setting": ["lean", "full"], "solver_s": [1.0, 1.1], "file_bytes": [1e5, 1e6]}).to_csv(

@@ -50,11 +50,15 @@ def run_resources(members):
     return {"mem_mb": max(r["mem_mb"] for r in res), "runtime": sum(r["runtime"] for r in res)}
 
 
+def workflow_schema(schema):
+    """A schema of workflow/schemas/ (a mapping), read by the hardened reader."""
+    return _inputs.read_yaml(os.path.join(workflow.basedir, "workflow", "schemas", schema), "schema")[1]
+
+
 def read_config(path, schema):
     """A configuration file read by the hardened reader and checked against a schema (workflow/schemas/)."""
     try:
-        _, schema_spec = _inputs.read_yaml(os.path.join(workflow.basedir, "workflow", "schemas", schema), "schema")
-        return _inputs.load(path, schema_spec, "workflow configuration")[1]
+        return _inputs.load(path, workflow_schema(schema), "workflow configuration")[1]
     except _inputs.InputError as err:
         refuse(err)
 
@@ -65,8 +69,7 @@ def read_sourced(path, schema, leaves):
     from isaflow import settings as _settings
 
     try:
-        _, schema_spec = _inputs.read_yaml(os.path.join(workflow.basedir, "workflow", "schemas", schema), "schema")
-        return _settings.read_values(path, _settings.values_of(schema_spec, leaves), "workflow settings")
+        return _settings.read_values(path, _settings.values_of(workflow_schema(schema), leaves), "workflow settings")
     except _inputs.InputError as err:
         refuse(err)
 

@@ -3,7 +3,7 @@
 # through the shared rule `run`; here the summary, figures, report fragment 55 and timing fragment (the claims:
 # claims.smk, measures in methods/mps/claims.py).
 # Package: src/isaflow/methods/mps/.
-_MPS_RUNS = settings_runs("mps")
+_MPS_RUNS = RUNS["mps"]  # its settings file's runs (common.smk)
 MPS_FILES = [run_file("mps", r) for r in _MPS_RUNS]
 MPS_SINGLE = [run_file("mps", r) for r in _MPS_RUNS if r.startswith("single_")]
 MPS_BEFORE = [run_file("mps", r) for r in _MPS_RUNS if r.startswith("kog_")]  # the settings before issue 30

@@ -1,7 +1,7 @@
 # Weakly compressible SPH (marko2017 section 2, completed): its runs (config/methods/sph.yaml runs: the
 # single vessel, both flow tanks, stability cases) go through the shared rule `run`; here the summary,
 # figures, claims, report fragment 50 and timing fragment.  Package: src/isaflow/methods/sph/.
-_SPH_RUNS = settings_runs("sph")
+_SPH_RUNS = RUNS["sph"]  # its settings file's runs (common.smk)
 # the periodic blocks (tensile-instability test, settings.domain periodic_block) load no wall: claims only
 _SPH_BLOCKS = [r for r, d in _SPH_RUNS.items()
                if d.get("set", {}).get("settings.domain", {}).get("value") == "periodic_block"]
