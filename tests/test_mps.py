@@ -460,6 +460,25 @@ def test_compiled_cg_matches_a_direct_solve_and_is_the_same_serial_and_parallel(
     assert np.abs(x1 - x_lu).max() < 1e-6 * np.abs(x_lu).max()
 
 
+def test_compiled_matvec_sums_each_row_in_row_order():
+    """The compiled CSR product (unsigned indices, so no wraparound test) gives, bit for bit, each row's sum
+    taken in row order in plain Python floats: the arithmetic the CG's results depend on."""
+    rng = np.random.default_rng(3)
+    n = 300
+    indptr = np.concatenate([[0], np.cumsum(rng.integers(1, 12, n))]).astype(np.int64)
+    indices = rng.integers(0, n, indptr[-1]).astype(np.int32)
+    data, x = rng.normal(size=indptr[-1]), rng.normal(size=n)
+    out = np.empty(n)
+    pressure._matvec_serial(indptr, indices, data, x, out)
+    ref = []
+    for r in range(n):
+        s = 0.0
+        for k in range(indptr[r], indptr[r + 1]):
+            s += float(data[k]) * float(x[indices[k]])
+        ref.append(s)
+    assert np.array_equal(out, np.array(ref))
+
+
 def test_failed_pressure_solve_is_reported_with_its_residual():
     """One CG iteration cannot reach rtol 1e-12: the run stops as solver_failed, naming the residual."""
     tank = load_tank(TANK)
