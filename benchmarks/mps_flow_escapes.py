@@ -27,8 +27,8 @@ FLOW_TIME = 8.0  # s
 
 def side_loads(r):
     h = r.history
-    t = h["hist_time"][1]
-    F = np.hypot(*np.moveaxis(h["hist_panel_force"][1], -1, 0))
+    t = h["sample_time"][1]
+    F = np.hypot(*np.moveaxis(h["sample_panel_force"][1], -1, 0))
     on = (t >= 0.1) & (t <= 0.3)
     early = np.mean([F[on][:, r.contact_wall == w].sum(1).mean() for w in (0, 2)])
     late = np.mean([np.hypot(*r.contact_force[r.contact_wall == w].T).sum() for w in (0, 2)])
@@ -69,7 +69,7 @@ def main(args):
                 rows.append(dict(run=f"{name}_{variant}_{res}", status=r.status, t_end_s=r.sim_time - single.sim_time,
                                  reflected=r.params["reflected_particles"], reflect_steps=r.params["reflect_steps"],
                                  graze_steps=r.params["graze_steps"], deepest_graze_cm=r.params["deepest_graze_cm"],
-                                 max_speed_cm_s=float(np.max(r.history["hist_max_speed"][1])),
+                                 max_speed_cm_s=float(np.max(r.history["sample_max_speed"][1])),
                                  ms_per_step=1e3 * (time.perf_counter() - w0) / max(1, steps),
                                  message=r.message))
                 print(rows[-1], flush=True)

@@ -163,3 +163,24 @@ def test_changing_a_shared_module_reruns_every_dependent_figure(tmp_path):
     os.utime(tmp_path / "src" / "isaflow" / "metrics.py", (new + 20, new + 20))
     after = jobs(dry())
     assert "run" not in after and {"compare_table", "isa_fig_single"} <= set(after)
+
+
+def test_history_names_say_their_dimension_and_shared_quantities_have_one_name():
+    """contract.history_problems: a hist_ / sample_ / snap_ variable whose first dimension is not record / sample /
+    snapshot, or a shared quantity (contract.SHARED_HISTORY) with other dims or units, is refused when a run file is
+    written; no method source still writes the names the methods used before they were unified."""
+    import numpy as np
+
+    from isaflow import contract
+
+    ok = {"sample_time": (("sample",), np.zeros(3), "s", "t"), "hist_fmax": (("record",), np.zeros(2), "N", "f"),
+          "snap_pos": (("snapshot", "particle", "xy"), np.zeros((1, 2, 2)), "cm", "x")}
+    assert contract.history_problems(ok) == []
+    assert contract.history_problems({"hist_time": (("sample",), np.zeros(3), "s", "t")})  # prefix vs dims
+    assert contract.history_problems({"sample_time": (("sample",), np.zeros(3), "ms", "t")})  # shared units
+    assert contract.history_problems({"sample_vessel_count": (("sample",), np.zeros(3), "1", "n")})  # shared dims
+    old = re.compile(r"\b(hist_(time|vessel_count|wall_resultant|rms_speed|energy_ratio)|sample_vrms|"
+                     r"sample_vessel_weight)\b")
+    hits = [f"{p.relative_to(ROOT)}:{k + 1}" for p in SRC.rglob("*.py")
+            for k, line in enumerate(p.read_text().splitlines()) if old.search(line)]
+    assert hits == []

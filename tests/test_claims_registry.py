@@ -372,3 +372,31 @@ def test_every_figure_that_carries_a_claim_is_tracked_and_viewed():
         if spec["claims"]:
             assert not any(name.startswith(i) for i in ignored), f"{name} carries claims but is git-ignored"
             assert "viewed" in spec, f"{name} carries claims but was never viewed"
+
+
+def test_a_measure_reads_only_the_runs_its_row_declares(tmp_path):
+    """judge hands each measure a view of its row's declared runs (runs, controls, its deviation's and its inferred
+    inputs' runs: claims_registry.declared_runs): a declared run reads; any other key, present or not, stops the
+    job (claims.Undeclared names the claim and the key) instead of becoming a verdict."""
+    from isaflow import claims
+
+    row = {"id": "x-1", "paper": "p", "section": "1", "kind": "method result", "testable": True,
+           "runs": [{"id": "isa:a"}], "controls": [{"id": "isa:c"}], "inferred_inputs": ["i"],
+           "tolerance": {"test": "t", "source": "s"}}
+    inputs = {"i": {"id": "i", "runs": [{"id": "isa:b"}]}}
+    assert reg.declared_runs(row, inputs) == {"isa:a", "isa:b", "isa:c"}
+    ctx = claims.Context({"isa:a": "a.nc", "isa:b": "b.nc", "isa:z": "z.nc"})
+    seen = {}
+
+    def reads(key):
+        def measure(view, entry):
+            seen[key] = sorted(view.paths)
+            view.has(key)
+            return claims.Measurement("read", True)
+        return {"x-1": measure}
+
+    df = claims.judge(ctx, [row], inputs, found=reads("isa:b"))
+    assert df["measured"].tolist() == ["read"] and seen["isa:b"] == ["isa:a", "isa:b"]
+    for key in ("isa:z", "isa:nowhere"):
+        with pytest.raises(claims.Undeclared, match=f"claim 'x-1' reads '{key}'"):
+            claims.judge(ctx, [row], inputs, found=reads(key))

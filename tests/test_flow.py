@@ -32,7 +32,7 @@ def chain(tmp_path_factory):
 def test_every_particle_is_in_one_vessel_at_every_recorded_step(chain):
     for key in ("app3", "app4", "app4c"):
         ds = chain[key]
-        counts = ds["hist_vessel_count"].values
+        counts = ds["sample_vessel_count"].values
         assert counts.shape[0] >= 10
         assert (counts.sum(1) == 180).all()
         assert metrics.flow_measures(ds)["mass_conserved"]

@@ -738,7 +738,7 @@ def test_time_averaged_pressure_of_a_column_is_hydrostatic(column_runs, variant)
     r = column_runs[variant]
     h = r.history
     win = h["in_window"][1].astype(bool)
-    mean = h["hist_probe_pressure"][1][win].mean(0)
+    mean = h["sample_probe_pressure"][1][win].mean(0)
     probes = h["probe_point"][1]
     rho_g = r.params["rho0_N_s2_cm4"] * units.G
     y_s = r.pos0[:, 1].max()
@@ -757,8 +757,8 @@ def test_side_wall_load_of_the_column_is_hydrostatic(l0):
     cfg = settings.resolved(CFG)
     r = solver.solve(tank, cfg, "standard", l0, 0.3, cfg["probes.single"], threads=1)
     h = r.history
-    t = h["hist_time"][1]
-    F = np.hypot(*np.moveaxis(h["hist_panel_force"][1], -1, 0))
+    t = h["sample_time"][1]
+    F = np.hypot(*np.moveaxis(h["sample_panel_force"][1], -1, 0))
     on = (t >= 0.1) & (t <= 0.3)
     side = np.mean([F[on][:, r.contact_wall == w].sum(1).mean() for w in (0, 2)])
     assert abs(side / 3262.5 - 1) < l0 / tank.depth
@@ -773,7 +773,7 @@ def test_mass_momentum_and_recorded_variant(column_runs, tmp_path):
     for v, r in column_runs.items():
         assert r.weight.sum() == pytest.approx(tank.weight, rel=1e-12)
         assert r.status in ("converged", "step_limit")
-        assert r.history["hist_vessel_count"][1][:, 0].min() == len(r.pos)
+        assert r.history["sample_vessel_count"][1][:, 0].min() == len(r.pos)
         ds = runfile.to_dataset(r, tank, {"command": "test"}, runfile.now(), runfile.now(), COARSE)
         runfile.write(ds, tmp_path / f"{v}.nc")
         back = runfile.read(tmp_path / f"{v}.nc")

@@ -64,16 +64,32 @@ class Context:
     """Run outputs a measure reads: run files by '<method>:<run id>' and tables by path, each read once.
 
     runs: {'<method>:<run id>': path}; tables: {name: path}.  A missing run raises Missing (the claim is
-    then 'not testable here', naming the run).
+    then 'not testable here', naming the run).  :meth:`only` gives the view a registry row's measure reads
+    through: its declared runs, any other key raises Undeclared.
     """
 
     def __init__(self, runs=None, tables=None):
         self.paths = dict(runs or {})
         self.table_paths = dict(tables or {})
         self._cache = {}
+        self.allowed = None  # None: every key; else the keys a view may read
+
+    def only(self, keys, claim=""):
+        """A view of the same files and cache that reads only keys (a registry row's declared runs): paths holds
+        only those, and run, group or has of any other key raises Undeclared naming the claim."""
+        view = Context(tables=self.table_paths)
+        view.allowed, view.claim, view._cache = frozenset(keys), claim, self._cache
+        view.paths = {k: p for k, p in self.paths.items() if k in view.allowed}
+        return view
+
+    def _check(self, key):
+        if self.allowed is not None and key not in self.allowed:
+            raise Undeclared(f"claim '{getattr(self, 'claim', '')}' reads '{key}', which its registry row does not "
+                             "declare (its runs, its deviation's runs or an inferred input's runs)")
 
     def run(self, key):
         """The run file of '<method>:<run id>' (xarray Dataset)."""
+        self._check(key)
         if key not in self._cache:
             path = self.paths.get(key)
             if not isinstance(path, str) or not Path(path).is_file():
@@ -83,6 +99,7 @@ class Context:
 
     def group(self, key):
         """{run id: Dataset} of a group of runs '<method>:<group>' (e.g. a study's error-against-run-time runs)."""
+        self._check(key)
         paths = self.paths.get(key)
         if not isinstance(paths, (list, tuple)) or not all(Path(p).is_file() for p in paths):
             raise Missing(key)
@@ -94,6 +111,7 @@ class Context:
         return self._cache[path]
 
     def has(self, key):
+        self._check(key)
         path = self.paths.get(key)
         return isinstance(path, str) and Path(path).is_file()
 
@@ -108,6 +126,11 @@ class Context:
 
 class Missing(KeyError):
     """A run or table a measure needs does not exist."""
+
+
+class Undeclared(Exception):
+    """A measure read a run its registry row does not declare: a defect of the measure or of the row, never a
+    verdict (judge lets it stop the claims job)."""
 
 
 def measures():
@@ -220,6 +243,7 @@ def judge(ctx, claims=None, inputs=None, found=None):
     if inputs is None:
         inputs = {i["id"]: i for lst in claims_registry.inputs().values() for i in lst}
     found = measures() if found is None else found
+    by_id = {e["id"]: e for e in claims}
     rows = []
     for e in claims:
         m = None
@@ -229,7 +253,7 @@ def judge(ctx, claims=None, inputs=None, found=None):
             m = Measurement("no measure implemented for this claim", None)
         else:
             try:
-                m = found[e["id"]](ctx, e)
+                m = found[e["id"]](ctx.only(claims_registry.declared_runs(e, inputs, by_id), e["id"]), e)
             except Missing as err:
                 m = Measurement(f"needs {err.args[0]}, which this workflow did not make", None)
         rob, flips, rob_ev = robustness(e, m, inputs)

@@ -79,7 +79,7 @@ TANK_METHOD = "{tank_method}"
 
 
 def _expand_runs(spec, path):
-    """Every ``runs`` list of a registry file in place: '{tank_method}' entries become one per tank method
+    """Every ``runs`` and ``controls`` list of a registry file in place: '{tank_method}' entries become one per tank method
     (registry order); a run naming no registered method is refused (InputError naming the file and entry)."""
     methods = registry()
     tank = [name for name, m in methods.items() if m.tank]
@@ -87,16 +87,17 @@ def _expand_runs(spec, path):
         (f"claims.{k}", c) for k, c in enumerate(spec.get("claims", []))] + [
         (f"claims.{k}.deviation", c["deviation"]) for k, c in enumerate(spec.get("claims", [])) if "deviation" in c]
     for where, node in entries:
-        if "runs" not in node:
-            continue
-        runs = []
-        for r in node["runs"]:
-            method = r["id"].split(":", 1)[0]
-            if method not in methods:
-                raise InputError(f"{path}: {where}.runs: '{r['id']}' names no registered method "
-                                 f"(choose from {', '.join(methods)})")
-            runs += [dict(r, id=r["id"].replace(TANK_METHOD, m)) for m in tank] if TANK_METHOD in r["id"] else [r]
-        node["runs"] = runs
+        for field in ("runs", "controls"):
+            if field not in node:
+                continue
+            runs = []
+            for r in node[field]:
+                method = r["id"].split(":", 1)[0]
+                if method not in methods:
+                    raise InputError(f"{path}: {where}.{field}: '{r['id']}' names no registered method "
+                                     f"(choose from {', '.join(methods)})")
+                runs += [dict(r, id=r["id"].replace(TANK_METHOD, m)) for m in tank] if TANK_METHOD in r["id"] else [r]
+            node[field] = runs
 
 
 def _check_file(paper, spec, ids):
@@ -203,6 +204,20 @@ def roots(claims):
     for k in deps:
         walk(k)
     return out
+
+
+def declared_runs(entry, inputs, entries=None):
+    """The run keys ('<method>:<run id>' or a group '<method>:<group>') a claim's measure may read: its runs and
+    controls, its deviation's runs and the runs of each of its inferred inputs (inputs: {input id: input}); with
+    entries ({claim id: entry}), also those of the rows it depends on (an aggregate measures through theirs)."""
+    keys = {r["id"] for r in entry.get("runs", []) + entry.get("controls", [])}
+    keys |= {r["id"] for r in entry.get("deviation", {}).get("runs", [])}
+    for name in entry.get("inferred_inputs", []):
+        keys |= {r["id"] for r in inputs.get(name, {}).get("runs", [])}
+    for dep in entry.get("depends_on", []) if entries else []:
+        if dep in entries and dep != entry["id"]:
+            keys |= declared_runs(entries[dep], inputs, {k: e for k, e in entries.items() if k != entry["id"]})
+    return keys
 
 
 def inputs(directory=DEFAULT_DIRECTORY):

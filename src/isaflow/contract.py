@@ -37,14 +37,40 @@ import numpy as np
 from .settings import OUTCOMES  # noqa: E402,F401 (the shared outcome list, defined with the accept vocabulary)
 
 
+# History names (every method): a variable's prefix names its first dimension, and a quantity more than one method
+# records has one name, dimensions and units (checked when a run file is written: history_problems)
+PREFIX_DIM = {"hist_": "record", "sample_": "sample", "snap_": "snapshot"}
+SHARED_HISTORY = {  # name -> (dims, units)
+    "sample_time": (("sample",), "s"),  # time of the sample on the chain's clock (dynamic methods)
+    "sample_step": (("sample",), "1"),  # step of the sample, counted from the start of the chain
+    "sample_vessel_count": (("sample", "vessel"), "1"),  # liquid particles in each vessel
+    "sample_wall_resultant": (("sample", "wall", "xy"), "N"),  # force of each wall on the liquid
+    "sample_rms_speed": (("sample",), "cm s-1"),
+    "sample_kinetic": (("sample",), "N cm"),
+}
+
+
+def history_problems(history):
+    """The ways a Result.history breaks the naming rule above: [] when it keeps it."""
+    bad = []
+    for name, (dims, _, units, *_rest) in history.items():
+        want = next((d for p, d in PREFIX_DIM.items() if name.startswith(p)), None)
+        if want is not None and (not dims or dims[0] != want):
+            bad.append(f"{name}: dims {dims}, its prefix says '{want}' first")
+        if name in SHARED_HISTORY and (tuple(dims), units) != SHARED_HISTORY[name]:
+            bad.append(f"{name}: dims {tuple(dims)} units '{units}', shared as {SHARED_HISTORY[name]}")
+    return bad
+
+
 @dataclass
 class Result:
     """Outcome of one run of any method (arrays in cm, N, s).
 
     history / fields map a run-file variable name to (dims, array, units,
-    long_name[, attrs]); history dims are ("record",) (per record) or
-    ("sample", ...) (per diagnostic sample), fields dims start with
-    "particle".  A run file holds no NaN: a variable whose values may be
+    long_name[, attrs]); history names start with hist_ (dims ("record",), per
+    record), sample_ (("sample", ...), per diagnostic sample) or snap_
+    (("snapshot", ...)), the quantities of SHARED_HISTORY under their shared
+    names; fields dims start with "particle".  A run file holds no NaN: a variable whose values may be
     missing says why in attrs {"missing": "..."} (runfile.finite).
     """
 

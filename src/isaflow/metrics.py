@@ -217,8 +217,8 @@ def flow_measures(ds):
     x0, x1 = ds["vessel_x"].sel(vessel=names[0]).values
     out["first_width_cm"] = float(x1 - x0)
     out["sum_fx_N"] = float(ds["wall_resultant"].sel(xy="x").sum())
-    if "hist_vessel_count" in ds:
-        out["mass_conserved"] = bool((ds["hist_vessel_count"].sum("vessel") == ds.sizes["particle"]).all())
+    if "sample_vessel_count" in ds:
+        out["mass_conserved"] = bool((ds["sample_vessel_count"].sum("vessel") == ds.sizes["particle"]).all())
     return out
 
 

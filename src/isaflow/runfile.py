@@ -110,6 +110,9 @@ def to_dataset(result, tank, prov, started, finished, spacing=None, references="
     width), default result.spacing; references: the papers the method follows.
     """
     r = result
+    bad = contract.history_problems(r.history)
+    if bad:
+        raise ValueError(f"{r.method} run history breaks the naming rule (isaflow.contract): {'; '.join(bad)}")
     spacing = r.spacing if spacing is None else spacing
     walls = tank.walls
     vessels = tank.spec.get("vessels", [])

@@ -1403,7 +1403,7 @@ def sph_needs_technique(view, e):
 def _mps_noise(ds, window=None):
     """(high-frequency noise std/mean of the side-wall panel loads over the final window after removing a linear
     trend, effective sample count); (inf, 0) for a run that escaped before its window."""
-    t = ds["hist_time"].values
+    t = ds["sample_time"].values
     win = ds["in_window"].values.astype(bool)
     if window is not None:
         win = t >= t[-1] - window + 1e-12
@@ -1411,7 +1411,7 @@ def _mps_noise(ds, window=None):
         return float("inf"), 0
     walls = ds["wall_segment"].values
     side = np.isclose(walls[ds["contact_wall"].values, 0], walls[ds["contact_wall"].values, 2])
-    mag = np.hypot(*np.moveaxis(ds["hist_panel_force"].values[win][:, side], -1, 0))
+    mag = np.hypot(*np.moveaxis(ds["sample_panel_force"].values[win][:, side], -1, 0))
     tt = t[win]
     mean = mag.mean(0)
     wet = mean > 0.01 * mean.max()

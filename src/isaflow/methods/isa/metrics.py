@@ -195,11 +195,11 @@ def transfer_curve(chain):
     """(t, f) of a flow: time since the opening (s; an ISA update's steps, counted as 1 s each, for the static
     update rules) and the fraction of the particles in the receiving vessel, from the vessel counts recorded at
     chunk ends.  chain: the run Datasets of one flow in order (an ISA chain: application 3, then 4); the first
-    one's start is the opening.  A liquid run (SPH: sampled vessel weights) is read from its samples."""
+    one's start is the opening.  A liquid run (SPH, MPS: samples in time) is read from its samples."""
     ds = chain[0]
-    if "sample_vessel_weight" in ds:
+    if "sample_time" in ds:
         t = ds["sample_time"].values - float(ds.attrs.get("start_time", 0.0))
-        f = ds["sample_vessel_weight"].values[:, -1] / float(ds["weight"].values.sum())
+        f = ds["sample_vessel_count"].values[:, -1] / ds.sizes["particle"]
         return np.concatenate([[0.0], t]), np.concatenate([[f[0]], f])
     ts, fs = [0.0], []
     t0 = int(ds["start_step"])
@@ -209,7 +209,7 @@ def transfer_curve(chain):
     for d in chain:
         dt = float(d.attrs["dt"]) if d.attrs.get("variant") == "overdamped" else 1.0
         ts += list((d["sample_step"].values - t0) * dt)
-        fs += list(d["hist_vessel_count"].values[:, -1] / d.sizes["particle"])
+        fs += list(d["sample_vessel_count"].values[:, -1] / d.sizes["particle"])
     return np.array(ts, float), np.array(fs, float)
 
 

@@ -177,7 +177,7 @@ class _History:
         self.n_snap = hist.get("snapshots", 0)
         self.n_walls = n_walls
         self.rec = {k: [] for k in ("hist_step", "hist_fmax", "hist_fmax_lo", "hist_fmax_hi", "hist_energy",
-                                    "sample_step", "hist_wall_resultant", "hist_vessel_count", "snap_step", "snap_pos")}
+                                    "sample_step", "sample_wall_resultant", "sample_vessel_count", "snap_step", "snap_pos")}
 
     def steps(self, step, h, origin, ke=None):
         """Record h (max|F| before steps step, step + 1, ...) in strides counted from step origin <= step;
@@ -194,9 +194,9 @@ class _History:
     def chunk(self, step, pos, s, walls, snap):
         if self.walls:
             part, wall, point, force = contacts(pos, walls, s)
-            self.rec["hist_wall_resultant"].append(wall_resultants(wall, force, self.n_walls))
+            self.rec["sample_wall_resultant"].append(wall_resultants(wall, force, self.n_walls))
         if self.vessels is not None:
-            self.rec["hist_vessel_count"].append(vessel_counts(pos, self.vessels))
+            self.rec["sample_vessel_count"].append(vessel_counts(pos, self.vessels))
         if self.walls or self.vessels is not None:
             self.rec["sample_step"].append(step)
         if snap:
@@ -213,14 +213,14 @@ class _History:
             "hist_fmax_hi": (("record",), float, "N", "largest max|F| over the record stride"),
             "hist_energy": (("record",), float, "N cm", "kinetic energy at hist_step (overdamped variant)"),
             "sample_step": (("sample",), np.int64, "1", "algorithm step of diagnostic sample"),
-            "hist_wall_resultant": (("sample", "wall", "xy"), float, "N", "resultant force of wall on liquid over the run"),
-            "hist_vessel_count": (("sample", "vessel"), np.int64, "1", "particles per vessel"),
+            "sample_wall_resultant": (("sample", "wall", "xy"), float, "N", "resultant force of wall on liquid over the run"),
+            "sample_vessel_count": (("sample", "vessel"), np.int64, "1", "particles per vessel"),
             "snap_step": (("snapshot",), np.int64, "1", "algorithm step of snapshot"),
             "snap_pos": (("snapshot", "particle", "xy"), float, "cm", "particle positions at snapshot"),
         }
         out = {k: (d, np.array(r[k], t), u, ln) for k, (d, t, u, ln) in spec.items() if r[k]}
-        if "hist_wall_resultant" in out:
-            out["hist_sum_fx"] = (("sample",), out["hist_wall_resultant"][1][:, :, 0].sum(1), "N",
+        if "sample_wall_resultant" in out:
+            out["sample_sum_fx"] = (("sample",), out["sample_wall_resultant"][1][:, :, 0].sum(1), "N",
                                   "horizontal resultant of all wall reactions (0 in equilibrium)")
         return out
 

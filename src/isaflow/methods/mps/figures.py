@@ -36,7 +36,7 @@ def wall_loads(runs, outputs):
         ds = runfile.read(p)
         e, (cw, cp, mag, th) = metrics.contact_loads(ds)
         win = ds["in_window"].values.astype(bool)
-        hist = np.hypot(*np.moveaxis(ds["hist_panel_force"].values[win], -1, 0))
+        hist = np.hypot(*np.moveaxis(ds["sample_panel_force"].values[win], -1, 0))
         k = np.arange(len(mag))
         v = VARIANTS[ds.attrs["variant"]]
         ax.errorbar(k, mag, yerr=hist.std(0), fmt=v.marker, color=v.colour, ms=4, capsize=2, label="MPS mean +- std")
@@ -111,7 +111,7 @@ def rest(runs, outputs, before=()):
         for ds, c in mine:
             old = ds.attrs["gradient_model"] != "variational"
             e_mean = float(ds.attrs["window_energy_ratio_mean"])
-            ax.semilogy(ds["hist_time"].values, ds["hist_energy_ratio"].values, color=c, lw=0.9 if old else 1.2,
+            ax.semilogy(ds["sample_time"].values, ds["sample_energy_ratio"].values, color=c, lw=0.9 if old else 1.2,
                         ls="--" if old else "-", label=f"l0 = {float(ds.attrs['spacing']):.3g} cm, {ds.attrs['gradient_model']} "
                                                          f"({ds.attrs['status']}; last {float(ds.attrs['rest_window']):g} s: mean {e_mean:.1e})")
         if mine:
@@ -143,7 +143,7 @@ def column(runs, outputs):
             axes[0, k].plot(depth, p, ".", color=c, ms=2.5, label=f"l0 = {l0:.3g} cm ({ds.attrs['status']})")
             d = np.array([0.0, depth.max()])
             axes[0, k].plot(d, rho_g * d, "-", color=c, lw=0.7)
-            t = ds["hist_time"].values
+            t = ds["sample_time"].values
             for reading, ls in (("pair", "-"), ("panel", ":")):
                 series = wall_series(ds, reading)
                 if series is None:

@@ -20,10 +20,10 @@ def noise(ds):
     """Wall-load and probe noise over the averaging window: mean over wetted panels of the std of |panel force|
     divided by its mean (1), the same std in N, and the std of each probe's pressure (N/cm^2)."""
     win = ds["in_window"].values.astype(bool)
-    mag = np.hypot(*np.moveaxis(ds["hist_panel_force"].values[win], -1, 0))
+    mag = np.hypot(*np.moveaxis(ds["sample_panel_force"].values[win], -1, 0))
     mean, std = mag.mean(0), mag.std(0)
     wet = mean > 0.01 * mean.max() if mean.max() > 0 else mean > 0
-    probe = ds["hist_probe_pressure"].values[win]
+    probe = ds["sample_probe_pressure"].values[win]
     if not wet.any():
         return np.nan, np.nan, np.nanstd(probe, axis=0)
     return float(np.mean(std[wet] / mean[wet])), float(np.mean(std[wet])), np.nanstd(probe, axis=0)
@@ -46,7 +46,7 @@ def side_loads(ds):
     return load, load / SIDE_LOAD - 1.0
 
 
-READINGS = {"pair": "hist_pair_force", "panel": "hist_panel_pressure_force"}  # wall-load readings: variable
+READINGS = {"pair": "sample_pair_force", "panel": "sample_panel_pressure_force"}  # wall-load readings: variable
 
 
 def wall_series(ds, reading="pair"):
@@ -116,7 +116,7 @@ def summary_row(path):
                escapes=int(a.get("escapes", int(a["status"] == "escaped"))), energy_ratio=float(a["final_energy_ratio"]),
                rest_energy_ratio=float(a["rest_energy_ratio"]), time_to_rest_s=time_to_rest(ds),
                side_load_N=side, side_err_3262=side_err, threads=int(a.get("threads", 1)),
-               max_speed_cm_s=float(ds["hist_max_speed"].values[-1]), message=a.get("status_message", ""),
+               max_speed_cm_s=float(ds["sample_max_speed"].values[-1]), message=a.get("status_message", ""),
                escape_depth_cm=escape_depth(ds), graze_steps=int(a.get("graze_steps", 0)),
                deepest_graze_cm=float(a.get("deepest_graze_cm", 0.0)),
                reflected_particles=int(a.get("reflected_particles", 0)), reflect_steps=int(a.get("reflect_steps", 0)),
@@ -134,9 +134,9 @@ def summary_row(path):
                window_energy_max=float(a.get("window_energy_ratio_max", np.nan)),
                gradient=a.get("gradient_model", ""))
     rel, absn, probe = noise(ds)
-    u = ds["hist_rms_speed"].values
+    u = ds["sample_rms_speed"].values
     row.update(panel_noise_rel=rel, panel_noise_N=absn, min_rms_speed_cm_s=float(u.min()),
-               min_rms_time_s=float(ds["hist_time"].values[int(np.argmin(u))]))
+               min_rms_time_s=float(ds["sample_time"].values[int(np.argmin(u))]))
     for k, p in enumerate(probe):
         row[f"probe{k}_std_N_cm2"] = float(p)
     m = metrics.run_row(ds)

@@ -453,27 +453,27 @@ class _Stepper:
         panels = np.array(rec["pair" if pairwise else "panel"])
         window = times >= times[-1] - cfg["time.average_window"] + 1e-12
         hist = {
-            "hist_time": (("sample",), times, "s", "time of sample"),
-            "hist_panel_force": (("sample", "contact", "xy"), panels, "N",
-                                 "force of each wall panel on the liquid, the contacts' reading: " + ("pair forces (hist_pair_force)"
-                                 if pairwise else "panel pressures (hist_panel_pressure_force; this gradient's pair terms are "
+            "sample_time": (("sample",), times, "s", "time of sample"),
+            "sample_panel_force": (("sample", "contact", "xy"), panels, "N",
+                                 "force of each wall panel on the liquid, the contacts' reading: " + ("pair forces (sample_pair_force)"
+                                 if pairwise else "panel pressures (sample_panel_pressure_force; this gradient's pair terms are "
                                  "not antisymmetric, so they are no momentum exchange)")),
-            "hist_pair_force": (("sample", "contact", "xy"), np.array(rec["pair"]), "N",
+            "sample_pair_force": (("sample", "contact", "xy"), np.array(rec["pair"]), "N",
                                 "force of each wall panel's boundary particles on the liquid: the wall-liquid pair terms of "
                                 "the pressure gradient (pair-force reading, model.wall_forces), mean over the steps since the "
                                 "previous sample (momentum exchanged / interval)"),
-            "hist_panel_pressure_force": (("sample", "contact", "xy"), np.array(rec["panel"]), "N",
+            "sample_panel_pressure_force": (("sample", "contact", "xy"), np.array(rec["panel"]), "N",
                                           "force of each wall panel on the liquid: first-row wall pressure times the wall "
                                           "length it faces (panel reading), mean over the steps since the previous sample"),
-            "hist_probe_pressure": (("sample", "probe"), np.array(rec["probe"]).reshape(len(times), -1), "N cm-2", "pressure at fixed probe",
+            "sample_probe_pressure": (("sample", "probe"), np.array(rec["probe"]).reshape(len(times), -1), "N cm-2", "pressure at fixed probe",
                                     {"missing": "no liquid particle within the probe's radius (a dry probe)"}),
-            "hist_rms_speed": (("sample",), np.array(rec["rms"]), "cm s-1", "rms speed of the liquid particles"),
-            "hist_max_speed": (("sample",), np.array(rec["vmax"]), "cm s-1", "largest liquid particle speed"),
-            "hist_energy_ratio": (("sample",), np.array(rec["energy"]), "1", "kinetic energy / (W h), isaflow.rest"),
-            "hist_vessel_count": (("sample", "vessel"), np.array(rec["count"]), "1", "particles per vessel"),
-            "hist_solve_residual": (("sample",), np.array(rec["resid"]), "1", "relative residual of the pressure solve"),
-            "hist_solve_iterations": (("sample",), np.array(rec["iters"]), "1", "iterations of the pressure solve"),
-            "hist_surface_count": (("sample",), np.array(rec["surf"]), "1", "liquid particles on the free surface"),
+            "sample_rms_speed": (("sample",), np.array(rec["rms"]), "cm s-1", "rms speed of the liquid particles"),
+            "sample_max_speed": (("sample",), np.array(rec["vmax"]), "cm s-1", "largest liquid particle speed"),
+            "sample_energy_ratio": (("sample",), np.array(rec["energy"]), "1", "kinetic energy / (W h), isaflow.rest"),
+            "sample_vessel_count": (("sample", "vessel"), np.array(rec["count"]), "1", "particles per vessel"),
+            "sample_solve_residual": (("sample",), np.array(rec["resid"]), "1", "relative residual of the pressure solve"),
+            "sample_solve_iterations": (("sample",), np.array(rec["iters"]), "1", "iterations of the pressure solve"),
+            "sample_surface_count": (("sample",), np.array(rec["surf"]), "1", "liquid particles on the free surface"),
             "probe_point": (("probe", "xy"), probes, "cm", "pressure probe position"),
             "in_window": (("sample",), window.astype(np.int8), "1", "1 if the sample is in the averaging window"),
         }

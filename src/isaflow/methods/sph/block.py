@@ -214,7 +214,7 @@ def run(tank, s, resolution, log=lambda msg: None):
                                 "largest distance of a particle from its stretched-lattice start, mean drift removed, / spacing"),
         "min_pair_over_dx_t": (("sample",), np.array(rec["dmin"]), "1",
                                "smallest distance between two particles since the last sample / spacing"),
-        "sample_vrms": (("sample",), np.array(rec["vrms"]), VELOCITY, "rms speed"),
+        "sample_rms_speed": (("sample",), np.array(rec["vrms"]), VELOCITY, "rms speed"),
         "sample_mean_pressure": (("sample",), np.array(rec["p_mean"]), "N cm-2", "mean particle pressure"),
     }
     fields = {

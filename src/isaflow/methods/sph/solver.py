@@ -302,13 +302,12 @@ class _Stepper:
         st, rec, x, nf = self.st, self.rec, self.x, self.nf
         sample = self.t, R.energy_ratio(self.ke, self.held, st["depth0"])
         rec["sample_time"].append(self.t)
-        rec["sample_vrms"].append(self.diag[0])
+        rec["sample_rms_speed"].append(self.diag[0])
         rec["sample_kinetic"].append(self.ke)
         per_wall = np.zeros((len(self.walls), 2))
         np.add.at(per_wall, st["owner"], self.window[-1] if self.window else 0.0)
         rec["sample_wall_resultant"].append(per_wall)
-        rec["sample_vessel_weight"].append([st["mass"] * G * np.count_nonzero((x[:nf, 0] >= a) & (x[:nf, 0] < b))
-                                            for _, (a, b) in self.vessels])
+        rec["sample_vessel_count"].append([np.count_nonzero((x[:nf, 0] >= a) & (x[:nf, 0] < b)) for _, (a, b) in self.vessels])
         return sample
 
     def spent(self):
@@ -348,12 +347,12 @@ class _Stepper:
         left = int(np.count_nonzero((x[:nf, 0] >= x0) & (x[:nf, 0] < x1)))
         history = {
             "sample_time": (("sample",), np.array(rec["sample_time"]), "s", "chain time at the end of the diagnostic chunk"),
-            "sample_vrms": (("sample",), np.array(rec["sample_vrms"]), VELOCITY, "largest rms liquid speed in the chunk"),
+            "sample_rms_speed": (("sample",), np.array(rec["sample_rms_speed"]), VELOCITY, "largest rms liquid speed in the chunk"),
             "sample_kinetic": (("sample",), np.array(rec["sample_kinetic"]), "N cm", "kinetic energy at the chunk's end"),
             "sample_wall_resultant": (("sample", "wall", "xy"), np.array(rec["sample_wall_resultant"]), "N",
                                       "force of each wall on the liquid, mean over the chunk"),
-            "sample_vessel_weight": (("sample", "vessel"), np.array(rec["sample_vessel_weight"]), "N",
-                                     "weight of the liquid in each vessel"),
+            "sample_vessel_count": (("sample", "vessel"), np.array(rec["sample_vessel_count"], np.int64), "1",
+                                    "liquid particles in each vessel"),
             "snap_time": (("snapshot",), np.array(rec["snap_time"]), "s", "chain time of the position snapshot"),
             "snap_pos": (("snapshot", "particle", "xy"), np.array(rec["snap_pos"]).reshape(-1, nf, 2), "cm",
                          "liquid particle positions"),

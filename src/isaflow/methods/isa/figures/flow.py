@@ -201,12 +201,12 @@ def flow_history_figure(inputs, outputs, chains=None):
             if "hist_step" in ds:
                 ax_m.plot(ds["hist_step"], ds["hist_fmax"], lw=0.6, color="k")
                 ax_m.fill_between(ds["hist_step"], ds["hist_fmax_lo"], ds["hist_fmax_hi"], color="gray", alpha=0.3, lw=0)
-            if "hist_vessel_count" in ds:
+            if "sample_vessel_count" in ds:
                 st = ds["sample_step"].values
                 for name, color in zip(ds["vessel"].values, VESSEL_COLOURS):
-                    ax_n.plot(st, ds["hist_vessel_count"].sel(vessel=name), color=color,
+                    ax_n.plot(st, ds["sample_vessel_count"].sel(vessel=name), color=color,
                               label=f"{name} vessel" if stem == stems[1] else None)
-                ax_f.plot(st, ds["hist_sum_fx"], color=COMPUTED)
+                ax_f.plot(st, ds["sample_sum_fx"], color=COMPUTED)
         ax_n.set_ylabel("particles")
         ax_n.legend(fontsize=8, loc="center right")
         ax_n.set_title(f"{label} chain\n\n", fontsize=9)
