@@ -78,8 +78,9 @@ def _chain(ds, spacing, weight):
 
 def _read_start(scene, ds, src, where, field):
     """(pos, weight, steps, spacing, (state, why)) of an open start file, shapes checked before loading."""
-    if ds.attrs.get("method", "isa") != "isa":
-        raise SceneError(f"{where}: '{src}' is a run of method '{ds.attrs['method']}', not an ISA run")
+    problem = runfile.start_problem(ds, src, "isa")
+    if problem and "status" not in problem:  # the state's own checks come first (shapes, count), then the status
+        raise SceneError(f"{where}: {problem}")
     shapes = {"pos": ("particle", "xy"), "weight": ("particle",), "steps": ()}
     for name, dims in shapes.items():
         if name not in ds.variables or ds[name].dims != dims:
@@ -88,8 +89,8 @@ def _read_start(scene, ds, src, where, field):
     if ds.sizes["xy"] != 2 or n == 0:
         raise SceneError(f"{where}: '{src}' holds no particles in 2D")
     budget.check_count(scene, n, field)
-    if ds.attrs.get("status") in ("escaped", "nonfinite"):
-        raise SceneError(f"{where}: '{src}' holds no valid state (status {ds.attrs['status']})")
+    if problem:
+        raise SceneError(f"{where}: {problem}")
     pos = np.asarray(ds["pos"].values, float)
     weight = np.asarray(ds["weight"].values, float)
     steps = ds["steps"].values

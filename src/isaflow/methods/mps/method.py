@@ -30,10 +30,10 @@ def check(tank, settings, start=None):
     l0 = settings["resolution.spacing"]
     if start is not None:
         with runfile.open_run(start) as ds:
-            if ds.attrs.get("method") != "mps":
-                raise InputError(f"--start: '{start}' is a run of method '{ds.attrs.get('method')}', not an MPS run")
-            if ds.attrs.get("status") in ("escaped", "nonfinite", "solver_failed"):
-                raise InputError(f"--start: '{start}' holds no valid state (status {ds.attrs['status']})")
+            problem = runfile.start_problem(ds, start, "mps", ("pos", "velocity", "steps", "sim_time", "spacing",
+                                                                    "initial_depth"))
+            if problem:
+                raise InputError(f"--start: {problem}")
             if not np.isclose(float(ds.attrs.get("spacing", np.nan)), l0, rtol=1e-9):
                 raise InputError(f"--start: '{start}' has spacing {ds.attrs.get('spacing')} cm, this run asks for "
                                  f"{l0:.6g} cm")

@@ -14,7 +14,7 @@ from . import solver
 REFERENCES = ("Marko (2017), Computation 5, 33 (section 2); Monaghan (1992), Annu. Rev. Astron. Astrophys. 30, 543; "
               "Monaghan (1994), J. Comput. Phys. 110, 399; Adami, Hu & Adams (2012), J. Comput. Phys. 231, 7057; "
               "Molteni & Colagrossi (2009), Comput. Phys. Commun. 180, 861")
-START_VARS = ("pos", "velocity", "density", "weight")
+START_VARS = ("pos", "velocity", "density", "weight", "cell_dx")  # variables and the attribute cell_dx
 
 
 def check(tank, settings, start=None):
@@ -25,13 +25,9 @@ def check(tank, settings, start=None):
         raise InputError("--start: a periodic block (settings.domain) starts from its stretched lattice, not a run file")
     if start is not None:
         with runfile.open_run(start) as ds:
-            if ds.attrs.get("method") != "sph":
-                raise InputError(f"--start: '{start}' is a run of method '{ds.attrs.get('method')}', not an SPH run")
-            missing = [v for v in START_VARS if v not in ds.variables]
-            if missing or "cell_dx" not in ds.attrs:
-                raise InputError(f"--start: '{start}' holds no SPH state ({', '.join(missing) or 'cell_dx'} missing)")
-            if ds.attrs.get("status") in ("escaped", "nonfinite"):
-                raise InputError(f"--start: '{start}' holds no valid state (status {ds.attrs['status']})")
+            problem = runfile.start_problem(ds, start, "sph", START_VARS)
+        if problem:
+            raise InputError(f"--start: {problem}")
 
 
 def warm_up(threads=None):
