@@ -461,3 +461,21 @@ def test_the_parse_time_checks_need_no_numerics():
             "for m in ('solid', 'sph1d'): preflight.check_file(m)\n")
     proc = subprocess.run([sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr[-2000:]
+
+
+def test_one_start_file_test_for_every_method():
+    """runfile.start_problem, the start check of ISA, SPH and MPS: another method's run, a missing variable or
+    attribute of the state, an outcome no run may continue (escaped, nonfinite, solver_failed) each give one line."""
+    import numpy as np
+    import xarray as xr
+
+    from isaflow import runfile
+
+    ds = xr.Dataset({"pos": (("particle", "xy"), np.zeros((2, 2)))}, attrs={"method": "mps", "status": "converged",
+                                                                           "spacing": 1.0})
+    assert runfile.start_problem(ds, "a.nc", "mps", ("pos", "spacing")) is None
+    assert "not an SPH run" in runfile.start_problem(ds, "a.nc", "sph")
+    assert "(velocity missing)" in runfile.start_problem(ds, "a.nc", "mps", ("pos", "velocity"))
+    for status in runfile.UNUSABLE:
+        ds.attrs["status"] = status
+        assert f"status {status}" in runfile.start_problem(ds, "a.nc", "mps")
