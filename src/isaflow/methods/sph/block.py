@@ -18,11 +18,11 @@ Units cm, N, s.
 """
 
 import math
-import time
 
 import numpy as np
 from ...core.jit import njit
 
+from ... import driver
 from ...contract import Result
 from ...core import smoothing
 from ...core.units import DENSITY_2D, G, VELOCITY
@@ -145,99 +145,129 @@ def nonaffine(x, x0, box):
 
 def run(tank, s, resolution, log=lambda msg: None):
     """The periodic block of the tank's liquid lattice (module docstring) -> contract.Result (status
-    step_limit at settings.t_max_block, nonfinite otherwise; no wall contacts)."""
-    x0, x1 = tank.vessels[0][1]
-    width, depth = x1 - x0, tank.depth
-    nx, ny = lattice_shape(width, depth, resolution.get("particles"), resolution.get("spacing"))
-    pos, (dx, dy) = liquid_lattice(0.0, 0.0, width, depth, nx, ny)
-    e = s["stretch"]
-    box = np.array([width, depth]) * (1.0 + e)
-    lattice = pos * (1.0 + e)
-    spacing = math.sqrt(dx * dy) * (1.0 + e)
-    rng = np.random.default_rng(s["seed"])
-    x = lattice + s["perturbation"] * spacing * rng.uniform(-1.0, 1.0, lattice.shape)
-    kind = smoothing.kernel_id(s["kernel"])
-    h = s["h_factor"] * math.sqrt(dx * dy)
-    c0 = s["sound_speed_factor"] * math.sqrt(2 * G * s["max_drop"])
-    mass = tank.weight / (nx * ny) / G
-    rho_ref = mass / (dx * dy)  # the continuity density of the unstretched lattice (as the tank runs)
-    if s["density"] != "continuity" or s.get("delta", 0.0) > 0.0:
-        raise ValueError("periodic block: only the continuity density without density diffusion is implemented "
-                         "(settings.density, settings.delta)")
-    ncx, ncy = int(box[0] // (2 * h)), int(box[1] // (2 * h))
-    if min(ncx, ncy) < 3:
-        raise ValueError(f"periodic block: {box[0]:.3g} x {box[1]:.3g} cm holds fewer than 3 x 3 cells of 2h = "
-                         f"{2 * h:.3g} cm (the minimum image needs them)")
-    n = len(x)
-    v = np.zeros_like(x)
-    rho = np.full(n, rho_ref / (1.0 + e) ** 2)
-    eos = np.array([rho_ref, c0, s["gamma"], float(s["eos"] == "tait"), float(s["negative_pressure"] == "clamp")])
-    p = np.array([pressure_of(r, *eos[:3], eos[3] > 0, eos[4] > 0) for r in rho])
-    p_start = float(p.mean())
-    par = np.array([h, mass, c0, s["alpha"], float(kind), smoothing.NORM[kind, 2]])
-    dt = s["cfl"] * h / c0
-    acc, drho = np.zeros_like(x), np.zeros(n)
-    head, nxt = np.empty(ncx * ncy, np.int64), np.empty(n, np.int64)
-    cells(x, box, ncx, ncy, head, nxt)
-    dmin0 = rates(x, v, rho, p, box, ncx, ncy, head, nxt, par, acc, drho)
-    n_total = max(1, int(round(s["t_max_block"] / dt)))
-    n_chunk = max(1, int(round(s["chunk_time"] / dt)))
-    diag = np.zeros(3)
-    rec = {k: [] for k in ("t", "nonaffine", "dmin", "vrms", "p_mean")}
+    step_limit at settings.t_max_block, nonfinite otherwise; no wall contacts), through the one run driver."""
+    stepper = _BlockStepper(tank, s, resolution)
+    res = driver.drive(stepper, log=log)
+    log(res.message)
+    return res
 
-    def record(t, dmin):
+
+class _BlockStepper:
+    """The periodic block for driver.drive: one advance is one chunk of settings.chunk_time, a sample after each
+    (no rest test: the block runs to t_max_block unless a value becomes non-finite)."""
+
+    t0 = 0.0
+
+    def __init__(self, tank, s, resolution):
+        x0, x1 = tank.vessels[0][1]
+        width, depth = x1 - x0, tank.depth
+        nx, ny = lattice_shape(width, depth, resolution.get("particles"), resolution.get("spacing"))
+        pos, (dx, dy) = liquid_lattice(0.0, 0.0, width, depth, nx, ny)
+        e = s["stretch"]
+        self.box = box = np.array([width, depth]) * (1.0 + e)
+        self.lattice = pos * (1.0 + e)
+        self.spacing = math.sqrt(dx * dy) * (1.0 + e)
+        rng = np.random.default_rng(s["seed"])
+        self.x = self.lattice + s["perturbation"] * self.spacing * rng.uniform(-1.0, 1.0, self.lattice.shape)
+        kind = smoothing.kernel_id(s["kernel"])
+        h = s["h_factor"] * math.sqrt(dx * dy)
+        c0 = s["sound_speed_factor"] * math.sqrt(2 * G * s["max_drop"])
+        self.mass = mass = tank.weight / (nx * ny) / G
+        rho_ref = mass / (dx * dy)  # the continuity density of the unstretched lattice (as the tank runs)
+        if s["density"] != "continuity" or s.get("delta", 0.0) > 0.0:
+            raise ValueError("periodic block: only the continuity density without density diffusion is implemented "
+                             "(settings.density, settings.delta)")
+        self.ncx, self.ncy = ncx, ncy = int(box[0] // (2 * h)), int(box[1] // (2 * h))
+        if min(ncx, ncy) < 3:
+            raise ValueError(f"periodic block: {box[0]:.3g} x {box[1]:.3g} cm holds fewer than 3 x 3 cells of 2h = "
+                             f"{2 * h:.3g} cm (the minimum image needs them)")
+        n = len(self.x)
+        self.v = np.zeros_like(self.x)
+        self.rho = np.full(n, rho_ref / (1.0 + e) ** 2)
+        self.eos = eos = np.array([rho_ref, c0, s["gamma"], float(s["eos"] == "tait"),
+                                   float(s["negative_pressure"] == "clamp")])
+        self.p = np.array([pressure_of(r, *eos[:3], eos[3] > 0, eos[4] > 0) for r in self.rho])
+        self.p_start = float(self.p.mean())
+        self.par = np.array([h, mass, c0, s["alpha"], float(kind), smoothing.NORM[kind, 2]])
+        self.dt = s["cfl"] * h / c0
+        self.acc, drho = np.zeros_like(self.x), np.zeros(n)
+        head, nxt = np.empty(ncx * ncy, np.int64), np.empty(n, np.int64)
+        cells(self.x, box, ncx, ncy, head, nxt)
+        dmin0 = rates(self.x, self.v, self.rho, self.p, box, ncx, ncy, head, nxt, self.par, self.acc, drho)
+        self.n_total = max(1, int(round(s["t_max_block"] / self.dt)))
+        self.n_chunk = max(1, int(round(s["chunk_time"] / self.dt)))
+        self.diag = np.zeros(3)
+        self.rec = {k: [] for k in ("t", "nonaffine", "dmin", "vrms", "p_mean")}
+        self.s, self.nx, self.ny, self.dx, self.dy, self.h, self.c0, self.rho_ref = s, nx, ny, dx, dy, h, c0, rho_ref
+        self.done = 0
+        self._sample(0.0, dmin0)
+
+    def _sample(self, t, dmin):
+        rec, n = self.rec, len(self.x)
         rec["t"].append(t)
-        rec["nonaffine"].append(nonaffine(x, lattice, box) / spacing)
-        rec["dmin"].append(dmin / spacing)
-        rec["vrms"].append(math.sqrt(2 * diag[1] / n) if np.isfinite(diag[1]) else np.inf)
-        rec["p_mean"].append(float(p.mean()))
+        rec["nonaffine"].append(nonaffine(self.x, self.lattice, self.box) / self.spacing)
+        rec["dmin"].append(dmin / self.spacing)
+        rec["vrms"].append(math.sqrt(2 * self.diag[1] / n) if np.isfinite(self.diag[1]) else np.inf)
+        rec["p_mean"].append(float(self.p.mean()))
 
-    record(0.0, dmin0)
-    done, status, message = 0, "step_limit", ""
-    started = time.perf_counter()
-    while done < n_total:
-        k = min(n_chunk, n_total - done)
-        code, steps = advance(x, v, rho, p, acc, box, ncx, ncy, par, eos, dt, k, diag)
-        done += steps
-        record(done * dt, diag[0])
+    def advance(self):
+        k = min(self.n_chunk, self.n_total - self.done)
+        code, steps = advance(self.x, self.v, self.rho, self.p, self.acc, self.box, self.ncx, self.ncy, self.par,
+                              self.eos, self.dt, k, self.diag)
+        self.done += steps
         if code == NONFINITE:
-            status, message = "nonfinite", f"a non-finite value at step {done} (t = {done * dt:.4g} s)"
-            break
-    wall_time = time.perf_counter() - started
-    if status == "step_limit":
-        message = f"periodic block, {done} steps of {dt:.4g} s to t = {done * dt:.4g} s (no rest test)"
-    log(message)
-    na = np.array(rec["nonaffine"])
-    history = {
-        "sample_time": (("sample",), np.array(rec["t"]), "s", "time of the sample"),
-        "nonaffine_over_dx_t": (("sample",), na, "1",
-                                "largest distance of a particle from its stretched-lattice start, mean drift removed, / spacing"),
-        "min_pair_over_dx_t": (("sample",), np.array(rec["dmin"]), "1",
-                               "smallest distance between two particles since the last sample / spacing"),
-        "sample_rms_speed": (("sample",), np.array(rec["vrms"]), VELOCITY, "rms speed"),
-        "sample_mean_pressure": (("sample",), np.array(rec["p_mean"]), "N cm-2", "mean particle pressure"),
-    }
-    fields = {
-        "pressure": (("particle",), p.copy(), "N cm-2", "particle pressure (equation of state)"),
-        "density": (("particle",), rho.copy(), DENSITY_2D, "particle density"),
-        "velocity": (("particle", "xy"), v.copy(), VELOCITY, "particle velocity"),
-    }
-    params = {f"sph_{k}": (str(v_) if isinstance(v_, (bool, list)) else v_) for k, v_ in s.items()}
-    params.update(
-        domain="periodic_block", box_width=float(box[0]), box_height=float(box[1]), cell_dx=dx * (1 + e),
-        cell_dy=dy * (1 + e), smoothing_length=h, sound_speed=c0, dt=dt, particle_mass=mass, rho_ref=rho_ref,
-        initial_pressure=p_start, max_nonaffine_over_dx=float(np.nanmax(na)) if np.isfinite(na).all()
-        else math.inf, max_step_move_over_dx=float(diag[2]) / spacing, layer_pitch=dy * (1 + e),
-        held_weight=float(mass * G * n), initial_depth=float(box[1]), t_max=s["t_max_block"], threads=1,
-        tank_difference=f"periodic block without walls or gravity: the tank's liquid lattice ({nx} x {ny}) "
-                        f"stretched by {e:g} in a periodic {box[0]:.4g} x {box[1]:.4g} cm box; the tank's walls "
-                        "are not used (no wall loads)")
-    return Result(
-        method="sph", variant="custom", pos0=lattice, pos=x.copy(), weight=np.full(n, mass * G),
-        contact_wall=np.zeros(0, int), contact_point=np.zeros((0, 2)), contact_force=np.zeros((0, 2)),
-        status=status, message=message, steps=done, start_step=0, wall_time=wall_time, force_evals=2 * done + 1,
-        residual=rec["vrms"][-1], residual_name="rms speed", residual_units=VELOCITY, sim_time=done * dt,
-        history=history, fields=fields, params=params, spacing=spacing)
+            return "nonfinite", f"a non-finite value at step {self.done} (t = {self.done * self.dt:.4g} s)"
+        return None
+
+    def record(self):
+        self._sample(self.done * self.dt, self.diag[0])
+        return None  # no rest sample
+
+    def spent(self):
+        return self.done >= self.n_total
+
+    def limit_message(self, monitor):
+        return (f"periodic block, {self.done} steps of {self.dt:.4g} s to t = {self.done * self.dt:.4g} s "
+                "(no rest test)")
+
+    def progress(self, monitor):
+        return f"sph periodic block: t = {self.done * self.dt:.3f} s, step {self.done} of {self.n_total}"
+
+    def result(self, run):
+        s, rec, box, e, n = self.s, self.rec, self.box, self.s["stretch"], len(self.x)
+        dx, dy, done, dt = self.dx, self.dy, self.done, self.dt
+        na = np.array(rec["nonaffine"])
+        history = {
+            "sample_time": (("sample",), np.array(rec["t"]), "s", "time of the sample"),
+            "nonaffine_over_dx_t": (("sample",), na, "1", "largest distance of a particle from its stretched-lattice "
+                                    "start, mean drift removed, / spacing"),
+            "min_pair_over_dx_t": (("sample",), np.array(rec["dmin"]), "1",
+                                   "smallest distance between two particles since the last sample / spacing"),
+            "sample_rms_speed": (("sample",), np.array(rec["vrms"]), VELOCITY, "rms speed"),
+            "sample_mean_pressure": (("sample",), np.array(rec["p_mean"]), "N cm-2", "mean particle pressure"),
+        }
+        fields = {
+            "pressure": (("particle",), self.p.copy(), "N cm-2", "particle pressure (equation of state)"),
+            "density": (("particle",), self.rho.copy(), DENSITY_2D, "particle density"),
+            "velocity": (("particle", "xy"), self.v.copy(), VELOCITY, "particle velocity"),
+        }
+        params = {f"sph_{k}": (str(v_) if isinstance(v_, (bool, list)) else v_) for k, v_ in s.items()}
+        params.update(
+            domain="periodic_block", box_width=float(box[0]), box_height=float(box[1]), cell_dx=dx * (1 + e),
+            cell_dy=dy * (1 + e), smoothing_length=self.h, sound_speed=self.c0, dt=dt, particle_mass=self.mass,
+            rho_ref=self.rho_ref, initial_pressure=self.p_start,
+            max_nonaffine_over_dx=float(np.nanmax(na)) if np.isfinite(na).all() else math.inf,
+            max_step_move_over_dx=float(self.diag[2]) / self.spacing, layer_pitch=dy * (1 + e),
+            held_weight=float(self.mass * G * n), initial_depth=float(box[1]), t_max=s["t_max_block"], threads=1,
+            tank_difference=f"periodic block without walls or gravity: the tank's liquid lattice ({self.nx} x {self.ny}) "
+                            f"stretched by {e:g} in a periodic {box[0]:.4g} x {box[1]:.4g} cm box; the tank's walls "
+                            "are not used (no wall loads)")
+        return Result(
+            method="sph", variant="custom", pos0=self.lattice, pos=self.x.copy(), weight=np.full(n, self.mass * G),
+            contact_wall=np.zeros(0, int), contact_point=np.zeros((0, 2)), contact_force=np.zeros((0, 2)),
+            status=run.status, message=run.message, steps=done, start_step=0, wall_time=run.wall_time,
+            force_evals=2 * done + 1, residual=rec["vrms"][-1], residual_name="rms speed", residual_units=VELOCITY,
+            sim_time=done * dt, history=history, fields=fields, params=params, spacing=self.spacing)
 
 
 def warm_up():
