@@ -4,7 +4,9 @@ params.func names 'module.function' under isaflow (e.g. 'methods.isa.tables.erro
 'figures.methods.tanks_figure').  It is called as func(**named inputs except 'code' and 'compiled',
 outputs=[output files], **params.kw); single-file inputs are passed as a path, others as a list.
 params.kernels, if given, names the kernel generation (isaflow.core.jit.use) of its kernels, whose
-compile stamp is the input 'compiled', or a list: that generation, then others it reads too (jit.read_also).  stderr goes to the rule's log.  BLAS and OpenMP run on the
+compile stamp is the input 'compiled', or a list: that generation, then others it reads too (jit.read_also).  A function that
+runs solvers returns the list of their contract.Results (their solver time counts as the job's solve phase in
+docs/timing.md).  stderr goes to the rule's log.  BLAS and OpenMP run on the
 rule's threads.  An input error (isaflow.inputs.InputError, or a
 file that is no run file) ends the job with one line in the log and exit status 2, no traceback.
 """
@@ -37,9 +39,12 @@ func = getattr(importlib.import_module(f"isaflow.{mod}"), name)
 _imported = time.time()
 inputs = {k: (v if isinstance(v, str) else list(v)) for k, v in snakemake.input.items() if k not in ("code", "compiled")}  # noqa: F821
 try:
-    func(**inputs, outputs=list(snakemake.output), **dict(snakemake.params.get("kw", {}) or {}))  # noqa: F821
+    _out = func(**inputs, outputs=list(snakemake.output), **dict(snakemake.params.get("kw", {}) or {}))  # noqa: F821
 except (InputError, RunFileError) as err:
     print(f"error: {err}", file=sys.stderr)
     sys.exit(2)
 print(f"{snakemake.params.func}: wrote {', '.join(snakemake.output)}", file=sys.stderr)  # noqa: F821
-timing.record(snakemake.rule, snakemake.output[0], _script_start, _imported)  # noqa: F821
+# a function that runs solvers returns their contract.Results: their solver time is the job's solve phase
+_runs = [r for r in (_out if isinstance(_out, list) else []) if hasattr(r, "wall_time")]
+timing.record(snakemake.rule, snakemake.output[0], _script_start, _imported, sum(r.wall_time for r in _runs),  # noqa: F821
+              len(_runs))

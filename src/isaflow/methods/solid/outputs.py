@@ -59,10 +59,10 @@ def run_case(cfg, outputs, case, variant, loads=None):
 def run_cases(cfg, outputs, cases, loads=None, kernels=None):
     """Workflow entry point of a block of cases in one process: write_run of each [case, variant] in cases to
     the output at the same place; loads: the rigid-floor run file of each (elastic-floor cases), or None;
-    kernels: an input that only orders the job (its file is not read)."""
+    kernels: an input that only orders the job (its file is not read).  Returns the contract.Results."""
     logging.basicConfig(stream=sys.stderr, level=logging.INFO, format="%(asctime)s %(message)s")
-    for k, ((case, variant), out) in enumerate(zip(cases, outputs)):
-        write_run(cfg, case, variant, out, loads=loads[k] if loads else None)
+    return [write_run(cfg, case, variant, out, loads=loads[k] if loads else None)
+            for k, ((case, variant), out) in enumerate(zip(cases, outputs))]
 
 
 def write_run(config_path, case, variant, out, loads=None):
