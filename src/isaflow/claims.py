@@ -72,20 +72,20 @@ class Context:
         self.paths = dict(runs or {})
         self.table_paths = dict(tables or {})
         self._cache = {}
-        self.allowed = None  # None: every key; else the keys a view may read
+        self.allowed, self.claim = None, ""  # a view's keys (None: every key) and the claim it reads for
 
     def only(self, keys, claim=""):
         """A view of the same files and cache that reads only keys (a registry row's declared runs): paths holds
         only those, and run, group or has of any other key raises Undeclared naming the claim."""
         view = Context(tables=self.table_paths)
-        view.allowed, view.claim, view._cache = frozenset(keys), claim, self._cache
+        view.allowed, view.claim, view._cache = frozenset(keys), claim, self._cache  # the files are read once
         view.paths = {k: p for k, p in self.paths.items() if k in view.allowed}
         return view
 
     def _check(self, key):
         if self.allowed is not None and key not in self.allowed:
-            raise Undeclared(f"claim '{getattr(self, 'claim', '')}' reads '{key}', which its registry row does not "
-                             "declare (its runs, its deviation's runs or an inferred input's runs)")
+            raise Undeclared(f"claim '{self.claim}' reads '{key}', which its registry row does not declare (its runs, "
+                             "controls, deviation's runs, inferred inputs' runs or the runs of the rows it depends on)")
 
     def run(self, key):
         """The run file of '<method>:<run id>' (xarray Dataset)."""

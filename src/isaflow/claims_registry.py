@@ -79,8 +79,9 @@ TANK_METHOD = "{tank_method}"
 
 
 def _expand_runs(spec, path):
-    """Every ``runs`` and ``controls`` list of a registry file in place: '{tank_method}' entries become one per tank method
-    (registry order); a run naming no registered method is refused (InputError naming the file and entry)."""
+    """Every ``runs`` and ``controls`` list of a registry file in place: '{tank_method}' entries become one per
+    tank method (registry order); a run naming no registered method is refused (InputError naming the file and
+    entry)."""
     methods = registry()
     tank = [name for name, m in methods.items() if m.tank]
     entries = [(f"inputs.{k}", i) for k, i in enumerate(spec.get("inputs", []))] + [
@@ -209,14 +210,17 @@ def roots(claims):
 def declared_runs(entry, inputs, entries=None):
     """The run keys ('<method>:<run id>' or a group '<method>:<group>') a claim's measure may read: its runs and
     controls, its deviation's runs and the runs of each of its inferred inputs (inputs: {input id: input}); with
-    entries ({claim id: entry}), also those of the rows it depends on (an aggregate measures through theirs)."""
-    keys = {r["id"] for r in entry.get("runs", []) + entry.get("controls", [])}
-    keys |= {r["id"] for r in entry.get("deviation", {}).get("runs", [])}
-    for name in entry.get("inferred_inputs", []):
-        keys |= {r["id"] for r in inputs.get(name, {}).get("runs", [])}
-    for dep in entry.get("depends_on", []) if entries else []:
-        if dep in entries and dep != entry["id"]:
-            keys |= declared_runs(entries[dep], inputs, {k: e for k, e in entries.items() if k != entry["id"]})
+    entries ({claim id: entry}), also those of the rows it depends on, transitively (an aggregate measures through
+    theirs)."""
+    keys, todo, seen = set(), [entry], set()
+    while todo:
+        e = todo.pop()
+        seen.add(e["id"])
+        keys |= {r["id"] for r in e.get("runs", []) + e.get("controls", [])}
+        keys |= {r["id"] for r in e.get("deviation", {}).get("runs", [])}
+        for name in e.get("inferred_inputs", []):
+            keys |= {r["id"] for r in inputs.get(name, {}).get("runs", [])}
+        todo += [entries[d] for d in e.get("depends_on", []) if entries and d in entries and d not in seen]
     return keys
 
 
