@@ -300,15 +300,16 @@ def write(ds, path):
 UNUSABLE = ("escaped", "nonfinite", "solver_failed")  # outcomes whose final state no run may continue
 
 
-def start_problem(ds, path, method, needs=()):
+def start_problem(ds, path, method, needs=(), unusable=UNUSABLE):
     """Why the open run file ds (at path) cannot start a run of ``method``, in one line, or None: a run of another
-    method, a variable or attribute of needs missing, or an outcome of UNUSABLE (every method's start check)."""
+    method, a variable or attribute of needs missing, or an outcome of unusable (every method's start check;
+    unusable=() leaves the outcome to a later call)."""
     if ds.attrs.get("method") != method:
         return f"'{path}' is a run of method '{ds.attrs.get('method')}', not an {method.upper()} run"
     missing = [n for n in needs if n not in ds.variables and n not in ds.attrs]
     if missing:
         return f"'{path}' holds no {method.upper()} state ({', '.join(missing)} missing)"
-    if ds.attrs.get("status") in UNUSABLE:
+    if ds.attrs.get("status") in unusable:
         return f"'{path}' holds no valid state (status {ds.attrs['status']})"
     return None
 

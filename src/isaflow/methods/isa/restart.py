@@ -78,8 +78,8 @@ def _chain(ds, spacing, weight):
 
 def _read_start(scene, ds, src, where, field):
     """(pos, weight, steps, spacing, (state, why)) of an open start file, shapes checked before loading."""
-    problem = runfile.start_problem(ds, src, "isa")
-    if problem and "status" not in problem:  # the state's own checks come first (shapes, count), then the status
+    problem = runfile.start_problem(ds, src, "isa", unusable=())  # the method first, the outcome after the shapes
+    if problem:
         raise SceneError(f"{where}: {problem}")
     shapes = {"pos": ("particle", "xy"), "weight": ("particle",), "steps": ()}
     for name, dims in shapes.items():
@@ -89,6 +89,7 @@ def _read_start(scene, ds, src, where, field):
     if ds.sizes["xy"] != 2 or n == 0:
         raise SceneError(f"{where}: '{src}' holds no particles in 2D")
     budget.check_count(scene, n, field)
+    problem = runfile.start_problem(ds, src, "isa")
     if problem:
         raise SceneError(f"{where}: {problem}")
     pos = np.asarray(ds["pos"].values, float)

@@ -34,7 +34,7 @@ def check(tank, settings, start=None):
                                                                     "initial_depth"))
             if problem:
                 raise InputError(f"--start: {problem}")
-            if not np.isclose(float(ds.attrs.get("spacing", np.nan)), l0, rtol=1e-9):
+            if not np.isclose(float(ds.attrs["spacing"]), l0, rtol=1e-9):
                 raise InputError(f"--start: '{start}' has spacing {ds.attrs.get('spacing')} cm, this run asks for "
                                  f"{l0:.6g} cm")
 
