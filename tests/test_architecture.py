@@ -6,6 +6,7 @@ import ast
 import re
 import subprocess
 import sys
+from pathlib import Path
 
 import pytest
 
@@ -91,26 +92,52 @@ with SnakemakeApi() as api:
 
     rules = json.loads(out.stdout.strip().splitlines()[-1])
     assert len(rules) >= 20
-    missing, seen = {}, {}
+    modules = sorted({"isaflow." + r["func"].rsplit(".", 1)[0] for r in rules.values()})
+    seen = _loaded_by_import(modules)
+    missing = {}
     for name, r in rules.items():
-        module = "isaflow." + r["func"].rsplit(".", 1)[0]
-        if module not in seen:
-            seen[module] = _loaded_by_import(module)
-        lacking = sorted(seen[module] - set(r["code"]))
+        lacking = sorted(seen["isaflow." + r["func"].rsplit(".", 1)[0]] - set(r["code"]))
         if lacking:
             missing[name] = lacking
     assert not missing, missing
 
 
-def _loaded_by_import(module):
-    """Repository paths of the isaflow modules a fresh interpreter holds after importing module, and the
-    static closure of module's imports."""
-    loaded = subprocess.run([sys.executable, "-c", f"import sys, importlib; importlib.import_module({module!r}); "
-                             "print('\\n'.join(m.__file__ for n, m in sys.modules.items() "
-                             "if n.startswith('isaflow') and getattr(m, '__file__', None)))"],
-                            cwd=ROOT, capture_output=True, text=True, timeout=120)
-    files = {str(__import__('pathlib').Path(f).resolve().relative_to(ROOT)) for f in loaded.stdout.split()}
-    return files | set(deps.closure(module))
+# imports each module in a child forked from one interpreter that holds the third-party libraries already
+# (none of them imports isaflow), so each child starts with no isaflow module loaded, as a fresh interpreter
+_FORKED_IMPORTS = """
+import importlib, json, os, sys
+import matplotlib, netCDF4, numba, numpy, pandas, scipy.sparse, xarray, yaml, jsonschema  # noqa: F401
+assert not any(n.startswith('isaflow') for n in sys.modules)
+out = {}
+for module in sys.argv[1:]:
+    r, w = os.pipe()
+    if os.fork() == 0:
+        os.close(r)
+        importlib.import_module(module)
+        files = [m.__file__ for n, m in list(sys.modules.items()) if n.startswith('isaflow') and getattr(m, '__file__', None)]
+        os.write(w, json.dumps(files).encode())
+        os._exit(0)
+    os.close(w)
+    with os.fdopen(r) as f:
+        out[module] = json.loads(f.read())
+    assert os.wait()[1] == 0, module
+print(json.dumps(out))
+"""
+
+
+def _loaded_by_import(modules):
+    """{module: repository paths of the isaflow modules an interpreter holds after importing it (from no
+    isaflow module loaded), and the static closure of its imports}."""
+    import json
+
+    loaded = subprocess.run([sys.executable, "-c", _FORKED_IMPORTS, *modules], cwd=ROOT, capture_output=True,
+                            text=True, timeout=300)
+    assert loaded.returncode == 0, loaded.stderr[-3000:]
+    out = {}
+    for module, paths in json.loads(loaded.stdout.strip().splitlines()[-1]).items():
+        files = {str(Path(f).resolve().relative_to(ROOT)) for f in paths}
+        out[module] = files | set(deps.closure(module))
+    return out
 
 
 def test_changing_a_shared_module_reruns_every_dependent_figure(tmp_path):

@@ -1,5 +1,6 @@
 """The one run driver (isaflow.driver): its stop decision, rest clock and progress cadence, on toy steppers."""
 
+import dataclasses
 import math
 
 from isaflow import driver
@@ -35,7 +36,14 @@ class Toy:
         return f"advance {self.k}"
 
     def result(self, run):
-        return run
+        return ToyResult(**dataclasses.asdict(run) | {"monitor": run.monitor})
+
+
+@dataclasses.dataclass
+class ToyResult(driver.Run):
+    """The Run a toy stepper hands back, with the params a contract.Result carries."""
+
+    params: dict = dataclasses.field(default_factory=dict)
 
 
 def test_at_rest_after_a_window_below_the_ratio_counted_from_the_runs_start():
@@ -43,6 +51,9 @@ def test_at_rest_after_a_window_below_the_ratio_counted_from_the_runs_start():
     # quiet from advance 3 (t = 10.75 s); the window of 1 s is full at advance 7
     assert (run.status, run.message) == ("converged", "at rest since 10.75")
     assert math.isclose(run.time_to_rest, 0.75) and run.wall_time >= 0.0
+    # the driver writes what the monitor decided into the result's params, from the run's own start
+    assert run.params == {"rest_energy_ratio": 1e-3, "rest_window": 1.0, "time_to_rest": run.time_to_rest,
+                          "final_energy_ratio": 1e-4, "start_time": 10.0}
 
 
 def test_the_steppers_outcome_comes_before_rest_and_budget():
@@ -55,6 +66,7 @@ def test_the_steppers_outcome_comes_before_rest_and_budget():
 def test_rest_is_judged_only_for_a_method_with_rest_settings():
     run = driver.drive(Toy([0.0], budget=20), None)  # a static method: never at rest by the monitor
     assert run.status == "step_limit" and run.monitor is None and math.isnan(run.time_to_rest)
+    assert run.params == {}  # nothing of rest added to a static method's result
 
 
 def test_progress_lines_at_the_cadence():

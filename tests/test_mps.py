@@ -495,10 +495,10 @@ def test_thin_walls_are_the_dividing_walls():
     of the single tank are not."""
     for path in FLOWS:
         tank = load_tank(path)
-        thin = boundary.thin_walls(tank.walls, solver.vessels(tank))
+        thin = boundary.thin_walls(tank.walls, tank.vessels)
         assert [n for n, f in zip(tank.wall_names, thin) if f] == ["right1"]
     tank = load_tank(TANK)
-    assert not boundary.thin_walls(tank.walls, solver.vessels(tank)).any()
+    assert not boundary.thin_walls(tank.walls, tank.vessels).any()
 
 
 @pytest.mark.parametrize("path", FLOWS)
@@ -507,7 +507,7 @@ def test_wall_particles_and_panels(path):
     either side; each face's first row faces exactly the wall's length; particles of a face at least l0/2
     apart; P = 1 on every wall particle loads each 10 cm panel of each face with 10 N/cm x 1 cm."""
     tank = load_tank(path)
-    thin = boundary.thin_walls(tank.walls, solver.vessels(tank))
+    thin = boundary.thin_walls(tank.walls, tank.vessels)
     l0 = 5.0
     b = boundary.wall_particles(tank.walls, l0, 4, 2, thin)
     assert set(np.unique(b["kind"])) == {model.WALL, model.DUMMY}
@@ -712,7 +712,7 @@ def test_drop_test_no_particle_crosses_any_wall(variant):
     speed = np.sqrt(2 * units.G * 122.5)
     for path in FLOWS:
         tank = load_tank(path)
-        thin = boundary.thin_walls(tank.walls, solver.vessels(tank))
+        thin = boundary.thin_walls(tank.walls, tank.vessels)
         for w, name in enumerate(tank.wall_names):
             for side in ((1, -1) if thin[w] else (1,)):
                 bad, vel, n = drop(tank, w, side, variant, COARSE)

@@ -83,7 +83,7 @@ def test_pair_list_is_the_brute_force_list_with_visibility():
     # every pair within rc once, liquid first; across a wall only liquid-wall pairs, along it only liquid ones
     dx = dy = 5.0
     wpos, owner, face = P.wall_particles(FLOW.walls, dx, dy, 2 * 1.3 * dx,
-                                         two_faced=P.wet_back(FLOW.walls, solver.vessels_of(FLOW)))
+                                         two_faced=P.wet_back(FLOW.walls, FLOW.vessels))
     rng = np.random.default_rng(1)
     liquid = np.concatenate([rng.uniform([1, 1], [99, 99], (300, 2)), rng.uniform([101, -49], [299, 99], (300, 2))])
     x = np.concatenate([liquid, wpos])
@@ -107,9 +107,9 @@ def test_pair_list_is_the_brute_force_list_with_visibility():
 def test_wall_particles_cover_both_faces_of_the_dividing_wall():
     dx = dy = 2.5
     h = 1.3 * dx
-    two = P.wet_back(FLOW.walls, solver.vessels_of(FLOW))
+    two = P.wet_back(FLOW.walls, FLOW.vessels)
     assert [n for n, t in zip(FLOW.wall_names, two) if t] == ["right1"]  # left2's back is under floor1
-    assert not P.wet_back(SAME.walls, solver.vessels_of(SAME))[[0, 1, 3, 4]].any()
+    assert not P.wet_back(SAME.walls, SAME.vessels)[[0, 1, 3, 4]].any()
     wpos, owner, face = P.wall_particles(FLOW.walls, dx, dy, 2 * h, two_faced=two)
     r1 = owner == 2
     # right1 (x = 100, y 20..100): layers on both sides covering the support 2h, from its tip to its top

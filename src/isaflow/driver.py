@@ -17,6 +17,9 @@ supplies a *stepper* and nothing else:
 - ``progress(monitor)``: one progress line;
 - ``result(run)``: the contract.Result, from the final :class:`Run`.
 
+The driver adds to the Result's params what the rest monitor decided (rest_energy_ratio, rest_window,
+time_to_rest, final_energy_ratio, start_time: the same names and time origin for every dynamic method).
+
 Per advance the decision is: the stepper's outcome, else ``converged`` once the monitor is at rest,
 else ``step_limit`` once the budget is spent, else go on.
 """
@@ -67,4 +70,8 @@ def drive(stepper, rest=None, log=None, every=LOG_EVERY):
             last_log = now
     wall_time = time.perf_counter() - started
     at = monitor.time_to_rest() - stepper.t0 if monitor is not None and status == "converged" else math.nan
-    return stepper.result(Run(status, message, wall_time, monitor, at))
+    result = stepper.result(Run(status, message, wall_time, monitor, at))
+    if monitor is not None:
+        result.params.update(rest_energy_ratio=monitor.limit, rest_window=monitor.window, time_to_rest=at,
+                             final_energy_ratio=monitor.last, start_time=float(stepper.t0))
+    return result

@@ -32,6 +32,15 @@ def _segments(spec):
     return [tuple(float(c) for c in w["from"] + w["to"]) for w in spec["walls"]]
 
 
+def vessel_counts(pos, vessels):
+    """(V,) int64: particles of pos (N, 2) [cm] whose x lies in each vessel's [xmin, xmax) range;
+    vessels: [(name, (xmin, xmax) cm)] (Tank.vessels)."""
+    import numpy as np
+
+    x = np.asarray(pos, float)[:, 0]
+    return np.array([np.count_nonzero((x >= a) & (x < b)) for _, (a, b) in vessels], np.int64)
+
+
 def vessel_floor(walls, x0, x1):
     """y [cm] of the floor of a vessel over (x0, x1): the lowest horizontal wall running inside that range (a
     floor only touching its end belongs to the next vessel); None if there is none.  walls: [(x0, y0, x1, y1)]."""

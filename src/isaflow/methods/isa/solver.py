@@ -19,6 +19,7 @@ from ... import driver, rest as REST
 from ...contract import Result, wall_resultants
 from ...core.geometry import bounding_box, outside_box
 from ...core.units import G
+from ...tank import vessel_counts
 from . import dynamics as D
 from . import forces as F
 from . import newton as NW
@@ -107,11 +108,6 @@ class ChunkMemo:
 def contacts(pos, walls, s):
     """(particle, wall, point, force) wall contacts of positions under settings s."""
     return F.wall_contacts(pos, walls, s["wall_l_u"], s["wall_r_u"], s["wall_p"])
-
-
-def vessel_counts(pos, vessels):
-    """(V,) particles whose x lies in each vessel's [xmin, xmax) range."""
-    return np.array([np.count_nonzero((pos[:, 0] >= a) & (pos[:, 0] < b)) for _, (a, b) in vessels])
 
 
 def thread_count(threads=None):
@@ -318,14 +314,33 @@ class _Stepper:
 
     def advance(self):
         """One chunk and the outcome checks of its end: (status, message) or None."""
-        s, pos, vel, kernel, force, buf = self.s, self.pos, self.vel, self.kernel, self.force, self.buf
-        step, chunk, resume, memo = self.step, self.chunk, self.resume, self.memo
+        s, pos, step, chunk, resume = self.s, self.pos, self.step, self.chunk, self.resume
         # chunks end on multiples of `chunk` counted from the chain's start, so
         # a run continued from a state file repeats an uninterrupted run exactly
         n = min(chunk - step % chunk, s["max_steps"] - step) if step < s["max_steps"] else 0
         origin = step - step % chunk if resume else step  # history strides count from here
         if not resume:
             self.chunk_start = pos.copy()
+        done, code, crossing = self._run_chunk(n, resume)
+        self.resume = False
+        if not self.newton:
+            self.max_step_move = max(self.max_step_move, float(self.kernel[4]))
+        h = self.buf[:done]
+        if self.hist.every:
+            self.hist.steps(step, h, origin, self.ke_buf[:done] if self.overdamped else None)
+        self.step = step + done
+        self.n_chunk += 1
+        self.recent = np.concatenate([self.recent, h])[-2000:]
+        self.fmax_last = float(h[-1]) if done else np.nan
+        self.quiet_end = False
+        if n == 0 and code != R.NONFINITE:  # started at or past max_steps: forces evaluated once, nothing moved
+            self.quiet_end = True
+            return ("converged", "") if self._fmax() < s["f_tol"] else ("step_limit", self.limit_message())
+        return self._outcome(code, crossing)
+
+    def _run_chunk(self, n, resume):
+        """Up to n steps of the update rule's compiled loop -> (steps done, R code, crossing)."""
+        s, pos, vel, kernel, force, buf, memo = self.s, self.pos, self.vel, self.kernel, self.force, self.buf, self.memo
         if self.overdamped:
             rc = self.rest_cfg
             done, code, crossing = D.overdamped_resume(
@@ -335,43 +350,30 @@ class _Stepper:
                 s["pair_p"],
             )
             self.evals += done + 1
-        elif self.newton:
+            return done, code, crossing
+        if self.newton:
             done, code, crossing = NW.newton_resume(
                 pos, self.weight, self.walls, self.box, s["wall_l_u"], s["wall_r_u"], s["pair_l_u"], s["pair_r_u"],
                 s["f_tol"], n, s["skin"], force, buf, self.nstate, self.counts)
             self.evals = int(self.counts[3])  # the chunk's first evaluation and every trial step
-            code = {NW.CONVERGED: R.CONVERGED, NW.NONFINITE: R.NONFINITE, NW.STALLED: NW.STALLED}.get(code, R.RUNNING)
-        else:
-            state_arrays = (pos, vel, self.pos_build, kernel, force)
-            key = memo.key(state_arrays, n) if memo is not None and not resume else None
-            out = memo.get(key, state_arrays, buf) if key is not None else None
-            if out is None:
-                out = R.relax_resume(
-                    pos, vel, self.weight, self.walls, self.box, s["wall_l_u"], s["wall_r_u"], s["pair_l_u"],
-                    s["pair_r_u"], RULES[s["variant"]], s["du"], s["f_ref"], s["dt_max"], s["f_tol"], n, s["skin"],
-                    force, buf, self.pos_build, kernel, resume, self.threads, s["wall_p"], s["pair_p"],
-                )
-                if key is not None:
-                    memo.put(key, state_arrays, buf, out)
-            done, code, crossing = out
-            self.evals += done + 1  # one evaluation per step taken, plus the chunk's initial one
-        self.resume = False
-        if not self.newton:
-            self.max_step_move = max(self.max_step_move, float(kernel[4]))
-        h = buf[:done]
-        if self.hist.every:
-            self.hist.steps(step, h, origin, self.ke_buf[:done] if self.overdamped else None)
-        self.step = step = step + done
-        self.n_chunk += 1
-        self.recent = np.concatenate([self.recent, h])[-2000:]
-        self.fmax_last = float(h[-1]) if done else np.nan
-        self.quiet_end = False
-        if n == 0:  # started at or past max_steps: forces evaluated once, nothing moved
-            if code != R.NONFINITE:
-                self.quiet_end = True
-                if np.abs(force).max(initial=0.0) < s["f_tol"]:
-                    return "converged", ""
-                return "step_limit", self.limit_message()
+            return done, {NW.CONVERGED: R.CONVERGED, NW.NONFINITE: R.NONFINITE, NW.STALLED: NW.STALLED}.get(code, R.RUNNING), crossing
+        state_arrays = (pos, vel, self.pos_build, kernel, force)
+        key = memo.key(state_arrays, n) if memo is not None and not resume else None
+        out = memo.get(key, state_arrays, buf) if key is not None else None
+        if out is None:
+            out = R.relax_resume(
+                pos, vel, self.weight, self.walls, self.box, s["wall_l_u"], s["wall_r_u"], s["pair_l_u"],
+                s["pair_r_u"], RULES[s["variant"]], s["du"], s["f_ref"], s["dt_max"], s["f_tol"], n, s["skin"],
+                force, buf, self.pos_build, kernel, resume, self.threads, s["wall_p"], s["pair_p"],
+            )
+            if key is not None:
+                memo.put(key, state_arrays, buf, out)
+        self.evals += out[0] + 1  # one evaluation per step taken, plus the chunk's initial one
+        return out
+
+    def _outcome(self, code, crossing):
+        """(status, message) of a chunk's end code and the checks after it (box, cycle), or None: go on."""
+        s, pos, step = self.s, self.pos, self.step
         if code == R.CONVERGED:
             return "converged", ""
         if code == R.NONFINITE:
@@ -383,7 +385,7 @@ class _Stepper:
             return "escaped", (f"particle {i} at ({pos[i, 0]:.4g}, {pos[i, 1]:.4g}) cm would cross wall "
                                f"'{self.scene.wall_names[w]}' at step {step}; step refused, run stopped")
         if self.newton and code == NW.STALLED:
-            return "step_limit", (f"max|F| = {np.abs(force).max():.4g} N >= f_tol = {s['f_tol']:g} N after {step} "
+            return "step_limit", (f"max|F| = {np.abs(self.force).max():.4g} N >= f_tol = {s['f_tol']:g} N after {step} "
                                   f"steps: no step lowers the energy (Levenberg-Marquardt mu "
                                   f"{self.nstate[0]:.3g} N/cm)")
         out = outside_box(pos, self.box)

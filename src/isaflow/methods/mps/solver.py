@@ -24,20 +24,15 @@ import numpy as np
 from isaflow import driver, rest
 from isaflow.contract import Result
 from isaflow.core import units
+from isaflow.tank import vessel_counts
 
 from . import boundary, model, pressure
-
-
-def vessels(tank):
-    """[(name, (xmin, xmax) cm)] of the tank's vessels; one spanning the walls if it names none."""
-    w = tank.walls
-    return tank.vessels or [("vessel", (float(w[:, [0, 2]].min()), float(w[:, [0, 2]].max())))]
 
 
 def first_vessel(tank):
     """(x range (cm, cm), floor y cm) of the tank's first vessel (floor: the highest horizontal wall spanning it
     with the liquid above, i.e. running in +x)."""
-    x0, x1 = vessels(tank)[0][1]
+    x0, x1 = tank.vessels[0][1]
     w = tank.walls
     span = np.minimum(np.maximum(w[:, 0], w[:, 2]), x1) - np.maximum(np.minimum(w[:, 0], w[:, 2]), x0)
     floors = np.isclose(w[:, 1], w[:, 3]) & (span > 0) & (w[:, 2] > w[:, 0])
@@ -64,7 +59,7 @@ class State:
         self.l0 = l0
         self.walls = np.asarray(tank.walls, float)
         self.nf = len(fluid_pos)
-        self.thin_mask = boundary.thin_walls(self.walls, vessels(tank))
+        self.thin_mask = boundary.thin_walls(self.walls, tank.vessels)
         layers = cfg["model.pressure_layers"] + cfg["model.dummy_layers"]
         self.pos, self.kind, self.bnd = boundary.assemble_particles(fluid_pos, self.walls, l0, layers,
                                                                     cfg["model.pressure_layers"], self.thin_mask)
@@ -180,8 +175,42 @@ class State:
 
 def step(s, dt, source, cfg, timers=None):
     """Advance State s by one step.  Returns (bad, residual, iterations); bad as model.check
-    (kind 4: the pressure solve failed outright or gave a non-finite pressure; residual inf)."""
+    (kind 4: the pressure solve failed outright or gave a non-finite pressure; residual inf).
+    timers: (3,) s accumulated in predict (to the assembled system), solve and correct."""
     t0 = time.perf_counter()
+    pos_old = s.pos
+    ps, vs, b_ecs = _predict(s, dt, cfg)
+    dist, surf, normal, p_dir, row, system = _pressure_system(s, ps, vs, dt, source, cfg, b_ecs)
+    t1 = time.perf_counter()
+    unk = row >= 0
+    x0 = np.zeros(int(unk.sum()))
+    x0[row[unk]] = s.p[unk]
+    try:
+        x, resid, its = pressure.solve_csr(*system, cfg["pressure.solver"], cfg["pressure.rtol"],
+                                           cfg["pressure.maxiter"], x0)
+    except (RuntimeError, ValueError, ArithmeticError) as err:  # e.g. SuperLU "matrix is exactly singular"
+        x, resid, its = np.full(len(system[-1]), np.nan), np.inf, 0
+        s.solve_error = str(err)
+    if not np.all(np.isfinite(x)):
+        resid = np.inf
+    t2 = time.perf_counter()
+    if not np.isfinite(resid):
+        if timers is not None:
+            timers += (t1 - t0, t2 - t1, 0.0)
+        return (4, -1, -1), resid, its
+    p = p_dir.copy()
+    p[unk] = x[row[unk]]
+    if cfg["model.clip_negative"]:
+        p = np.maximum(p, 0.0)
+    bad = _correct(s, pos_old, ps, vs, p, dist, surf, normal, dt, cfg)
+    if timers is not None:
+        timers += (t1 - t0, t2 - t1, time.perf_counter() - t2)
+    return bad, resid, its
+
+
+def _predict(s, dt, cfg):
+    """The explicit part of a step (viscosity, gravity, collisions, reflection) -> (ps, vs) (P, 2) predicted
+    positions [cm] and velocities [cm/s], b_ecs (P,) the ECS source term (None without it)."""
     pos_old = s.pos
     if s.start is None or not s.list_valid(s.pos):
         s.neighbours(s.pos)
@@ -193,6 +222,7 @@ def step(s, dt, source, cfg, timers=None):
         lap = model.laplacian(s.vel, s.kind, s.start, s.nbr, dist, s.re_l, s.n0_l, s.lam)
     else:
         lap = np.zeros_like(s.vel)
+    b_ecs = None
     if ecs:
         n_now = model.number_density(s.start, s.nbr, dist, s.re_n)
         b_ecs = model.ecs_term(n_now, n_now if s.n_prev is None else s.n_prev, s.n0_n, s.rho0, dt)
@@ -210,6 +240,13 @@ def step(s, dt, source, cfg, timers=None):
         s.count_reflections(hit)
         if not s.list_valid(ps):
             s.neighbours(ps)
+    return ps, vs, b_ecs
+
+
+def _pressure_system(s, ps, vs, dt, source, cfg, b_ecs):
+    """The pressure Poisson system at the predicted state -> (dist, surf, normal, p_dir, row, (indptr, indices,
+    data, rhs)): pair distances [cm], free-surface flags and normals, Dirichlet pressures [N/cm2], each
+    particle's unknown (-1: none) and the CSR system (model.assemble)."""
     dist = s.distances(ps)
     n_star = model.number_density(s.start, s.nbr, dist, s.re_n)
     if s.div_mode == 1:
@@ -220,7 +257,7 @@ def step(s, dt, source, cfg, timers=None):
     surf, normal = model.surface(ps, s.kind, s.start, s.nbr, dist, s.re_s, s.n0_s, cfg["model.beta"], dist_thr, s.rmax)
     b = model.source_term_all(n_star, div, s.n0_n, s.rho0, dt, model.SOURCES[source], cfg["model.gamma_mixed"],
                               cfg["model.relaxation"], model.RELAX_SCOPES[cfg["model.relaxation_scope"]])
-    if ecs:
+    if b_ecs is not None:
         b = b + b_ecs
     p_dir = np.zeros(len(ps))
     if s.surface_mode == 1:
@@ -231,27 +268,11 @@ def step(s, dt, source, cfg, timers=None):
     extra = s.lam * s.n0_l / (2.0 * model.DIM * sound**2 * dt**2) if sound > 0 else 0.0
     row, indptr, indices, data, rhs = model.assemble(s.kind, surf, p_dir, b, s.start, s.nbr, dist, s.re_l, s.n0_l,
                                                      s.lam, extra, s.lap_mode)
-    t1 = time.perf_counter()
-    unk = row >= 0
-    x0 = np.zeros(int(unk.sum()))
-    x0[row[unk]] = s.p[unk]
-    try:
-        x, resid, its = pressure.solve_csr(indptr, indices, data, rhs, cfg["pressure.solver"], cfg["pressure.rtol"],
-                                           cfg["pressure.maxiter"], x0)
-    except (RuntimeError, ValueError, ArithmeticError) as err:  # e.g. SuperLU "matrix is exactly singular"
-        x, resid, its = np.full(len(rhs), np.nan), np.inf, 0
-        s.solve_error = str(err)
-    if not np.all(np.isfinite(x)):
-        resid = np.inf
-    t2 = time.perf_counter()
-    if not np.isfinite(resid):
-        if timers is not None:
-            timers += (t1 - t0, t2 - t1, 0.0)
-        return (4, -1, -1), resid, its
-    p = p_dir.copy()
-    p[unk] = x[row[unk]]
-    if cfg["model.clip_negative"]:
-        p = np.maximum(p, 0.0)
+    return dist, surf, normal, p_dir, row, (indptr, indices, data, rhs)
+
+
+def _correct(s, pos_old, ps, vs, p, dist, surf, normal, dt, cfg):
+    """The pressure-gradient correction, shifting and reflection; stores the new state in s -> bad (model.check)."""
     g = model.gradient(ps, p, s.kind, s.start, s.nbr, dist, s.re_g, s.n_grad, s.grad_mode)
     s.pair_state = (ps, dist, s.start, s.nbr)
     pos, vel = model.update(ps, vs, s.kind, g, s.rho0, dt)
@@ -271,13 +292,7 @@ def step(s, dt, source, cfg, timers=None):
     if graze > 0.0:
         s.grazes += 1
         s.deepest_graze = max(s.deepest_graze, graze)
-    if timers is not None:
-        timers += (t1 - t0, t2 - t1, time.perf_counter() - t2)
-    return bad, resid, its
-
-
-def _vessel_counts(pos, tank):
-    return [int(np.count_nonzero((pos[:, 0] >= a) & (pos[:, 0] < b))) for _, (a, b) in vessels(tank)]
+    return bad
 
 
 def solve(tank, cfg, variant, spacing, t_end, probes, start=None, snapshots=0, log=print, threads=None,
@@ -406,7 +421,7 @@ class _Stepper:
             rec["rms"].append(np.sqrt(speed2.mean()))
             rec["vmax"].append(np.sqrt(speed2.max()))
             rec["energy"].append(e)
-            rec["count"].append(_vessel_counts(s.pos[: s.nf], self.tank))
+            rec["count"].append(vessel_counts(s.pos[: s.nf], self.tank.vessels))
             rec["resid"].append(self.resid)
             rec["iters"].append(self.its)
             rec["surf"].append(int(s.surf[: s.nf].sum()))
@@ -439,19 +454,32 @@ class _Stepper:
 
     def result(self, run):
         """contract.Result of the run."""
-        s, cfg, tank, rec, l0, t0, k = self.s, self.cfg, self.tank, self.rec, self.l0, self.t0, self.k
-        variant, threads, depth0, origin, probes = self.variant, self.threads, self.depth0, self.origin, self.probes
-        dt0, vcfl, dt_min, short_steps, t_end = self.dt0, self.vcfl, self.dt_min, self.short_steps, self.t_end
-        snaps, snap_t, p_means, max_resid, iters = self.snaps, self.snap_t, self.p_means, self.max_resid, self.iters
-        timers, pos0, elapsed, step0 = self.timers, self.pos0, self.elapsed, self.step0
-        status, message, wall, monitor = run.status, run.message, run.wall_time, run.monitor
-        rms = float(np.sqrt((s.vel[: s.nf] ** 2).sum(1).mean()))
+        s, rec, monitor = self.s, self.rec, run.monitor
         times = np.array(rec["time"])
-        e_mean, e_max, rms_window = self._window_energy(monitor)
-        t_rest = run.time_to_rest
         pairwise = s.grad_mode in model.PAIRWISE  # momentum exchange is defined: the pair forces are the contacts
         panels = np.array(rec["pair" if pairwise else "panel"])
-        window = times >= times[-1] - cfg["time.average_window"] + 1e-12
+        window = times >= times[-1] - self.cfg["time.average_window"] + 1e-12
+        p_window = [q for tq, q in self.p_means if tq >= times[-1] - self.cfg["time.average_window"] + 1e-12]
+        fields = {
+            "pressure": (("particle",), s.p[: s.nf].copy(), "N cm-2", "pressure of each liquid particle at the end"),
+            "pressure_mean": (("particle",), np.mean(p_window, axis=0), "N cm-2",
+                              "pressure of each liquid particle, mean over the steps of the averaging window (the pressure "
+                              "alternates from step to step)"),
+            "velocity": (("particle", "xy"), s.vel[: s.nf].copy(), "cm s-1", "velocity of each liquid particle at the end"),
+        }
+        rms_window = self._window_energy(monitor)[2]
+        return Result(
+            method="mps", variant=self.variant, pos0=self.pos0, pos=s.pos[: s.nf].copy(), weight=np.full(s.nf, s.weight),
+            contact_wall=s.panel_wall, contact_point=s.panel_centre, contact_force=panels[window].mean(0),
+            status=run.status, message=run.message, steps=self.step0 + self.k, start_step=self.step0,
+            wall_time=run.wall_time, force_evals=self.k, residual=rms_window,
+            residual_name=f"rms speed over the last {monitor.window:g} s", residual_units="cm s-1",
+            sim_time=self.t0 + self.elapsed, history=self._history(times, panels, window, pairwise), fields=fields,
+            params=self._params(run, pairwise))
+
+    def _history(self, times, panels, window, pairwise):
+        """The run file's sample_* and snap_* variables."""
+        rec = self.rec
         hist = {
             "sample_time": (("sample",), times, "s", "time of sample"),
             "sample_panel_force": (("sample", "contact", "xy"), panels, "N",
@@ -474,26 +502,25 @@ class _Stepper:
             "sample_solve_residual": (("sample",), np.array(rec["resid"]), "1", "relative residual of the pressure solve"),
             "sample_solve_iterations": (("sample",), np.array(rec["iters"]), "1", "iterations of the pressure solve"),
             "sample_surface_count": (("sample",), np.array(rec["surf"]), "1", "liquid particles on the free surface"),
-            "probe_point": (("probe", "xy"), probes, "cm", "pressure probe position"),
+            "probe_point": (("probe", "xy"), self.probes, "cm", "pressure probe position"),
             "in_window": (("sample",), window.astype(np.int8), "1", "1 if the sample is in the averaging window"),
         }
-        if snaps:
-            hist["snap_time"] = (("snapshot",), np.array(snap_t), "s", "time of position snapshot")
-            hist["snap_pos"] = (("snapshot", "particle", "xy"), np.array(snaps), "cm", "liquid particle positions at snapshot")
-        p_window = [q for tq, q in p_means if tq >= times[-1] - cfg["time.average_window"] + 1e-12]
-        fields = {
-            "pressure": (("particle",), s.p[: s.nf].copy(), "N cm-2", "pressure of each liquid particle at the end"),
-            "pressure_mean": (("particle",), np.mean(p_window, axis=0), "N cm-2",
-                              "pressure of each liquid particle, mean over the steps of the averaging window (the pressure "
-                              "alternates from step to step)"),
-            "velocity": (("particle", "xy"), s.vel[: s.nf].copy(), "cm s-1", "velocity of each liquid particle at the end"),
-        }
+        if self.snaps:
+            hist["snap_time"] = (("snapshot",), np.array(self.snap_t), "s", "time of position snapshot")
+            hist["snap_pos"] = (("snapshot", "particle", "xy"), np.array(self.snaps), "cm",
+                                "liquid particle positions at snapshot")
+        return hist
+
+    def _params(self, run, pairwise):
+        """The run file's attributes (settings, counters, the tank difference; the driver adds the rest ones)."""
+        s, cfg, tank, l0, depth0, timers = self.s, self.cfg, self.tank, self.l0, self.depth0, self.timers
+        e_mean, e_max, rms_window = self._window_energy(run.monitor)
         nb = np.bincount(s.kind, minlength=3)
         rows_note = (f"depth rounded to whole rows: {depth0:.4g} cm (tank {tank.depth:g} cm), weight held at {tank.weight:g} N"
                      if abs(depth0 - tank.depth) > 1e-9 else "none")
-        params = {
-            "source_term": variant, "spacing_cm": l0, "dt_s": dt0, "velocity_courant": vcfl, "min_dt_s": dt_min,
-            "short_steps": short_steps, "rho0_N_s2_cm4": s.rho0, "particle_weight_N": s.weight,
+        return {
+            "source_term": self.variant, "spacing_cm": l0, "dt_s": self.dt0, "velocity_courant": self.vcfl,
+            "min_dt_s": self.dt_min, "short_steps": self.short_steps, "rho0_N_s2_cm4": s.rho0, "particle_weight_N": s.weight,
             "re_density_cm": s.re_n, "re_gradient_cm": s.re_g, "re_laplacian_cm": s.re_l, "re_surface_cm": s.re_s,
             "n0_density": s.n0_n, "n0_laplacian": s.n0_l, "n0_gradient": s.n0_g, "n0_surface": s.n0_s,
             "gradient_norm": s.n_grad, "relaxation_scope": cfg["model.relaxation_scope"],
@@ -504,27 +531,21 @@ class _Stepper:
             "ecs": int(cfg["model.ecs"]),
             "surface_distribution": cfg["model.surface_distribution"], "kinematic_viscosity_cm2_s": cfg["model.kinematic_viscosity"],
             "gamma_mixed": cfg["model.gamma_mixed"], "courant": cfg["time.courant"], "pressure_solver": cfg["pressure.solver"],
-            "pressure_rtol": cfg["pressure.rtol"], "max_solve_residual": max_resid, "mean_solve_iterations": float(np.mean(iters)),
-            "average_window_s": cfg["time.average_window"], "time_limit_s": float(t_end), "wall_particles": int(nb[model.WALL]),
+            "pressure_rtol": cfg["pressure.rtol"], "max_solve_residual": self.max_resid,
+            "mean_solve_iterations": float(np.mean(self.iters)),
+            "average_window_s": cfg["time.average_window"], "time_limit_s": float(self.t_end), "wall_particles": int(nb[model.WALL]),
             "dummy_particles": int(nb[model.DUMMY]), "thin_walls": ",".join(n for n, f in zip(tank.wall_names, s.thin_mask) if f) or "none",
             "time_predict_s": timers[0], "time_solve_s": timers[1], "time_correct_s": timers[2], "list_builds": s.builds,
             "collision_distance_cm": cfg["model.collision_distance"] * l0, "restitution": cfg["model.restitution"],
             "settings_file": cfg.path, "panel_length": cfg["walls.panel_length"], "graze_depth_cm": s.graze_depth,
             "graze_steps": s.grazes, "deepest_graze_cm": s.deepest_graze, "wall_reflect": int(cfg["walls.reflect"]),
-            "reflect_steps": s.reflect_steps, "reflected_particles": s.reflections, "escapes": int(status == "escaped"),
-            "threads": threads, "start_state": origin,
+            "reflect_steps": s.reflect_steps, "reflected_particles": s.reflections, "escapes": int(run.status == "escaped"),
+            "threads": self.threads, "start_state": self.origin,
             "layer_pitch": l0, "held_weight": float(s.weight * s.nf), "initial_depth": depth0, "tank_difference": rows_note,
-            "rest_energy_ratio": monitor.limit, "rest_window": monitor.window, "rest_depth_cm": depth0,
-            "time_to_rest": t_rest, "final_energy_ratio": monitor.last, "final_rms_speed_cm_s": rms,
+            "rest_depth_cm": depth0, "final_rms_speed_cm_s": float(np.sqrt((s.vel[: s.nf] ** 2).sum(1).mean())),
             "window_energy_ratio_mean": e_mean, "window_energy_ratio_max": e_max, "window_rms_speed_cm_s": rms_window,
             "wall_load_reading": "pair forces" if pairwise else "panel pressures",
         }
-        return Result(
-            method="mps", variant=variant, pos0=pos0, pos=s.pos[: s.nf].copy(), weight=np.full(s.nf, s.weight),
-            contact_wall=s.panel_wall, contact_point=s.panel_centre, contact_force=panels[window].mean(0),
-            status=status, message=message, steps=step0 + k, start_step=step0, wall_time=wall, force_evals=k,
-            residual=rms_window, residual_name=f"rms speed over the last {monitor.window:g} s", residual_units="cm s-1", sim_time=t0 + elapsed,
-            history=hist, fields=fields, params=params)
 
 
 def _solve(tank, cfg, variant, l0, t_end, probes, start, snapshots, log, threads, rest_cfg):

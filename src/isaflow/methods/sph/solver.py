@@ -25,6 +25,7 @@ from ...core import smoothing
 from ...core.geometry import bounding_box
 from ...core.panels import wall_panels
 from ...core.units import DENSITY_2D, G, VELOCITY
+from ...tank import vessel_counts
 from . import kernels as K
 from . import particles as P
 from . import settings as S
@@ -32,17 +33,9 @@ from . import settings as S
 CODES = {K.CROSSED: "escaped", K.LEFT_BOX: "escaped", K.NONFINITE: "nonfinite"}
 
 
-def vessels_of(tank):
-    """[(name, (xmin, xmax) cm)] of the tank's vessels; one spanning the walls if it names none."""
-    w = tank.walls
-    if tank.spec.get("vessels"):
-        return [(v["name"], tuple(float(a) for a in v["x"])) for v in tank.spec["vessels"]]
-    return [("vessel", (float(w[:, [0, 2]].min()), float(w[:, [0, 2]].max())))]
-
-
 def first_vessel(tank):
     """(x0, x1, floor_y) [cm] of the tank's first vessel (its lowest horizontal wall)."""
-    x0, x1 = vessels_of(tank)[0][1]
+    x0, x1 = tank.vessels[0][1]
     walls = tank.walls
     horiz = np.isclose(walls[:, 1], walls[:, 3])
     over = np.minimum(walls[:, [0, 2]].max(1), x1) - np.maximum(walls[:, [0, 2]].min(1), x0) > 1e-9
@@ -121,7 +114,7 @@ def setup(tank, s, resolution, start=None, on_wall=False):
         depth0 = float(pos[:, 1].max() - floor_y + dy / 2)
     else:
         rho = start["density"].values.copy()
-    two = P.wet_back(tank.walls, vessels_of(tank)) if tank.spec.get("vessels") else None
+    two = P.wet_back(tank.walls, tank.vessels) if tank.spec.get("vessels") else None
     wpos, owner, face = P.wall_particles(tank.walls, dx, dy, 2 * h, origin=(x0, floor_y), two_faced=two)
     dt = min(s["cfl"] * h / c0, 0.25 * math.sqrt(h / G))
     return dict(pos=pos, vel=vel, rho=rho, xref=xref, wpos=wpos, owner=owner, face=face, dx=dx, dy=dy, h=h, c0=c0,
@@ -255,7 +248,7 @@ class _Stepper:
         self.held = st["mass"] * G * nf
         n_window = max(1, int(math.ceil(rest_cfg["window"] / (self.n_chunk * dt))))
         self.window, self.lj_window = collections.deque(maxlen=n_window), collections.deque(maxlen=n_window)
-        self.vessels = vessels_of(tank)
+        self.vessels = tank.vessels
         self.rec = collections.defaultdict(list)
         self.snaps = sorted(s["snapshot_times"])
         self.t0, self.step0 = st["t0"], st["step0"]
@@ -307,7 +300,7 @@ class _Stepper:
         per_wall = np.zeros((len(self.walls), 2))
         np.add.at(per_wall, st["owner"], self.window[-1] if self.window else 0.0)
         rec["sample_wall_resultant"].append(per_wall)
-        rec["sample_vessel_count"].append([np.count_nonzero((x[:nf, 0] >= a) & (x[:nf, 0] < b)) for _, (a, b) in self.vessels])
+        rec["sample_vessel_count"].append(vessel_counts(x[:nf], self.vessels))
         return sample
 
     def spent(self):
@@ -332,11 +325,11 @@ class _Stepper:
         """contract.Result of the run (variant 'custom'; solve() names it)."""
         st, s, tank, walls, x, nf, nw = self.st, self.s, self.tank, self.walls, self.x, self.nf, self.nw
         p, rho, v, acc, xref, dt = self.p, self.rho, self.v, self.acc, self.xref, self.dt
-        window, lj_window, rec, rest_cfg = self.window, self.lj_window, self.rec, self.rest_cfg
+        window, lj_window, rec = self.window, self.lj_window, self.rec
         held, ke = self.held, self.ke
         t0, step0, done_total, n_chunk, t_max = self.t0, self.step0, self.done_total, self.n_chunk, self.t_max
         start, resolution, on_wall, flow, vessels = self.start, self.resolution, self.on_wall, self.flow, self.vessels
-        status, message, wall_time, monitor = run.status, run.message, run.wall_time, run.monitor
+        status, message, wall_time = run.status, run.message, run.wall_time
         mean_force = np.mean(np.array(window), axis=0) if window else np.zeros((nw, 2))
         cw, cp, cf, side = _panels(walls, s["panel_length"], st["owner"], st["face"], st["wpos"], mean_force,
                                    st["dx"], st["dy"])
@@ -384,9 +377,7 @@ class _Stepper:
             t_max=t_max, panel_length=s["panel_length"], load_window=len(window) * n_chunk * dt,
             resolution=str(resolution) if start is None else "continued", on_wall=str(bool(on_wall)),
             threads=int(self.threads), layer_pitch=st["dy"], held_weight=held, initial_depth=initial_depth,
-            tank_difference="; ".join(diff), rest_energy_ratio=rest_cfg["energy_ratio"], rest_window=rest_cfg["window"],
-            time_to_rest=run.time_to_rest, start_time=t0,
-            final_energy_ratio=monitor.last, final_rms_speed=math.sqrt(2 * ke / (st["mass"] * nf)),
+            tank_difference="; ".join(diff), final_rms_speed=math.sqrt(2 * ke / (st["mass"] * nf)),
             particles_left=left, list_builds=self.builds)
         return Result(
             method="sph", variant="custom", pos0=st["pos"], pos=x[:nf].copy(), weight=np.full(nf, st["mass"] * G),
