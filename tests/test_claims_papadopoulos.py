@@ -145,7 +145,8 @@ def test_a_longer_time_limit_keeps_a_run_that_ended_at_rest(tmp_path):
         paths[key] = str(tmp_path / f"{status}.nc")
         xr.Dataset({"x": ("n", np.zeros(1), {"units": "1"})}, attrs={"status": status}).to_netcdf(paths[key])
     ctx = claims.Context(paths)
-    label, subs, affected, params = next(v for v in PC.SWEEPS["sph_rest"] if v[0] == "t_max x 3")
+    value = next(v for v in PC.sweeps()["sph_rest"] if v.label == "t_max x 3")
+    subs, affected, params = value.subs, value.affected, value.params
     v = PC.View(ctx, subs, affected, params)
     assert v.key("sph:rested") == "sph:rested"
     with pytest.raises(PC.NoRun):

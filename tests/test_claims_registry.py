@@ -316,6 +316,14 @@ def test_copy_loads(registry_copy):
     ("NaN", "hattori.yaml", "value: 1.5\n", "value: .nan\n", "finite"),
     ("unregistered method", "marko2017.yaml", '{id: "solid:floor_uniform_uniform_load"}', '{id: "dem:floor"}',
      "'dem:floor' names no registered method"),
+    ("sweep value outside the range", "papadopoulos2016.yaml", '- {value: 2000, label: "2000 N/cm"',
+     '- {value: 3000, label: "2000 N/cm"', "sweep: its values"),
+    ("undeclared stand-in run", "papadopoulos2016.yaml", '"isa:single_coarse": "isa:single_coarse_kp1000"',
+     '"isa:single_coarse": "isa:single_coarse_kp1500"', "stands in run 'isa:single_coarse_kp1500'"),
+    ("two kept sweep values", "papadopoulos2016.yaml", 'label: "250 N/cm", runs', 'label: "250 N/cm", kept: true, runs',
+     "more than one value is kept"),
+    ("unknown affected set", "papadopoulos2016.yaml", "affects: isa_uncalibrated}", "affects: everything}",
+     "everything"),
 ])
 def test_loader_refuses(registry_copy, case, file, old, new, message):
     _edit(registry_copy / file, old, new)
@@ -400,3 +408,17 @@ def test_a_measure_reads_only_the_runs_its_row_declares(tmp_path):
     for key in ("isa:z", "isa:nowhere"):
         with pytest.raises(claims.Undeclared, match=f"claim 'x-1' reads '{key}'"):
             claims.judge(ctx, [row], inputs, found=reads(key))
+
+
+def test_sweep_sets_are_the_registry_vocabulary():
+    """The named run sets a sweep value may change (the schema's 'affects') are exactly those the ISA claims
+    measure (methods.isa.claims.AFFECTS), and every paper's version of a swept input is a value of its sweep."""
+    import json
+
+    from isaflow.methods.isa import claims as PC
+
+    schema = json.loads((Path(reg.__file__).parent / "claims.schema.json").read_text())
+    vocab = schema["$defs"]["input"]["properties"]["sweep"]["items"]["properties"]["affects"]["enum"]
+    assert sorted(vocab) == sorted(PC.AFFECTS)
+    assert PC.paper_versions()["cycle_detector"].label.startswith("off")
+    assert sum(v.kept for v in PC.sweeps()["k_pair"]) == 1

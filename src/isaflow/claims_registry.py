@@ -115,6 +115,7 @@ def _check_file(paper, spec, ids):
         for c in i.get("calibrated_against", []):
             if c not in ids:
                 raise InputError(f"{path}: input '{i['id']}': calibrated_against names no claim '{c}'")
+        _check_sweep(path, i, values)
     own = {c["id"] for c in spec["claims"]}
     for k, f in enumerate(spec.get("findings", [])):
         for c in f["claims"]:
@@ -146,6 +147,23 @@ def _check_file(paper, spec, ids):
             raise InputError(f"{where}: an untestable claim needs why_not")
         if "quote" in c and "..." in c["quote"] and any(not f.strip() for f in c["quote"].split("...")):
             raise InputError(f"{where}: quote has an empty fragment around '...'")
+
+
+def _check_sweep(path, i, values):
+    """An input's sweep: its values are those of its range, at most one is kept, and every run standing in at a
+    value is one of the input's runs."""
+    sweep = i.get("sweep", [])
+    where = f"{path}: input '{i['id']}': sweep"
+    if sweep and sorted(str(v["value"]) for v in sweep) != sorted(values):
+        raise InputError(f"{where}: its values {[v['value'] for v in sweep]} are not those of the range ({values})")
+    if sum(v.get("kept", False) for v in sweep) > 1:
+        raise InputError(f"{where}: more than one value is kept")
+    own = {r["id"] for r in i.get("runs", [])}
+    for v in sweep:
+        for run in v.get("runs", {}).values():
+            if run not in own:
+                raise InputError(f"{where}: value '{v['value']}' stands in run '{run}', which is not one of the "
+                                 f"input's runs")
 
 
 def load(directory=DEFAULT_DIRECTORY):

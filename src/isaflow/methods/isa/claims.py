@@ -10,8 +10,9 @@ paper number lives here.  It returns whether the test passed, never a verdict: i
 turns the boolean into one.
 
 Sensitivity.  Each inferred input of the registry that has runs (or a reading) for other values of its
-range is a *sweep* here (:data:`SWEEPS`): per value, the runs that stand in for the kept ones, the runs
-the value changes (a measure that needs one of them without a stand-in has no run for that value), and
+range is a *sweep*, declared as data (the input's ``sweep`` in config/claims/papadopoulos2016.yaml, read by
+:func:`sweeps`): per value, the runs that stand in for the kept ones, the runs the value changes (a measure
+that needs one of them without a stand-in has no run for that value; :data:`AFFECTS` names the sets), and
 the parameters of readings that need no run (the level definition).  A measure is written once, as a
 core ``core(view, entry) -> Out``; the same core runs on a :class:`View` of the context per swept value,
 and ``sensitivity`` lists the test's outcome at every value ('passes' / 'fails' / 'no run'); the same outcomes
@@ -19,7 +20,7 @@ go to the measurement's ``sweep`` (isaflow.claims.robustness decides robust or f
 claims (every run converges) judge, in a sweep, the runs the value has (``partial``), and say so.
 
 The paper's version.  Where the project added something the paper does not have and the paper's version was
-run (:data:`PAPER_VERSION`: the cycle stop switched off), every row resting on that input is judged on the
+run (its ``paper_version``: the cycle stop switched off), every row resting on that input is judged on the
 paper's version's runs; the project's kept value is then one more value of the sweep.
 
 Units: cm, N, s.
@@ -149,157 +150,77 @@ def _flow_tank(key):
     return "flow" in key and "samefloor" not in key
 
 
-def _subs(pairs):
-    return {ISA + a if ":" not in a else a: ISA + b if ":" not in b else b for a, b in pairs.items()}
-
-
-# the sweeps: input id -> [(label of the value, substitutions, affected, params)]; the kept value has no
-# substitutions (every label names the value as config/claims/papadopoulos2016.yaml's range does)
-NOCYCLE = {"single_coarse": "single_coarse_nocycle", "single_refined": "single_refined_nocycle",
-           "flow_complete": "flow_complete_nocycle"}
-
-
-def _drop(h, liquid=False):
-    """The second_floor_drop value h cm: its ISA flows, and (liquid) the WCSPH flow at the range's ends."""
-    runs = {"flow_incomplete": f"flow_step{h}_incomplete", "flow_complete": f"flow_step{h}",
-            "flow_complete_capped": f"flow_step{h}_capped", "flow_complete_settle": f"flow_step{h}_settle",
-            "flow_refined_incomplete": f"flow_refined_step{h}_incomplete", "flow_refined_complete": f"flow_refined_step{h}"}
-    if liquid:
-        runs["sph:flow_wcsph_dx2.5"] = f"sph:flow_wcsph_dx2.5_step{h}"
-    return (f"{h} cm", _subs(runs), _flow_tank, {})
-
-
 def _isa_uncalibrated(key):
     """ISA runs other than the calibration sweep's (a k_pair value changes them)."""
     return _isa(key) and "calibration" not in key
 
 
-def _kp(k, label):
-    runs = {"single_coarse": f"single_coarse_kp{k}", "single_refined": f"single_refined_kp{k}",
-            "flow_incomplete": f"flow_kp{k}_incomplete", "flow_complete": f"flow_kp{k}",
-            "flow_complete_capped": f"flow_kp{k}_capped", "flow_refined_incomplete": f"flow_refined_kp{k}_incomplete",
-            "flow_refined_complete": f"flow_refined_kp{k}"}
-    return (label, _subs(runs), _isa_uncalibrated, {})
-
-
-SWEEPS = {
-    "force_law_shape": [
-        ("linear (kept)", {}, _never, {}),
-        ("(1 - l/l_u)^1.5", _subs({"single_coarse": "single_coarse_law_p15", "single_refined": "single_refined_law_p15"}),
-         _isa, {}),
-        ("quadratic", _subs({"single_coarse": "single_coarse_law_quadratic",
-                             "single_refined": "single_refined_law_quadratic"}), _isa, {}),
-    ],
-    "k_pair": [
-        _kp(250, "250 N/cm"),
-        ("500 N/cm (kept)", {}, _never, {}),
-        ("1000 N/cm (literal k_b/2)", _subs({"single_coarse": "single_coarse_kp1000",
-                                             "single_refined": "single_refined_kp1000"}),
-         _isa_uncalibrated, {}),
-        _kp(2000, "2000 N/cm"),
-    ],
-    "refined_wall_law": [
-        ("kept (l_bu 5 cm, R_bu 10 kN)", {}, _never, {}),
-        ("scaled (l_bu 2.5 cm, R_bu 5 kN)", _subs({"single_refined": "single_refined_lbu25_paper",
-                                                   "single_refined_capped": "single_refined_lbu25"}), _refined, {}),
-        ("literal rule (l_bu 2.5 cm, R_bu = 10 max R_b = 4.32 kN)",
-         _subs({"single_refined": "single_refined_literal", "single_refined_capped": "single_refined_literal_capped",
-                "flow_refined_incomplete": "flow_refined_literal_incomplete",
-                "flow_refined_complete": "flow_refined_literal_complete"}), _refined, {}),
-    ],
-    "level_definition": [
-        ("top centres + 0 (the reading the k_p calibration used)", {}, _never, {"level": "top centres + 0"}),
-        ("+ a/4, half the layer pitch (kept: the one surface)", {}, _never, {"level": LEVEL_KEPT}),
-        ("+ 5 cm (the paper's y_in)", {}, _never, {"level": "top centres + 5 cm"}),
-    ],
-    "step_limit": [  # the paper's version of the stop rule (cycle stop off) runs to 100 x: the judged value
-        (f"{f} x the paper's steps{' (kept)' if f == 100 else ''} (cycle stop off)", _subs(NOCYCLE), _isa, {"n_u": f})
-        for f in (10, 25, 100)
-    ],
-    "cycle_detector": [
-        ("on (the project's addition)", {}, _never, {}),
-        ("off (the paper's stop rule, to 100 x the paper's steps)", _subs(NOCYCLE), _isa, {"n_u": 100}),
-    ],
-    "second_floor_drop": [_drop(20, liquid=True), _drop(32), ("50 cm (kept)", {}, _never, {}), _drop(80),
-                          _drop(100, liquid=True)],
-    "flow_start_state": [
-        ("single_coarse's last state (kept)", {}, _never, {}),
-        ("single_coarse_capped's equilibrium", _subs({"flow_incomplete": "flow_capstart_incomplete",
-                                                      "flow_complete": "flow_capstart_complete",
-                                                      "single_coarse": "single_coarse_capped"}), _isa_flow, {}),
-    ],
-    "overdamped_damping": [
-        ("zeta 1 (kept)", {}, _never, {}),
-        *[(f"zeta {z}", _subs({"flow_overdamped": f"flow_overdamped_z{z}",
-                               "single_coarse_overdamped": f"single_coarse_overdamped_z{z}"}),
-           lambda k: "overdamped" in k, {}) for z in (3, 10, 100)],
-    ],
-    "sph_reference_resolution": [
-        ("n180", {"sph:flow_wcsph_dx2.5": "sph:flow_wcsph_n180"}, _never, {}),
-        ("n684", {"sph:flow_wcsph_dx2.5": "sph:flow_wcsph_n684"}, _never, {}),
-        ("dx 2.5 cm (kept)", {}, _never, {}),
-    ],
-    "sph_viscosity": [
-        ("alpha 0", {"sph:single_wcsph_n684": "sph:stab_no_viscosity",
-                     "sph:flow_wcsph_dx2.5": "sph:flow_wcsph_dx2.5_alpha0"},
-         lambda k: k.startswith("sph:") and "viscosity" not in k and "single_wcsph_n684" not in k, {"alpha": 0.0}),
-        ("alpha 0.02", {"sph:single_wcsph_n684": "sph:stab_low_viscosity",
-                        "sph:flow_wcsph_dx2.5": "sph:flow_wcsph_dx2.5_alpha0.02"},
-         lambda k: k.startswith("sph:") and "viscosity" not in k and "single_wcsph_n684" not in k, {"alpha": 0.02}),
-        ("alpha 0.1 (kept)", {}, _never, {}),
-    ],
-    "sph_rest": [
-        ("e < 1e-5 (kept)", {}, _never, {}),
-        ("e < 1e-4", {}, _never, {"rest_ratio": 1e-4}),
-        # a run that ended at rest (converged) stands for itself: a longer t_max cannot change it (View.key)
-        ("t_max x 3", {}, lambda k: k.startswith("sph:"), {"t_max_factor": 3}),
-    ],
-    "mps_relaxation": [
-        ("gamma 0.2 (the kept MPS setting)", {}, _never, {"gamma": 0.2}),
-        ("gamma 1 (Koshizuka & Oka: judged, no added technique)", {}, _never, {"gamma": 1.0}),
-    ],
-    "mps_collision": [
-        ("on (kept)", {}, _never, {}),
-        ("off", {}, lambda k: k.startswith("mps:"), {}),
-    ],
-    "mps_noise_window": [
-        ("0.25 s", {}, _never, {"window": 0.25}),
-        ("0.5 s (kept)", {}, _never, {}),
-        ("1.0 s", {}, lambda k: k.startswith("mps:"), {}),
-    ],
-    "rhomb_alternative": [
-        ("square lattice of the rhomb side (kept)", {}, _never, {}),
-        ("disordered packing (the square lattice jittered by +-0.1 spacing, seed 0)",
-         _subs({"single_coarse_square_capped": "single_coarse_square_jitter_capped"}), _never, {}),
-    ],
+# the sets of run keys a swept value changes (the registry's sweep 'affects'; absent: none)
+AFFECTS = {
+    "isa": _isa,
+    "isa_flow": _isa_flow,
+    "isa_uncalibrated": _isa_uncalibrated,
+    "refined": _refined,
+    "flow_tank": _flow_tank,
+    "overdamped": lambda k: "overdamped" in k,
+    "sph": lambda k: k.startswith("sph:"),
+    "sph_outside_viscosity": lambda k: k.startswith("sph:") and "viscosity" not in k and "single_wcsph_n684" not in k,
+    "mps": lambda k: k.startswith("mps:"),
 }
 PARTIAL = {"pap-abs-converges", "pap-7-isa-oscillations", "pap-5-rigid", "pap-5-incompressible"}  # aggregates: a sweep judges what it has
-# inputs whose paper's version was run: the label of that value in SWEEPS (rows resting on them are judged there)
-PAPER_VERSION = {"cycle_detector": "off (the paper's stop rule, to 100 x the paper's steps)"}
 
 
-def _value(name, label):
-    return next(v for v in SWEEPS[name] if v[0] == label)
+@dataclass(frozen=True)
+class Value:
+    """One value of a sweep (config/claims/papadopoulos2016.yaml, an input's ``sweep``)."""
+
+    label: str  # as the robustness text prints it
+    subs: dict  # {kept run key: the run standing in for it at this value}
+    affected: object  # run key -> True if the value changes that run (AFFECTS)
+    params: dict  # parameters of readings that need no run
+    kept: bool  # the project's kept value
+    value: object  # the range value it is
+
+
+@lru_cache(maxsize=1)
+def sweeps():
+    """{input id: [Value]} of every swept input of the papadopoulos2016 registry file, in its order."""
+    out = {}
+    for i in claims_registry.inputs()["papadopoulos2016"]:
+        if "sweep" in i:
+            out[i["id"]] = [Value(v["label"], dict(v.get("runs", {})), AFFECTS.get(v.get("affects"), _never),
+                                  dict(v.get("params", {})), v.get("kept", False), v["value"]) for v in i["sweep"]]
+    return out
+
+
+@lru_cache(maxsize=1)
+def paper_versions():
+    """{input id: the sweep Value of its paper's version} of the inputs whose paper's version was run (the rows
+    resting on them are judged there)."""
+    out = {}
+    for i in claims_registry.inputs()["papadopoulos2016"]:
+        if "paper_version" in i and "sweep" in i:
+            out[i["id"]] = next(v for v in sweeps()[i["id"]] if str(v.value) == i["paper_version"])
+    return out
 
 
 def judged_at(entry):
-    """{input: label} of the paper's versions a row is judged at (its inferred inputs in PAPER_VERSION)."""
-    return {n: PAPER_VERSION[n] for n in entry.get("inferred_inputs", []) if n in PAPER_VERSION}
+    """{input: label} of the paper's versions a row is judged at (its inferred inputs with a paper's version)."""
+    return {n: paper_versions()[n].label for n in entry.get("inferred_inputs", []) if n in paper_versions()}
 
 
 def base_view(ctx, entry):
     """The view a row is judged on: the run substitutions of the paper's versions it rests on."""
     subs, params = {}, {}
-    for name, label in judged_at(entry).items():
-        _, s, _, p = _value(name, label)
-        subs.update(s)
-        params.update(p)
+    for name in judged_at(entry):
+        subs.update(paper_versions()[name].subs)
+        params.update(paper_versions()[name].params)
     return View(ctx, subs, None, params)
 
 
-def _kept(name, label, at):
+def _kept(name, value, at):
     """True when a sweep value is the one the row is judged at (the paper's version, else the kept value)."""
-    return label == at[name] if name in at else "(kept)" in label
+    return value.label == at[name] if name in at else value.kept
 
 
 def sensitivity(ctx, entry, core, kept):
@@ -309,12 +230,13 @@ def sensitivity(ctx, entry, core, kept):
     at = judged_at(entry)
     base = base_view(ctx, entry)
     for name in entry.get("inferred_inputs", []):
-        if name not in SWEEPS:
+        if name not in sweeps():
             unswept.append(name)
             continue
         vals = []
-        for label, subs, affected, params in SWEEPS[name]:
-            if _kept(name, label, at):
+        for value in sweeps()[name]:
+            label, subs, affected, params = value.label, value.subs, value.affected, value.params
+            if _kept(name, value, at):
                 vals.append(f"{label}: {_word(kept.passed)}" + (f" ({kept.short})" if kept.short else ""))
                 sweep.append((name, label, kept.passed))
                 continue
