@@ -42,7 +42,7 @@ def step_cost(root, n, method="cg_jacobi", warm=30, steps=20):
     tank = load_tank(Path(root) / "config/tanks/single.yaml")
     l0 = 100.0 / round(np.sqrt(n * 100.0 / 72.5))  # whole columns: the lattice is square (dx = l0)
     cfg = settings.resolved(Path(root) / "config/methods/mps.yaml").with_overrides(**{"pressure.solver": method})
-    xr, floor = solver.first_vessel(tank)
+    xr, floor = tank.first_vessel
     fluid = boundary.liquid_block(xr, floor, tank.depth, l0)
     s = solver.State(tank, cfg, l0, fluid, np.zeros_like(fluid))
     dt = solver.time_step(tank, l0, cfg["time.courant"])

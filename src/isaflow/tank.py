@@ -126,6 +126,11 @@ class Tank:
         return [("vessel", (min(xs), max(xs)))]
 
     @property
+    def first_vessel(self):
+        """((xmin, xmax) cm, floor y cm) of the first vessel, where every method's liquid starts (vessel_floor)."""
+        return self.vessels[0][1], self.floor_y(0)
+
+    @property
     def weight(self):
         """Liquid weight W [N] per unit thickness."""
         return float(self.spec["liquid"]["weight"])

@@ -31,19 +31,9 @@ BETA = (0.8, 0.99, "the free-surface threshold n* < beta n0: 0.97 in Koshizuka &
 RADII = ("model.re_density", "model.re_gradient", "model.re_laplacian", "model.re_surface")
 
 
-def first_vessel(tank):
-    """((x0, x1) cm, floor y cm) of the tank's first vessel: the highest +x horizontal wall spanning it
-    (solver.first_vessel, in Python)."""
-    x0, x1 = tank.vessels[0][1]
-    floors = [w["from"][1] for w in tank.spec["walls"]
-              if abs(w["from"][1] - w["to"][1]) <= 1e-9 and w["to"][0] > w["from"][0]
-              and min(w["to"][0], x1) - max(w["from"][0], x0) > 0]
-    return (x0, x1), max(floors)
-
-
 def time_step(tank, l0, courant):
-    """dt [s] = courant l0 / sqrt(2 g H), H = liquid top minus the lowest wall point (solver.time_step)."""
-    _, floor = first_vessel(tank)
+    """dt [s] = courant l0 / sqrt(2 g H), H = liquid top minus the lowest wall point (free-fall speed)."""
+    _, floor = tank.first_vessel
     low = min(min(w["from"][1], w["to"][1]) for w in tank.spec["walls"])
     return courant * l0 / math.sqrt(2.0 * G * (floor + tank.depth - low))
 
@@ -63,7 +53,7 @@ def plausible(tank, s, stability=False):
     """Refuse implausible settings (InputError naming the file and the setting, with the reason)."""
     path, l0 = s.path, s["resolution.spacing"]
     require(l0 is not None, path, f"resolutions.{s.resolution}", "no resolution.spacing")
-    (x0, x1), _ = first_vessel(tank)
+    (x0, x1), _ = tank.first_vessel
     nx, ny = _counts(x1 - x0, tank.depth, l0)
     require(nx >= 2 and ny >= 2, path, lattice_field(tank, nx, ny, "resolution.spacing"),
             f"the liquid ({x1 - x0:g} cm wide, {tank.depth:g} cm deep) would be {nx:g} x {ny:g} particles of "
@@ -99,7 +89,7 @@ def cost(tank, s, particles=None):
     from the wall particles to the panels (dense, panels x wall particles; both faces of a thin wall) and the
     samples."""
     l0 = s["resolution.spacing"]
-    (x0, x1), _ = first_vessel(tank)
+    (x0, x1), _ = tank.first_vessel
     nx, ny = _counts(x1 - x0, tank.depth, l0)
     liquid = nx * ny if particles is None else particles
     wall = 2 * tank.perimeter() / l0 * (s["model.pressure_layers"] + s["model.dummy_layers"])

@@ -50,7 +50,7 @@ def start_state(path):
 
 def on_wall_start(tank, l0, point):
     """The liquid block at rest with the particle nearest ``point`` (x, y cm) moved onto it."""
-    xr, floor = solver.first_vessel(tank)
+    xr, floor = tank.first_vessel
     fluid = boundary.liquid_block(xr, floor, tank.depth, l0)
     k = int(np.argmin(np.hypot(*(fluid - np.asarray(point) - [0, l0 / 2]).T)))
     fluid[k] = point

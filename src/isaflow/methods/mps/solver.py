@@ -27,23 +27,7 @@ from isaflow.core import units
 from isaflow.tank import vessel_counts
 
 from . import boundary, model, pressure
-
-
-def first_vessel(tank):
-    """(x range (cm, cm), floor y cm) of the tank's first vessel (floor: the highest horizontal wall spanning it
-    with the liquid above, i.e. running in +x)."""
-    x0, x1 = tank.vessels[0][1]
-    w = tank.walls
-    span = np.minimum(np.maximum(w[:, 0], w[:, 2]), x1) - np.maximum(np.minimum(w[:, 0], w[:, 2]), x0)
-    floors = np.isclose(w[:, 1], w[:, 3]) & (span > 0) & (w[:, 2] > w[:, 0])
-    return (x0, x1), float(w[floors, 1].max())
-
-
-def time_step(tank, l0, courant):
-    """dt [s] = courant l0 / sqrt(2 g H), H = liquid top minus the lowest wall point (free-fall speed)."""
-    _, floor = first_vessel(tank)
-    H = floor + tank.depth - tank.walls[:, [1, 3]].min()
-    return courant * l0 / np.sqrt(2.0 * units.G * H)
+from .checks import time_step
 
 
 def rows_depth(tank, l0):
@@ -326,7 +310,7 @@ class _Stepper:
 
     def __init__(self, tank, cfg, variant, l0, t_end, probes, start, snapshots, threads):
         self.tank, self.cfg, self.variant, self.l0, self.t_end, self.threads = tank, cfg, variant, l0, t_end, threads
-        xr, floor = first_vessel(tank)
+        xr, floor = tank.first_vessel
         if start is None:
             fpos, self.step0, self.t0 = boundary.liquid_block(xr, floor, tank.depth, l0), 0, 0.0
             fvel = np.zeros_like(fpos)

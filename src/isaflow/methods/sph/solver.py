@@ -33,15 +33,6 @@ from . import settings as S
 CODES = {K.CROSSED: "escaped", K.LEFT_BOX: "escaped", K.NONFINITE: "nonfinite"}
 
 
-def first_vessel(tank):
-    """(x0, x1, floor_y) [cm] of the tank's first vessel (its lowest horizontal wall)."""
-    x0, x1 = tank.vessels[0][1]
-    walls = tank.walls
-    horiz = np.isclose(walls[:, 1], walls[:, 3])
-    over = np.minimum(walls[:, [0, 2]].max(1), x1) - np.maximum(walls[:, [0, 2]].min(1), x0) > 1e-9
-    return x0, x1, float(walls[horiz & over, 1].min())
-
-
 def lattice_density_sum(kind, h, dx, dy):
     """sum_b W(r_ab) [1/cm^2] over an infinite dx x dy lattice (its undisturbed summed density / mass)."""
     n = int(np.ceil(2 * h / min(dx, dy))) + 1
@@ -82,7 +73,7 @@ def _start_value(start, name, default):
 def setup(tank, s, resolution, start=None, on_wall=False):
     """Initial state: dict of arrays and scalars (see _run).  start: a run Dataset to continue
     (its pos, velocity, density, list_pos, acceleration, weight, lattice cell, clock and step count)."""
-    x0, x1, floor_y = first_vessel(tank)
+    (x0, x1), floor_y = tank.first_vessel
     kind = smoothing.kernel_id(s["kernel"])
     c0 = s["sound_speed_factor"] * math.sqrt(2 * G * s["max_drop"])
     t0, step0, acc = 0.0, 0, None
@@ -336,7 +327,7 @@ class _Stepper:
         if lj_window:  # the safety net's panel forces, with the front faces' panels
             front = np.flatnonzero(side == 0)
             cf[front] += np.mean(np.array(lj_window), axis=0)
-        x0, x1, floor_y = first_vessel(tank)
+        (x0, x1), floor_y = tank.first_vessel
         left = int(np.count_nonzero((x[:nf, 0] >= x0) & (x[:nf, 0] < x1)))
         history = {
             "sample_time": (("sample",), np.array(rec["sample_time"]), "s", "chain time at the end of the diagnostic chunk"),
