@@ -14,7 +14,7 @@ import xarray as xr
 
 from isaflow import claims, claims_registry
 from isaflow.core import units
-from isaflow.methods.mps import boundary, claims as mps_claims
+from isaflow.methods.mps import boundary, claims as mps_claims, step_check
 from isaflow.methods.sph1d import claims as sph1d_claims, sweep
 
 from conftest import ROOT
@@ -117,14 +117,25 @@ def test_rho_star_of_the_project_is_the_number_density_not_the_jacobian():
     assert mps_claims.measure_rho_star(FakeContext(_mps_state()), REGISTRY["hat-eq4-rho-star"]).passed is None
 
 
-def test_one_mps_step_satisfies_eqs_1_2_at_u_star_and_not_at_u_new():
+def test_one_mps_step_satisfies_eqs_1_2_at_u_star_and_not_at_u_new(tmp_path):
+    """The step check (its run file, as the rule writes it) and the two measures that read it."""
     ds = _mps_state()
-    st = mps_claims.one_step(ds)
+    run = tmp_path / "run.nc"
+    ds.to_netcdf(run)
+    step_check.write(str(run), [str(tmp_path / "check.nc")])
+    check = xr.open_dataset(tmp_path / "check.nc").load()
+    assert check.attrs["checked_run"] == ds.attrs["run_id"] and all("units" in v.attrs for v in check.data_vars.values())
+    st = {k: check[k].item() for k in check.data_vars}
+    assert st == step_check.one_step(ds)  # the file holds the check's numbers exactly
     assert st["res1_star"] < 1e-12 and st["res2"] < 1e-9
     assert st["res1_new"] > 1e-6  # the gradient moves with U[n+1] - U* = dt^2 grad P / rho0
-    assert mps_claims.measure_mps_step(FakeContext(ds), REGISTRY["prj-hat-mps-step"]).passed
+    for row in ("prj-hat-mps-step", "hat-eq5-implicit"):
+        assert [r["id"] for r in REGISTRY[row]["runs"]][1] == "mps:step_check_" + REGISTRY[row]["runs"][0]["id"][4:]
+    ctx = FakeContext(ds, **{r["id"]: check for row in ("prj-hat-mps-step", "hat-eq5-implicit")
+                             for r in REGISTRY[row]["runs"][1:2]})
+    assert mps_claims.measure_mps_step(ctx, REGISTRY["prj-hat-mps-step"]).passed
     # the printed eqs. (5)-(6) are inconsistent with the step: the quoted claim does not hold
-    assert mps_claims.measure_eq5_implicit(FakeContext(ds), REGISTRY["hat-eq5-implicit"]).passed is False
+    assert mps_claims.measure_eq5_implicit(ctx, REGISTRY["hat-eq5-implicit"]).passed is False
 
 
 # --- Merino-Alonso: a small synthetic sweep with known classes ----------------------------------------------

@@ -242,6 +242,16 @@ def declared_runs(entry, inputs, entries=None):
     return keys
 
 
+def run_ids(prefix, directory=DEFAULT_DIRECTORY):
+    """Sorted run keys starting with ``prefix`` ('<method>:<run id>...') that any row, deviation or input of the
+    registry names (its runs and controls): the workflow builds the checks the rows declare, and no others."""
+    keys = set()
+    for spec in load_files(directory).values():
+        for node in spec.get("inputs", []) + spec["claims"] + [c["deviation"] for c in spec["claims"] if "deviation" in c]:
+            keys |= {r["id"] for field in ("runs", "controls") for r in node.get(field, []) if r["id"].startswith(prefix)}
+    return sorted(keys)
+
+
 def inputs(directory=DEFAULT_DIRECTORY):
     """{paper: [input dicts]}: the inferred inputs of each file, with their sweep ranges."""
     return {p: spec.get("inputs", []) for p, spec in load_files(directory).items()}

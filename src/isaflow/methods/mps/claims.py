@@ -3,8 +3,8 @@ each row's tolerance test passed, read from the registry entry (isaflow.claims t
 
 ``MEASURES = {claim id: function(ctx, entry) -> isaflow.claims.Measurement}``.  The paper's statements are
 derivations, so most measures are exact or numeric checks of the printed equations (paper arithmetic);
-two take one MPS step from the final state of a registry run (``ctx.run('mps:<run id>')``) and check the
-step against eqs. (1)-(2) by recomputing every operator independently of the solver.
+two read the check of one MPS step from the final state of a registry run against eqs. (1)-(2)
+(``ctx.run('mps:step_check_<run id>')``, written by methods.mps.step_check).
 
 Units: cm, N, s; rho0 [N s^2 / cm^4], accelerations [cm / s^2], sources of lap P = S [N / cm^4].
 """
@@ -18,7 +18,8 @@ import numpy as np
 from ...claims import Measurement, measure_table
 from ...core import units
 from ...tank import load as load_tank
-from . import model, settings, solver
+from . import model
+from .step_check import run_settings
 
 MEASURES, claim = measure_table()  # {claim id: measure(ctx, entry)}, each measure entered by @claim(id)
 
@@ -28,63 +29,6 @@ ROOT = Path(__file__).resolve().parents[4]
 EPS_SEQUENCE = (1e-2, 5e-3, 2.5e-3, 1.25e-3)
 DILATION = 1e-4
 DENSITY_OFFSET = 1e-3  # Rho[n] / rho0 - 1 of the alternative reference configuration (sensitivity only)
-
-
-def _file(path):
-    """A path recorded in a run file (relative to the repository root when relative)."""
-    p = Path(path)
-    return p if p.is_absolute() or p.is_file() else ROOT / p
-
-
-def run_settings(ds):
-    """The MPS settings of a run file: its settings file, variant and resolution, and the run's own 'set'
-    overrides when its id is declared there (isaflow.settings.Settings)."""
-    cfg = settings.resolved(_file(ds.attrs["settings_file"]), variant=ds.attrs["variant"],
-                        resolution=ds.attrs["resolution"])
-    decl = cfg.runs().get(str(ds.attrs.get("run_id", "")), {})
-    return cfg.with_overrides(decl.get("set", {}), what="run") if decl.get("set") else cfg
-
-
-def one_step(ds):
-    """One MPS step (solver.step, the project's own) from the final state of run file ds, the collision
-    model off (it is no term of eqs. 1-3), then eqs. (1)-(2) checked with every operator recomputed.
-
-    Returns dict: res1_star, res1_new (max over fluid particles of |(V[n+1] - V[n])/dt - (nu lap V[n] + g -
-    grad P[n+1] / rho0)| over the largest term, grad P at U* and at U[n+1]), res2 (|(U[n+1] - U[n])/dt -
-    V[n+1]| over max |V[n+1]|), scale [cm/s^2] (largest acceleration term), dt [s], particles, the solve's
-    residual, the largest |U[n+1] - U*| [cm] and the largest |grad P(U[n+1]) - grad P(U*)| / rho0 [cm/s^2].
-    """
-    tank = load_tank(_file(ds.attrs["tank_file"]))
-    cfg = run_settings(ds).with_overrides(**{"model.collision_distance": 0.0})
-    l0, dt = float(ds.attrs["spacing"]), float(ds.attrs["dt_s"])
-    s = solver.State(tank, cfg, l0, ds["pos"].values.astype(float), ds["velocity"].values.astype(float))
-    pos_n, vel_n = s.pos.copy(), s.vel.copy()
-    _, resid, _ = solver.step(s, dt, ds.attrs["variant"], cfg)
-    f = slice(0, s.nf)
-    nu = cfg["model.kinematic_viscosity"]
-    g = np.array([0.0, -units.G])
-    s.neighbours(pos_n)  # eq. (3) recomputed: V* = V[n] + dt (nu lap V[n] + g), U* = U[n] + dt V*
-    lap = model.laplacian(vel_n, s.kind, s.start, s.nbr, model.distances(pos_n, s.start, s.nbr), s.re_l, s.n0_l,
-                          s.lam)
-    u_star = pos_n.copy()
-    u_star[f] = pos_n[f] + dt * (vel_n[f] + dt * (nu * lap[f] + g))
-
-    def grad_at(pos):
-        s.neighbours(pos)
-        d = model.distances(pos, s.start, s.nbr)
-        return model.gradient(pos, s.p, s.kind, s.start, s.nbr, d, s.re_g, s.n_grad, s.grad_mode)
-
-    g_star, g_new = grad_at(u_star), grad_at(s.pos)
-    lhs = (s.vel[f] - vel_n[f]) / dt
-    rhs_star = nu * lap[f] + g - g_star[f] / s.rho0
-    scale = float(max(np.abs(nu * lap[f]).max(), units.G, np.abs(g_star[f] / s.rho0).max()))
-    res1_star = float(np.abs(lhs - rhs_star).max() / scale)
-    res1_new = float(np.abs(lhs - (nu * lap[f] + g - g_new[f] / s.rho0)).max() / scale)
-    res2 = float(np.abs((s.pos[f] - pos_n[f]) / dt - s.vel[f]).max() / np.abs(s.vel[f]).max())
-    return dict(res1_star=res1_star, res1_new=res1_new, res2=res2, scale=scale, dt=dt, particles=s.nf,
-                solve_residual=float(resid), shift=float(np.hypot(*(s.pos[f] - u_star[f]).T).max()),
-                grad_change=float(np.abs(g_new[f] - g_star[f]).max() / s.rho0), rho0=s.rho0,
-                rho0_file=float(ds.attrs["rho0_N_s2_cm4"]))
 
 
 def _run_text(key, ds):
@@ -278,11 +222,11 @@ def measure_rho_star(ctx, entry):
 
 
 def _stepped(ctx, entry):
-    """(tolerance, run key, run, :func:`one_step` from its final state) of a row judged on one MPS step from its
-    first run."""
-    key = entry["runs"][0]["id"]
-    ds = ctx.run(key)
-    return entry["tolerance"]["value"], key, ds, one_step(ds)
+    """(tolerance, run key, run, the step check of its final state) of a row judged on one MPS step: its runs
+    are the run and its check (results/mps/step_check_<run>.nc, methods.mps.step_check)."""
+    key, check = (r["id"] for r in entry["runs"][:2])
+    ds, st = ctx.run(key), ctx.run(check)
+    return entry["tolerance"]["value"], key, ds, {k: st[k].item() for k in st.data_vars}
 
 
 @claim("hat-eq5-implicit")
@@ -295,7 +239,8 @@ def measure_eq5_implicit(ctx, entry):
                  f"(U[n+1] - U* up to {st['shift']:.3g} cm; grad P / rho0 changes by up to {st['grad_change']:.3g} "
                  f"cm/s^2 of {st['scale']:.4g})",
         passed=not found,  # paper inconsistency: the quoted claim holds unless its test finds the inconsistency
-        evidence=f"isaflow.methods.mps.claims.one_step on results/runs/mps/{key.split(':', 1)[1]}.nc; "
+        evidence=f"isaflow.methods.mps.step_check.one_step on results/runs/mps/{key.split(':', 1)[1]}.nc "
+                 f"(results/mps/step_check_{key.split(':', 1)[1]}.nc); "
                  "tests/test_mps.py::test_pressure_gradient_at_new_positions_equals_the_one_used (strict xfail)",
         why=(f"eqs. (5)-(6) as printed: the step satisfies eq. (1) with the gradient at U* (residual "
              f"{st['res1_star']:.3g}), not at U[n+1] ({st['res1_new']:.3g} > {tol:g})") if found else "",
@@ -311,7 +256,8 @@ def measure_mps_step(ctx, entry):
                  f"residual {st['solve_residual']:.2g}) from {_run_text(key, ds)}: relative residual of eq. (1) "
                  f"(grad P at U*, rho0 for Rho[n+1]) {st['res1_star']:.3g}, of eq. (2) {st['res2']:.3g}",
         passed=worst <= tol,
-        evidence=f"isaflow.methods.mps.claims.one_step on results/runs/mps/{key.split(':', 1)[1]}.nc; "
+        evidence=f"isaflow.methods.mps.step_check.one_step on results/runs/mps/{key.split(':', 1)[1]}.nc "
+                 f"(results/mps/step_check_{key.split(':', 1)[1]}.nc); "
                  "tests/test_mps.py::test_eqs_3_and_5_add_up_to_the_discrete_navier_stokes_eqs_1_2",
         why="" if worst <= tol else f"a residual {worst:.3g} > {tol:g}",
         margin=f"largest residual {worst:.3g} against {tol:g}")
