@@ -164,6 +164,18 @@ def synthetic_sweep(c2_divergent=True):
                "variant_floor": "mirror_hydrostatic mirror_hydrostatic", "height_cm": 100.0, "rho_g_N_cm3": 9.81e-3})
 
 
+def test_the_solve_is_linear_in_rho_g_and_the_claim_reads_the_check():
+    """sweep.linearity (the rule sph1d_linearity's product) on a sweep: each kernel at its best-conditioned h/dx
+    (Wendland C2 avoids its ill-conditioned 1.3), p(2 rho g) = 2 p(rho g) to round-off; mer-abs-linear judges
+    from that product alone."""
+    ds = synthetic_sweep(True)
+    lin = sweep.linearity(ds)
+    assert list(lin.kernel.values) == KERNELS and float(lin.ratio.sel(kernel="wendland_c2")) != 1.3
+    assert float(lin.rel_diff.max()) < 1e-12 and lin.attrs["n"] == NS[-1]
+    m = sph1d_claims.measure_linear(FakeContext(None, **{sph1d_claims.LINEARITY: lin}), REGISTRY["mer-abs-linear"])
+    assert m.passed and "C2 h/dx 0.80" in m.measured
+
+
 @pytest.mark.parametrize("cid, divergent, expected", [
     ("mer-abs-c2-divergent-two", True, True), ("mer-abs-c2-divergent-two", False, False),
     ("mer-abs-c2-worst", True, True), ("mer-abs-c2-worst", False, False),

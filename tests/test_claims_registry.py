@@ -267,7 +267,7 @@ def existing_runs():
     sweeps = S.read(ROOT / methods.registry()["sph1d"].settings, methods.registry()["sph1d"].values_schema()).get(
         "resolutions", {})  # sph1d.smk: one sweep per resolution
     runs |= {f"mps:step_check_{r.split(':', 1)[1]}" for r in runs if r.startswith("mps:")}  # mps.smk: any MPS run's
-    return runs | {"sph1d:sweep"} | {f"sph1d:sweep_{r}" for r in sweeps}
+    return runs | {"sph1d:sweep", "sph1d:linearity"} | {f"sph1d:sweep_{r}" for r in sweeps}
 
 
 def test_runs_exist_or_are_flagged_new():

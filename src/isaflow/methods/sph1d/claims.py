@@ -20,11 +20,12 @@ from scipy import stats
 from ... import claims_registry
 from ...claims import Measurement, measure_table
 from ...inputs import InputError, load as load_yaml
-from . import closed_form, column, sweep
+from . import closed_form, sweep
 
 MEASURES, claim = measure_table()  # {claim id: measure(ctx, entry)}, each measure entered by @claim(id)
 
 SWEEP = "sph1d:sweep"
+LINEARITY = "sph1d:linearity"  # results/sph1d/linearity.nc (sweep.linearity)
 EXTENDED = "sph1d:sweep_n8192"  # the sweep to N = 8192 (registry input n_window): sensitivity only
 SURFACE_TOP = "sph1d:sweep_surface_top"  # the top particle on the surface (registry input surface_placement)
 EVIDENCE = "results/sph1d/sweep.nc"
@@ -66,13 +67,6 @@ def limits(ds):
     return pd.DataFrame(rows)
 
 
-def _variant_forms(ds):
-    """{variant: (gradient form, floor)} of the sweep's variants (its attributes)."""
-    grads = str(ds.attrs["variant_gradient"]).split()
-    floors = str(ds.attrs["variant_floor"]).split()
-    return {str(v): (g, f) for v, g, f in zip(ds.variant.values, grads, floors)}
-
-
 def _judged(ctx, judge, table, entry):
     """Measurement of judge(rows of one variant, entry) -> (passed, text, margin, why) on the sweep's first
     variant; the sensitivity (``sweep``, one value of a registry input each): the other variants (gradient_form,
@@ -85,7 +79,7 @@ def _judged(ctx, judge, table, entry):
     per = {v: judge(rows[rows.variant == v], entry) for v in variants}
     ok, text, margin, why = per[variants[0]]
     notes = []
-    forms = _variant_forms(ds)
+    forms = sweep.variant_forms(ds)
     g0, f0 = forms[variants[0]]
     sweep = [("gradient_form", f"{g0} (kept)", bool(ok)), ("floor_treatment", f"{f0} (kept)", bool(ok))]
     if len(variants) > 1:
@@ -150,25 +144,16 @@ def measure_setup(ctx, entry):
 @claim("mer-abs-linear")
 def measure_linear(ctx, entry):
     tol = entry["tolerance"]["value"]
-    ds = ctx.run(SWEEP)
-    v0 = str(ds.variant.values[0])
-    grad, floor = _variant_forms(ds)[v0]
-    n = int(ds.n.values[-1])
-    height, rho_g = float(ds.attrs["height_cm"]), float(ds.attrs["rho_g_N_cm3"])
-    parts, worst = [], 0.0
-    for kern in ds.kernel.values:
-        cond = ds.cond.sel(variant=v0, kernel=kern).values[:, -1]
-        ratio = float(ds.ratio.values[int(np.nanargmin(np.where(np.isfinite(cond), cond, np.nan)))])
-        p1 = column.solve_column(n, ratio, str(kern), grad, floor, height, rho_g).p
-        p2 = column.solve_column(n, ratio, str(kern), grad, floor, height, 2.0 * rho_g).p
-        d = float(np.abs(p2 - 2.0 * p1).max() / np.abs(2.0 * p1).max())
-        worst = max(worst, d)
-        parts.append(f"{SHORT[str(kern)]} h/dx {ratio:.2f}: {d:.3g}")
+    lin = ctx.run(LINEARITY)
+    worst = float(lin.rel_diff.max())
+    parts = [f"{SHORT[str(k)]} h/dx {float(lin.ratio.sel(kernel=k)):.2f}: {float(lin.rel_diff.sel(kernel=k)):.3g}"
+             for k in lin.kernel.values]
     ok = worst <= tol
     return Measurement(
-        measured=f"{v0}, N = {n}, the best-conditioned h/dx of each kernel: max |p(2 rho g) - 2 p(rho g)| / "
-                 f"max |2 p(rho g)| = " + "; ".join(parts),
-        passed=ok, evidence="isaflow.methods.sph1d.column.solve_column (A p = b, b linear in rho g)",
+        measured=f"{lin.attrs['variant']}, N = {int(lin.attrs['n'])}, the best-conditioned h/dx of each kernel: max "
+                 f"|p(2 rho g) - 2 p(rho g)| / max |2 p(rho g)| = " + "; ".join(parts),
+        passed=ok, evidence="isaflow.methods.sph1d.sweep.linearity (results/sph1d/linearity.nc: A p = b, b linear "
+                            "in rho g)",
         why="" if ok else f"a relative difference {worst:.3g} > {tol:g}",
         margin=f"largest difference {worst:.3g} against {tol:g}")
 
@@ -183,7 +168,7 @@ def measure_one_nb_explicit(ctx, entry):
     one = ds.neighbours.values == 1
     ratios = ds.ratio.values[one]
     worst, worst_abs, largest, where, checked = 0.0, 0.0, 0.0, "", []
-    for var, (grad, floor) in _variant_forms(ds).items():
+    for var, (grad, floor) in sweep.variant_forms(ds).items():
         if grad != "symmetric" or floor not in ("mirror_hydrostatic", "mirror_equal"):
             continue  # the closed form is that of the symmetric form with a mirrored floor
         checked.append(var)
@@ -252,7 +237,7 @@ def measure_one_nb_residue(ctx, entry):
         parts.append(f"{SHORT[str(kern)]} median {np.median(res):.3g}, {100 * share:.0f} % >= {large:g}")
     k_min = min(flips, key=flips.get)
     # the other gradient form (no closed form here): the solver's error at the largest N stands for its residue
-    forms = _variant_forms(ds)
+    forms = sweep.variant_forms(ds)
     v0 = str(ds.variant.values[0])
     sweep = [("gradient_form", f"{forms[v0][0]} (kept)", bool(ok))]
     other = []

@@ -76,6 +76,36 @@ def run_sweep(s):
     )
 
 
+def variant_forms(ds):
+    """{variant: (gradient form, floor)} of a sweep's variants (its attributes)."""
+    grads = str(ds.attrs["variant_gradient"]).split()
+    floors = str(ds.attrs["variant_floor"]).split()
+    return {str(v): (g, f) for v, g, f in zip(ds.variant.values, grads, floors)}
+
+
+def linearity(ds):
+    """Linearity of the solve in rho g on sweep ds: for its first variant at its largest N and, per kernel, the
+    h/dx whose cond_1(A) there is smallest, the columns at rho g and 2 rho g -> Dataset over 'kernel' of that
+    ratio and max |p(2 rho g) - 2 p(rho g)| / max |2 p(rho g)| (1)."""
+    v0 = str(ds.variant.values[0])
+    grad, floor = variant_forms(ds)[v0]
+    n = int(ds.n.values[-1])
+    height, rho_g = float(ds.attrs["height_cm"]), float(ds.attrs["rho_g_N_cm3"])
+    ratios, diffs = [], []
+    for kern in ds.kernel.values:
+        cond = ds.cond.sel(variant=v0, kernel=kern).values[:, -1]
+        ratio = float(ds.ratio.values[int(np.nanargmin(np.where(np.isfinite(cond), cond, np.nan)))])
+        p1 = solve_column(n, ratio, str(kern), grad, floor, height, rho_g).p
+        p2 = solve_column(n, ratio, str(kern), grad, floor, height, 2.0 * rho_g).p
+        ratios.append(ratio)
+        diffs.append(float(np.abs(p2 - 2.0 * p1).max() / np.abs(2.0 * p1).max()))
+    return xr.Dataset(
+        {"ratio": ("kernel", np.array(ratios), {"units": "1", "long_name": "h/dx of the best-conditioned A at N"}),
+         "rel_diff": ("kernel", np.array(diffs), {"units": "1",
+                                                   "long_name": "max |p(2 rho g) - 2 p(rho g)| / max |2 p(rho g)|"})},
+        coords={"kernel": ds.kernel.values}, attrs={"variant": v0, "n": n, "height_cm": height, "rho_g_N_cm3": rho_g})
+
+
 def behaviour(errors, settle_band, round_off):
     """Class of an error history (window,) at doubling N (1): the rule of config/claims/merino_alonso2020.yaml
     (file header), with its numbers settle_band b and round_off (tolerance.parameters of its rows).
