@@ -181,37 +181,53 @@ def test_a_thread_count_outside_the_machine_is_refused(bad):
 
 
 COLD_PROBE = """
-import json, sys
+import json, sys, time
+from numba.core import event
+from isaflow import driver
 from isaflow.methods.isa import scene as S
 from isaflow.methods.isa import solver
+compiles = []  # perf_counter at the start of every compile (numba's own events)
+
+class Listener(event.Listener):
+    def on_start(self, ev):
+        compiles.append(time.perf_counter())
+
+    def on_end(self, ev):
+        pass
+
+event.register("numba:compile", Listener())
+loops, drive = [], driver.drive
+
+def timed_drive(*args, **kw):  # the driver's timed loop lies inside this call
+    start = time.perf_counter()
+    result = drive(*args, **kw)
+    loops.append((start, time.perf_counter()))
+    return result
+
+driver.drive = timed_drive
 out = {}
 for variant in ("capped", "newton_lm"):
     sc = S.of_run("single", "refined", variant, (), sys.argv[1])
     pos0, weight, _, _ = S.initial_state(sc)
     r = solver.solve(sc, pos0, weight, threads=1)
-    out[variant] = [r.wall_time, r.status]
+    a, b = loops[-1]
+    out[variant] = dict(status=r.status, before=sum(c < a for c in compiles), inside=sum(a <= c <= b for c in compiles))
 print(json.dumps(out))
 """
 
 
 def test_solver_times_exclude_compilation():
-    """The same case in a fresh process with an empty numba cache (everything compiled) and again
-    with the cache filled (loaded): the solver times agree within a factor of 2.  The compile of
-    the ISA kernels takes tens of seconds; solving the refined single vessel (tank single,
-    resolution refined) takes about 0.25 s (capped) and 0.1 s (newton), so any compile inside
-    the timed loop would break the factor.  Timing noise of a shared machine is well inside 2x
-    at these durations."""
+    """In a fresh process with an empty numba cache (every kernel compiled in it), no kernel compiles while the
+    run driver's timed loop runs (Result.wall_time): the stepper is built and its kernels warmed before.  Read
+    off numba's compile events, not off timings."""
     import tempfile
 
     with tempfile.TemporaryDirectory() as cache:
         env = {**os.environ, "NUMBA_CACHE_DIR": cache, "PYTHONPATH": str(ROOT / "src")}
-        runs = []
-        for _ in ("cold", "warm"):
-            out = subprocess.run([sys.executable, "-c", COLD_PROBE, SETTINGS], env=env, cwd=ROOT, capture_output=True,
-                                 text=True, check=True)
-            runs.append(json.loads(out.stdout.strip().splitlines()[-1]))
-    cold, warm = runs
+        out = subprocess.run([sys.executable, "-c", COLD_PROBE, SETTINGS], env=env, cwd=ROOT, capture_output=True,
+                             text=True, check=True)
+    cold = json.loads(out.stdout.strip().splitlines()[-1])
+    assert cold["capped"]["before"] > 0  # the cache was empty: the process compiled, and the events were seen
     for variant in ("capped", "newton_lm"):
-        assert cold[variant][1] == warm[variant][1] == "converged"
-        t_cold, t_warm = cold[variant][0], warm[variant][0]
-        assert t_cold < 2 * t_warm and t_warm < 2 * t_cold, (variant, t_cold, t_warm)
+        assert cold[variant]["status"] == "converged"
+        assert cold[variant]["inside"] == 0, (variant, cold[variant])
