@@ -90,8 +90,6 @@ def one_step(ds):
                 rho0_file=float(ds.attrs["rho0_N_s2_cm4"]))
 
 
-
-
 def checked(ds):
     """The Dataset of :func:`one_step` on run Dataset ds: one scalar variable per VARIABLES entry."""
     st = one_step(ds)
