@@ -192,14 +192,15 @@ def peer_comparison(df):
     parts = [f"l0 = {r.spacing_cm:.3g} cm: {r.status}" + (f" from {r.time_to_rest_s:.3g} s" if r.status == "converged" else "")
              + f", e over the last rest window {r.window_energy_mean:.2g} (max {r.window_energy_max:.2g}), side "
              f"{100 * r.side_err_pair:+.1f} %, floor {100 * r.floor_err_pair:+.1f} % (pair forces; panel reading "
-             f"{100 * r.side_err_panel:+.1f} / {100 * r.floor_err_panel:+.1f} %), {r.ms_per_step:.3g} ms per step"
+             f"{100 * r.side_err_panel:+.1f} / {100 * r.floor_err_panel:+.1f} %)"
              for r in mine.itertuples()]
     return (f"Peer: {PEER['code']} with its defaults on this tank at l0 = {PEER['spacing_cm']:g} cm (../shared/peers.md) is "
             f"not at rest: rms {PEER['rms_1s']:g} / {PEER['rms_3s']:g} cm/s at 1 / 3 s, e = {e_peer:.2g} at 3 s, floor "
             f"{100 * PEER['floor_err']:+.1f} %, side {100 * PEER['side_err']:+.1f} % (averages over 1-3 s, its own panel "
             f"pressures), {PEER['ms_per_step']:g} ms per step on one thread.  This project's standard source: "
             + "; ".join(parts) + ".  Same tank (weight, depth, rho g); the project's spacings other than the peer's hold "
-            "whole rows (72.22 / 72.41 cm, weight held at 9000 N).")
+            "whole rows (72.22 / 72.41 cm, weight held at 9000 N).  This project's time per step at each spacing: "
+            "docs/timing.md (a timing would make this report differ between runs of the same commit).")
 
 
 def cost(bench, target_n=5000, target_ms=50.0):
@@ -227,6 +228,12 @@ def timing(df, cfg):
              f"Pressure solver `{cfg['pressure.solver']}`.", ""]
     lines += _table(df.sort_values(["case", "run"]), [("run", None), ("status", None), ("particles", g), ("ms_per_step", g)],
                     ["run", "status", "particles", "ms/step"])
+    mine = df[(df.source_term == "standard") & df.case.isin(["single", "peer"])].sort_values("spacing_cm")
+    if len(mine):
+        lines += ["", f"Against the peer {PEER['code']} ({PEER['ms_per_step']:g} ms per step on one thread at l0 = "
+                      f"{PEER['spacing_cm']:g} cm, ../shared/peers.md), this project's standard source: "
+                  + "; ".join(f"l0 = {r.spacing_cm:.3g} cm {r.ms_per_step:.3g} ms per step" for r in mine.itertuples())
+                  + "."]
     return "\n".join(lines + [""])
 
 
