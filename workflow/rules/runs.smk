@@ -10,11 +10,14 @@ RUN_BLOCKS = run_blocks()  # {block id: [(method, run id), ...] in run order} (c
 BLOCKED = {run for members in RUN_BLOCKS.values() for _, run in members}
 
 
+# The stamp is kept (not temp): a temp stamp is made again whenever any of its consumers must run, and a job
+# that makes it makes every run of the method rerun (one changed run declaration reran all of them).  A stamp
+# older than the cache folder is harmless: the first run that finds its generation unsealed fills it (core.jit).
 rule compile:
     input:
         code=lambda wc: code("isaflow.run", REGISTRY[wc.method].entry) + ["workflow/scripts/compile.py"],
     output:
-        temp("results/compiled/{method}.txt"),
+        "results/compiled/{method}.txt",
     message:
         "compile {wildcards.method}: every kernel its runs use, into its cache"
     threads: 1

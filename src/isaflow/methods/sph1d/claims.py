@@ -21,6 +21,7 @@ from ... import claims_registry
 from ...claims import Measurement, measure_table
 from ...inputs import InputError, load as load_yaml
 from . import closed_form, sweep
+from .sweep import variant_forms
 
 MEASURES, claim = measure_table()  # {claim id: measure(ctx, entry)}, each measure entered by @claim(id)
 
@@ -79,7 +80,7 @@ def _judged(ctx, judge, table, entry):
     per = {v: judge(rows[rows.variant == v], entry) for v in variants}
     ok, text, margin, why = per[variants[0]]
     notes = []
-    forms = sweep.variant_forms(ds)
+    forms = variant_forms(ds)
     g0, f0 = forms[variants[0]]
     sweep = [("gradient_form", f"{g0} (kept)", bool(ok)), ("floor_treatment", f"{f0} (kept)", bool(ok))]
     if len(variants) > 1:
@@ -168,7 +169,7 @@ def measure_one_nb_explicit(ctx, entry):
     one = ds.neighbours.values == 1
     ratios = ds.ratio.values[one]
     worst, worst_abs, largest, where, checked = 0.0, 0.0, 0.0, "", []
-    for var, (grad, floor) in sweep.variant_forms(ds).items():
+    for var, (grad, floor) in variant_forms(ds).items():
         if grad != "symmetric" or floor not in ("mirror_hydrostatic", "mirror_equal"):
             continue  # the closed form is that of the symmetric form with a mirrored floor
         checked.append(var)
@@ -237,7 +238,7 @@ def measure_one_nb_residue(ctx, entry):
         parts.append(f"{SHORT[str(kern)]} median {np.median(res):.3g}, {100 * share:.0f} % >= {large:g}")
     k_min = min(flips, key=flips.get)
     # the other gradient form (no closed form here): the solver's error at the largest N stands for its residue
-    forms = sweep.variant_forms(ds)
+    forms = variant_forms(ds)
     v0 = str(ds.variant.values[0])
     sweep = [("gradient_form", f"{forms[v0][0]} (kept)", bool(ok))]
     other = []
