@@ -17,20 +17,20 @@ from ...tank import load as load_tank
 from . import model, settings, solver
 
 ROOT = Path(__file__).resolve().parents[4]
-# the check's numbers: name -> (units, long name)
-VARIABLES = {
-    "res1_star": ("1", "largest relative residual of eq. (1) over the liquid, grad P at U*"),
-    "res1_new": ("1", "largest relative residual of eq. (1) over the liquid, grad P at U[n+1]"),
-    "res2": ("1", "largest |(U[n+1] - U[n]) / dt - V[n+1]| over max |V[n+1]| (eq. 2)"),
-    "scale": ("cm s-2", "largest acceleration term of eq. (1): the residuals' unit"),
-    "dt": ("s", "time step of the checked step"),
-    "particles": ("1", "liquid particles"),
-    "solve_residual": ("1", "relative residual of the step's pressure solve"),
-    "shift": ("cm", "largest |U[n+1] - U*|"),
-    "grad_change": ("cm s-2", "largest |grad P(U[n+1]) - grad P(U*)| / rho0"),
-    "rho0": ("N s2 cm-4", "reference density of the step"),
-    "rho0_file": ("N s2 cm-4", "reference density the run file records"),
-}
+# the check's numbers: (name, units, long name)
+VARIABLES = (
+    ("res1_star", "1", "largest relative residual of eq. (1) over the liquid, grad P at U*"),
+    ("res1_new", "1", "largest relative residual of eq. (1) over the liquid, grad P at U[n+1]"),
+    ("res2", "1", "largest |(U[n+1] - U[n]) / dt - V[n+1]| over max |V[n+1]| (eq. 2)"),
+    ("scale", "cm s-2", "largest acceleration term of eq. (1): the residuals' unit"),
+    ("dt", "s", "time step of the checked step"),
+    ("particles", "1", "liquid particles"),
+    ("solve_residual", "1", "relative residual of the step's pressure solve"),
+    ("shift", "cm", "largest |U[n+1] - U*|"),
+    ("grad_change", "cm s-2", "largest |grad P(U[n+1]) - grad P(U*)| / rho0"),
+    ("rho0", "N s2 cm-4", "reference density of the step"),
+    ("rho0_file", "N s2 cm-4", "reference density the run file records"),
+)
 
 
 def _file(path):
@@ -94,7 +94,7 @@ def checked(ds):
     """The Dataset of :func:`one_step` on run Dataset ds: one scalar variable per VARIABLES entry."""
     st = one_step(ds)
     return xr.Dataset({k: ((), np.float64(st[k]) if k != "particles" else np.int64(st[k]), {"units": u, "long_name": n})
-                       for k, (u, n) in VARIABLES.items()})
+                       for k, u, n in VARIABLES})
 
 
 def write(run, outputs):
