@@ -12,7 +12,7 @@ import numpy as np
 
 from ... import runfile
 from ...inputs import InputError
-from . import boundary, solver
+from . import boundary, model, solver
 
 REFERENCES = ("Koshizuka & Oka (1996), Nucl. Sci. Eng. 123, 421; MPS-Basic (github.com/MPS-Basic/MPS-Basic); "
               "Hattori, Seta, Shibata & Koshizuka, 'A new derivation of pressure Poisson equation in MPS'; "
@@ -69,6 +69,8 @@ def warm_up(threads=None):
     for variant in ("standard", "hattori", "mixed"):
         cfg = S.resolved(variant=variant, resolution=None, overrides={"resolution.spacing": 2.0})
         solver.solve(tank, cfg, variant, 2.0, 3e-3, np.array([[10.0, 5.0]]), log=lambda msg: None, threads=threads)
+    # the plain pair distances the step check (step_check.one_step) recomputes its operators with
+    model.distances(np.zeros((2, 2)), np.array([0, 1, 1], np.int64), np.array([1], np.int32))
 
 
 def solve(tank, settings, variant, resolution, start=None, progress=None, threads=None):
