@@ -84,10 +84,7 @@ def _expand_runs(spec, path):
     entry)."""
     methods = registry()
     tank = [name for name, m in methods.items() if m.tank]
-    entries = [(f"inputs.{k}", i) for k, i in enumerate(spec.get("inputs", []))] + [
-        (f"claims.{k}", c) for k, c in enumerate(spec.get("claims", []))] + [
-        (f"claims.{k}.deviation", c["deviation"]) for k, c in enumerate(spec.get("claims", [])) if "deviation" in c]
-    for where, node in entries:
+    for where, node in _run_nodes(spec):
         for field in ("runs", "controls"):
             if field not in node:
                 continue
@@ -99,6 +96,14 @@ def _expand_runs(spec, path):
                                      f"(choose from {', '.join(methods)})")
                 runs += [dict(r, id=r["id"].replace(TANK_METHOD, m)) for m in tank] if TANK_METHOD in r["id"] else [r]
             node[field] = runs
+
+
+def _run_nodes(spec):
+    """[(where, node)] of every part of a registry file that may list runs and controls: its inputs, claims and
+    the claims' deviations."""
+    return [(f"inputs.{k}", i) for k, i in enumerate(spec.get("inputs", []))] + [
+        (f"claims.{k}", c) for k, c in enumerate(spec.get("claims", []))] + [
+        (f"claims.{k}.deviation", c["deviation"]) for k, c in enumerate(spec.get("claims", [])) if "deviation" in c]
 
 
 def _check_file(paper, spec, ids):
@@ -247,7 +252,7 @@ def run_ids(prefix, directory=DEFAULT_DIRECTORY):
     registry names (its runs and controls): the workflow builds the checks the rows declare, and no others."""
     keys = set()
     for spec in load_files(directory).values():
-        for node in spec.get("inputs", []) + spec["claims"] + [c["deviation"] for c in spec["claims"] if "deviation" in c]:
+        for _, node in _run_nodes(spec):
             keys |= {r["id"] for field in ("runs", "controls") for r in node.get(field, []) if r["id"].startswith(prefix)}
     return sorted(keys)
 
