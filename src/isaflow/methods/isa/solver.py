@@ -9,7 +9,6 @@ a particle left the walls' bounding box), ``nonfinite``.
 """
 
 import hashlib
-import time
 from contextlib import contextmanager
 
 import numba

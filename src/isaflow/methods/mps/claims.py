@@ -10,20 +10,16 @@ Units: cm, N, s; rho0 [N s^2 / cm^4], accelerations [cm / s^2], sources of lap P
 """
 
 from fractions import Fraction
-from pathlib import Path
 import random
 
 import numpy as np
 
 from ...claims import Measurement, measure_table
-from ...core import units
-from ...tank import load as load_tank
 from . import model
 from .step_check import run_settings
 
 MEASURES, claim = measure_table()  # {claim id: measure(ctx, entry)}, each measure entered by @claim(id)
 
-ROOT = Path(__file__).resolve().parents[4]
 # measurement design of the registry's 'measure' fields (not tolerances): the eps sequence of
 # hat-eq6-derivation and the dilation of hat-eq4-rho-star
 EPS_SEQUENCE = (1e-2, 5e-3, 2.5e-3, 1.25e-3)
