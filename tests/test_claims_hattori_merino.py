@@ -14,7 +14,8 @@ import xarray as xr
 
 from isaflow import claims, claims_registry
 from isaflow.core import units
-from isaflow.methods.mps import boundary, claims as mps_claims, step_check
+from isaflow import derived
+from isaflow.methods.mps import boundary, claims as mps_claims, derived as mps_derived
 from isaflow.methods.sph1d import claims as sph1d_claims, sweep
 
 from conftest import ROOT
@@ -101,20 +102,29 @@ def _mps_state(variant="standard", l0=100.0 / 18.0, seed=0):
                       attrs=attrs)
 
 
-def test_rho_star_of_the_project_is_the_number_density_not_the_jacobian():
-    """Uniform dilation of the lattice: d ln(n*/n0) / d ln(1/det) = (n0 + z) / (2 n0) for the MPS weight
-    re/r - 1 (z lattice neighbours within the settings' r_e: 28 within 3.1 l0), not 1; the measure finds the source
-    equal to eq. 6 with n*/n0."""
+def test_rho_star_of_the_project_is_the_number_density_not_the_jacobian(tmp_path):
+    """Uniform dilation of the lattice (the derived file, as rule derived writes it): d ln(n*/n0) / d ln(1/det) =
+    (n0 + z) / (2 n0) for the MPS weight re/r - 1 (z lattice neighbours within the settings' r_e: 28 within 3.1
+    l0), not 1; the measure finds the source equal to eq. 6 with n*/n0."""
     ds = _mps_state("hattori")
-    d = mps_claims.dilation_sources(ds)
+    run = tmp_path / "run.nc"
+    ds.to_netcdf(run)
+    derived.write(str(run), [str(tmp_path / "dilation.nc")], "mps:dilation_x", "methods.mps.derived.dilation")
+    dil = xr.open_dataset(tmp_path / "dilation.nc").load()
+    assert all("units" in v.attrs for v in dil.data_vars.values()) and dil.attrs["derived"] == "mps:dilation_x"
+    d = {k: dil[k].item() for k in dil.data_vars}
     n0 = d["n0"]
-    re = mps_claims.run_settings(ds)["model.re_density"]
+    re = mps_derived.run_settings(ds)["model.re_density"]
     g = np.arange(-4, 5)
     z = int(np.count_nonzero((np.hypot(*np.meshgrid(g, g)) > 0) & (np.hypot(*np.meshgrid(g, g)) < re)))
     assert d["sensitivity"] == pytest.approx((n0 + z) / (2 * n0), rel=1e-6)
     assert abs(d["s_model"] - d["s_nd"]) < 1e-9 * abs(d["s_nd"]) < abs(d["s_model"] - d["s_det"])
-    assert mps_claims.measure_rho_star(FakeContext(ds), REGISTRY["hat-eq4-rho-star"]).passed is False
-    assert mps_claims.measure_rho_star(FakeContext(_mps_state()), REGISTRY["hat-eq4-rho-star"]).passed is None
+    row = REGISTRY["hat-eq4-rho-star"]
+    assert [r["id"] for r in row["runs"]][1] == "mps:dilation_" + row["runs"][0]["id"][4:]
+    assert mps_claims.measure_rho_star(FakeContext(ds, **{row["runs"][1]["id"]: dil}), row).passed is False
+    standard = _mps_state()
+    assert mps_claims.measure_rho_star(FakeContext(standard, **{row["runs"][1]["id"]: mps_derived.dilation(standard)}),
+                                       row).passed is None
 
 
 def test_one_mps_step_satisfies_eqs_1_2_at_u_star_and_not_at_u_new(tmp_path):
@@ -122,11 +132,11 @@ def test_one_mps_step_satisfies_eqs_1_2_at_u_star_and_not_at_u_new(tmp_path):
     ds = _mps_state()
     run = tmp_path / "run.nc"
     ds.to_netcdf(run)
-    step_check.write(str(run), [str(tmp_path / "check.nc")])
+    derived.write(str(run), [str(tmp_path / "check.nc")], "mps:step_check_x", "methods.mps.derived.step_check")
     check = xr.open_dataset(tmp_path / "check.nc").load()
-    assert check.attrs["checked_run"] == ds.attrs["run_id"] and all("units" in v.attrs for v in check.data_vars.values())
+    assert check.attrs["run_file"] == str(run) and all("units" in v.attrs for v in check.data_vars.values())
     st = {k: check[k].item() for k in check.data_vars}
-    assert st == step_check.one_step(ds)  # the file holds the check's numbers exactly
+    assert st == mps_derived.one_step(ds)  # the file holds the check's numbers exactly
     assert st["res1_star"] < 1e-12 and st["res2"] < 1e-9
     assert st["res1_new"] > 1e-6  # the gradient moves with U[n+1] - U* = dt^2 grad P / rho0
     for row in ("prj-hat-mps-step", "hat-eq5-implicit"):
@@ -165,7 +175,7 @@ def synthetic_sweep(c2_divergent=True):
 
 
 def test_the_solve_is_linear_in_rho_g_and_the_claim_reads_the_check():
-    """sweep.linearity (the rule sph1d_linearity's product) on a sweep: each kernel at its best-conditioned h/dx
+    """sweep.linearity (the registry's derived sph1d:linearity) on a sweep: each kernel at its best-conditioned h/dx
     (Wendland C2 avoids its ill-conditioned 1.3), p(2 rho g) = 2 p(rho g) to round-off; mer-abs-linear judges
     from that product alone."""
     ds = synthetic_sweep(True)

@@ -266,8 +266,8 @@ def existing_runs():
     runs |= {f"solid:{r}" for r in _smk_list("workflow/rules/methods/solid.smk", "SOLID_CLAIM_RUN_IDS")}
     sweeps = S.read(ROOT / methods.registry()["sph1d"].settings, methods.registry()["sph1d"].values_schema()).get(
         "resolutions", {})  # sph1d.smk: one sweep per resolution
-    runs |= {f"mps:step_check_{r.split(':', 1)[1]}" for r in runs if r.startswith("mps:")}  # mps.smk: any MPS run's
-    return runs | {"sph1d:sweep", "sph1d:linearity"} | {f"sph1d:sweep_{r}" for r in sweeps}
+    runs |= set(reg.derived(CLAIMS_DIR))  # claims.smk: the registry's derived numbers
+    return runs | {"sph1d:sweep"} | {f"sph1d:sweep_{r}" for r in sweeps}
 
 
 def test_runs_exist_or_are_flagged_new():
@@ -325,11 +325,30 @@ def test_copy_loads(registry_copy):
      "more than one value is kept"),
     ("unknown affected set", "papadopoulos2016.yaml", "affects: isa_uncalibrated}", "affects: everything}",
      "everything"),
+    ("derived number no row reads", "hattori.yaml", '- id: "mps:dilation_single_hattori_dx3.45"\n',
+     '- id: "mps:dilation_other"\n', "derived.2 ('mps:dilation_other'): no row or input of its file reads it"),
+    ("derived from an unregistered method", "merino_alonso2020.yaml", 'from: "sph1d:sweep"', 'from: "dem:sweep"',
+     "field 'from' names no registered method"),
+    ("derived number defined twice", "hattori.yaml", '- id: "mps:step_check_single_standard_dx3.45"\n',
+     '- id: "mps:step_check_single_hattori_dx3.45"\n', "defined twice"),
+    ("derived without a function", "hattori.yaml", "compute: methods.mps.derived.dilation",
+     "compute: dilation()", "compute"),
 ])
 def test_loader_refuses(registry_copy, case, file, old, new, message):
     _edit(registry_copy / file, old, new)
     with pytest.raises(InputError, match=re.escape(message) if case != "unknown field" else message):
         reg.load(registry_copy)
+
+
+def test_every_derived_number_names_a_function_and_a_run_of_the_workflow():
+    """A derived entry's compute is an isaflow function and its 'from' a run the workflow makes."""
+    from isaflow import derived
+
+    known = existing_runs()
+    for key, d in reg.derived(CLAIMS_DIR).items():
+        assert callable(derived.function(d["compute"])), key
+        assert d["from"] in known, f"{key}: from '{d['from']}' is no run of the workflow"
+        assert derived.path(key) == f"results/derived/{key.replace(':', '/')}.nc"
 
 
 def test_a_tank_method_run_is_one_entry_per_tank_method():

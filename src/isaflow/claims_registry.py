@@ -186,6 +186,7 @@ def load(directory=DEFAULT_DIRECTORY):
     cycle = _depends_cycle(claims)
     if cycle:
         raise InputError(f"depends_on forms a cycle: {' -> '.join(cycle)}")
+    _derived_of(files)
     return claims
 
 
@@ -245,6 +246,32 @@ def declared_runs(entry, inputs, entries=None):
             keys |= {r["id"] for r in inputs.get(name, {}).get("runs", [])}
         todo += [entries[d] for d in e.get("depends_on", []) if entries and d in entries and d not in seen]
     return keys
+
+
+def derived(directory=DEFAULT_DIRECTORY):
+    """{id: entry} of every file's ``derived`` entries (isaflow.derived), in file order (checked as :func:`load`
+    checks them)."""
+    return _derived_of(load_files(directory))
+
+
+def _derived_of(files):
+    """The derived entries of the loaded files; InputError naming the file and entry for an id defined twice, a
+    method not registered, or an entry no row or input of its file reads."""
+    methods, out = registry(), {}
+    for spec in files.values():
+        named = {r["id"] for _, node in _run_nodes(spec) for f in ("runs", "controls") for r in node.get(f, [])}
+        for k, d in enumerate(spec.get("derived", [])):
+            where = f"{spec['_path']}: derived.{k} ('{d['id']}')"
+            for field in ("id", "from"):
+                if d[field].split(":", 1)[0] not in methods:
+                    raise InputError(f"{where}: field '{field}' names no registered method "
+                                     f"(choose from {', '.join(methods)})")
+            if d["id"] in out:
+                raise InputError(f"{where}: defined twice")
+            if d["id"] not in named:
+                raise InputError(f"{where}: no row or input of its file reads it (name it among a row's runs)")
+            out[d["id"]] = d
+    return out
 
 
 def run_ids(prefix, directory=DEFAULT_DIRECTORY):

@@ -7,6 +7,24 @@
 CLAIMS_KERNELS = next(iter(REGISTRY))
 
 
+# numbers the claims read that no solver writes (the registry files' `derived` entries, isaflow.derived; DERIVED in
+# common.smk): each computed from the run file its entry names by its own job, with that method's kernels
+use rule call as derived with:
+    input:
+        unpack(derived_inputs),
+    output:
+        "results/derived/{method}/{name}.nc",
+    params:
+        func="derived.write",
+        kernels=lambda wc: wc.method,
+        kw=lambda wc: {"key": f"{wc.method}:{wc.name}", "compute": DERIVED[f"{wc.method}:{wc.name}"]["compute"]},
+    wildcard_constraints:
+        method="|".join(sorted({k.split(":", 1)[0] for k in DERIVED})) or "(?!)",
+        name="|".join(re.escape(k.split(":", 1)[1]) for k in DERIVED) or "(?!)",
+    log:
+        "logs/derived/{method}/{name}.log",
+
+
 use rule call as claims with:
     input:
         run_files=claim_inputs,

@@ -13,6 +13,7 @@ import time
 sys.path.insert(0, os.path.join(workflow.basedir, "src"))
 
 from isaflow import deps as _deps  # noqa: E402
+from isaflow import derived as _derived  # noqa: E402
 from isaflow import inputs as _inputs  # noqa: E402
 from isaflow import methods as _methods  # noqa: E402
 from isaflow import timing as _timing  # noqa: E402
@@ -311,6 +312,33 @@ CLAIM_LABELS = _methods.papers()  # {paper id: label}
 OTHER_RUN_FILES = {}
 # groups of runs, by '<method>:<group>' (ISA's study groups, calibration)
 RUN_GROUPS = {}
+
+
+# numbers the claims read that no solver writes (the registry files' `derived` entries, isaflow.derived; rule
+# derived in claims.smk): each computed from the run file its entry names, read by the claims as a run file
+def _derived_entries():
+    from isaflow import claims_registry  # noqa: E402
+
+    try:
+        return claims_registry.derived()
+    except _inputs.InputError as err:
+        refuse(err)
+
+
+DERIVED = _derived_entries()  # {'<method>:<name>': entry}
+OTHER_RUN_FILES.update({k: _derived.path(k) for k in DERIVED})
+
+
+def derived_inputs(wc):
+    """The run file a derived number is computed from, the code, and (a tank method's) the kernels' compile stamp."""
+    key = f"{wc.method}:{wc.name}"
+    if key not in DERIVED:
+        refuse(f"config/claims: field 'derived': no entry '{key}' (declared: {', '.join(DERIVED)})")
+    entry = DERIVED[key]
+    out = {"run": claim_runs()[entry["from"]], "code": func_code(entry["compute"]) + code("derived")}
+    if wc.method in TANK_METHODS:
+        out["compiled"] = ancient(f"results/compiled/{wc.method}.txt")
+    return out
 
 
 def claim_runs(wc=None):

@@ -3,35 +3,11 @@
 # through the shared rule `run`; here the summary, figures, report fragment 55 and timing fragment (the claims:
 # claims.smk, measures in methods/mps/claims.py).
 # Package: src/isaflow/methods/mps/.
-from isaflow import claims_registry as _claims_registry  # noqa: E402
-
 _MPS_RUNS = RUNS["mps"]  # its settings file's runs (common.smk)
 MPS_FILES = [run_file("mps", r) for r in _MPS_RUNS]
 MPS_SINGLE = [run_file("mps", r) for r in _MPS_RUNS if r.startswith("single_")]
 MPS_BEFORE = [run_file("mps", r) for r in _MPS_RUNS if r.startswith("kog_")]  # the settings before issue 30
 MPS_FLOW_FINEST = [run_file("mps", r) for r, d in _MPS_RUNS.items() if r.startswith("flow_") and d["resolution"] == "dx3.45"]
-
-
-# one MPS step from a run's final state, checked against Hattori et al.'s eqs. (1)-(2) (methods.mps.step_check):
-# the checks the claims registry's rows name ('mps:step_check_<run id>'), each read by the claims as a run file
-MPS_STEP_CHECKS = [k.split(":", 1)[1].removeprefix("step_check_") for k in _claims_registry.run_ids("mps:step_check_")]
-OTHER_RUN_FILES.update({f"mps:step_check_{r}": f"results/mps/step_check_{r}.nc" for r in MPS_STEP_CHECKS})
-
-
-use rule call as mps_step_check with:
-    input:
-        run=lambda wc: run_file("mps", wc.run),
-        compiled=ancient("results/compiled/mps.txt"),
-        code=code("methods.mps.step_check"),
-    output:
-        "results/mps/step_check_{run}.nc",
-    params:
-        func="methods.mps.step_check.write",
-        kernels="mps",
-    wildcard_constraints:
-        run="|".join(re.escape(r) for r in MPS_STEP_CHECKS) or "(?!)",
-    log:
-        "logs/mps/step_check_{run}.log",
 
 
 use rule call as mps_summary with:

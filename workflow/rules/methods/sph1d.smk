@@ -104,19 +104,5 @@ use rule call as sph1d_report with:
         "logs/sph1d/report.log",
 
 
-# the solve's linearity in rho g, at the sweep's best-conditioned h/dx of each kernel (claim mer-abs-linear)
-use rule call as sph1d_linearity with:
-    input:
-        sweep_nc="results/sph1d/sweep.nc",
-        code=SPH1D_CODE,
-    output:
-        "results/sph1d/linearity.nc",
-    params:
-        func="methods.sph1d.pipeline.run_linearity",
-    log:
-        "logs/sph1d/linearity.log",
-
-
-# the sweep and its products the claims read (claims.smk)
+# the sweep, read by the claims (claims.smk)
 OTHER_RUN_FILES["sph1d:sweep"] = "results/sph1d/sweep.nc"
-OTHER_RUN_FILES["sph1d:linearity"] = "results/sph1d/linearity.nc"

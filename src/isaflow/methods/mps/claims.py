@@ -3,8 +3,9 @@ each row's tolerance test passed, read from the registry entry (isaflow.claims t
 
 ``MEASURES = {claim id: function(ctx, entry) -> isaflow.claims.Measurement}``.  The paper's statements are
 derivations, so most measures are exact or numeric checks of the printed equations (paper arithmetic);
-two read the check of one MPS step from the final state of a registry run against eqs. (1)-(2)
-(``ctx.run('mps:step_check_<run id>')``, written by methods.mps.step_check).
+three read numbers derived from a registry run (its file's ``derived``: the check of one MPS step from the run's
+final state against eqs. (1)-(2), ``mps:step_check_<run id>``, and its source on a dilated lattice,
+``mps:dilation_<run id>``; methods.mps.derived).
 
 Units: cm, N, s; rho0 [N s^2 / cm^4], accelerations [cm / s^2], sources of lap P = S [N / cm^4].
 """
@@ -14,16 +15,15 @@ import random
 
 import numpy as np
 
+from ... import derived
 from ...claims import Measurement, measure_table
 from . import model
-from .step_check import run_settings
 
 MEASURES, claim = measure_table()  # {claim id: measure(ctx, entry)}, each measure entered by @claim(id)
 
 # measurement design of the registry's 'measure' fields (not tolerances): the eps sequence of
-# hat-eq6-derivation and the dilation of hat-eq4-rho-star
+# hat-eq6-derivation (hat-eq4-rho-star's dilation: methods.mps.derived.DILATION)
 EPS_SEQUENCE = (1e-2, 5e-3, 2.5e-3, 1.25e-3)
-DILATION = 1e-4
 DENSITY_OFFSET = 1e-3  # Rho[n] / rho0 - 1 of the alternative reference configuration (sensitivity only)
 
 
@@ -149,65 +149,36 @@ def measure_eq6_derivation(ctx, entry):
 # --- hat-eq4-rho-star: the project's Rho* against rho0 / det(dU*/dxi) -------------------------------------
 
 
-def dilation_sources(ds, e=DILATION):
-    """On a square lattice of the run's spacing dilated uniformly by (1 + e) in 2D (det(dU*/dxi) = (1 + e)^2,
-    V* = e U[n] / dt, div V* = 2 e / ((1 + e) dt) with respect to U*): the project's source of the run's
-    variant (model.source_term, unrelaxed) at the centre particle, eq. (6) with Rho* = rho0 / det and with
-    Rho* = rho0 n*/n0 [N/cm^4], and the sensitivity d ln(n*/n0) / d ln(1/det) (1; central difference)."""
-    cfg = run_settings(ds)
-    l0, dt, rho0 = float(ds.attrs["spacing"]), float(ds.attrs["dt_s"]), float(ds.attrs["rho0_N_s2_cm4"])
-    re = cfg["model.re_density"] * l0
-    k = int(np.ceil(cfg["model.re_density"])) + 2
-    grid = np.arange(-k, k + 1) * l0
-    x, y = np.meshgrid(grid, grid)
-    base = np.column_stack([x.ravel(), y.ravel()])
-    centre = int(np.argmin(np.hypot(*base.T)))
-
-    def density(scale):
-        pos = base * scale
-        kind = np.zeros(len(pos), np.int64)
-        box = np.array([pos[:, 0].min() - l0, pos[:, 1].min() - l0, pos[:, 0].max() + l0, pos[:, 1].max() + l0])
-        start, nbr = model.neighbour_list(pos, kind, box, re, np.full(len(pos), -1, np.int64),
-                                          np.ones(len(pos), np.int64), np.zeros((0, 4)))
-        return float(model.number_density(start, nbr, model.distances(pos, start, nbr), re)[centre])
-
-    n0 = density(1.0)
-    n_star = density(1.0 + e)
-    det = (1.0 + e) ** 2
-    div = 2.0 * e / ((1.0 + e) * dt)
-    source = model.SOURCES[str(ds.attrs["source_term"])]
-    s_model = float(model.source_term(n_star, div, n0, rho0, dt, source, cfg["model.gamma_mixed"], 1.0))
-
-    def eq6(rho_star):
-        return (rho0 - rho_star) / dt**2 + (rho0 - rho_star) / dt * div
-
-    sens = (np.log(density(1.0 + e)) - np.log(density(1.0 - e))) / (2 * np.log(1 - e) - 2 * np.log(1 + e))
-    return dict(s_model=s_model, s_det=eq6(rho0 / det), s_nd=eq6(rho0 * n_star / n0), sensitivity=float(sens),
-                n0=n0, n0_file=float(ds.attrs["n0_density"]), relax=cfg["model.relaxation"],
-                scope=str(cfg["model.relaxation_scope"]), source=str(ds.attrs["source_term"]))
+def _with_derived(ctx, entry):
+    """(run key, product key, run, {name: value} of the product) of a row whose runs are a run and a number
+    derived from it (its registry file's ``derived``, isaflow.derived): variables, then the product's text
+    attributes."""
+    key, product = (r["id"] for r in entry["runs"][:2])
+    ds, d = ctx.run(key), ctx.run(product)
+    return key, product, ds, {k: d[k].item() for k in d.data_vars} | {k: v for k, v in d.attrs.items()
+                                                                   if k in ("relaxation_scope", "source_term")}
 
 
 @claim("hat-eq4-rho-star")
 def measure_rho_star(ctx, entry):
-    key = entry["runs"][0]["id"]
-    ds = ctx.run(key)
+    key, product, ds, d = _with_derived(ctx, entry)
     if str(ds.attrs["source_term"]) != "hattori":
         return Measurement(f"{key} is a run of the '{ds.attrs['source_term']}' source term, not of eq. (6)", None)
-    d = dilation_sources(ds)
     off_det = abs(d["s_model"] - d["s_det"]) / abs(d["s_det"])
     off_nd = abs(d["s_model"] - d["s_nd"]) / abs(d["s_det"])
     ok = off_det < off_nd
-    a_d, a_v = model.relaxation_factors(model.SOURCES["hattori"], model.RELAX_SCOPES[d["scope"]], d["relax"])
+    a_d, a_v = model.relaxation_factors(model.SOURCES["hattori"], model.RELAX_SCOPES[d["relaxation_scope"]],
+                                       d["relaxation"])
     relax = (f"; the run also multiplies eq. (6)'s density term by {a_d:g} and its divergence term by {a_v:g} "
-             f"(model.relaxation {d['relax']:g}, relaxation_scope '{d['scope']}'), which eq. (6) does not have"
+             f"(model.relaxation {d['relaxation']:g}, relaxation_scope '{d['relaxation_scope']}'), which eq. (6) does not have"
              ) if (a_d, a_v) != (1.0, 1.0) else ""
     return Measurement(
-        measured=f"source term '{d['source']}' of {key.split(':', 1)[1]} on a uniform dilation e = {DILATION:g} of its "
+        measured=f"source term '{d['source_term']}' of {key.split(':', 1)[1]} on a uniform dilation e = {d['dilation']:g} of its "
                  f"lattice (l0 = {float(ds.attrs['spacing']):.4g} cm): differs from eq. (6) with Rho* = rho0/det by "
                  f"{off_det:.3g} and from eq. (6) with Rho* = rho0 n*/n0 by {off_nd:.3g} (relative); "
                  f"d ln(n*/n0) / d ln(1/det) = {d['sensitivity']:.4f} (1 for the Jacobian){relax}",
         passed=bool(ok),
-        evidence="isaflow.methods.mps.claims.dilation_sources; model.source_term (Rho* = rho0 n*/n0)",
+        evidence=f"isaflow.methods.mps.derived.dilation ({derived.path(product)}); model.source_term (Rho* = rho0 n*/n0)",
         why="" if ok else ("the project's Rho* is rho0 n*/n0 (number density), not rho0 / det(dU*/dxi): to first order "
                            f"it responds {d['sensitivity']:.3f} times as strongly to a dilation"),
         margin=f"first-order sensitivity {d['sensitivity']:.4f} against 1 (the two definitions agree only at 1)",
@@ -219,10 +190,9 @@ def measure_rho_star(ctx, entry):
 
 def _stepped(ctx, entry):
     """(tolerance, run key, run, the step check of its final state) of a row judged on one MPS step: its runs
-    are the run and its check (results/mps/step_check_<run>.nc, methods.mps.step_check)."""
-    key, check = (r["id"] for r in entry["runs"][:2])
-    ds, st = ctx.run(key), ctx.run(check)
-    return entry["tolerance"]["value"], key, ds, {k: st[k].item() for k in st.data_vars}
+    are the run and its check (results/derived/mps/step_check_<run>.nc, methods.mps.derived.step_check)."""
+    key, _, ds, st = _with_derived(ctx, entry)
+    return entry["tolerance"]["value"], key, ds, st
 
 
 @claim("hat-eq5-implicit")
@@ -235,8 +205,8 @@ def measure_eq5_implicit(ctx, entry):
                  f"(U[n+1] - U* up to {st['shift']:.3g} cm; grad P / rho0 changes by up to {st['grad_change']:.3g} "
                  f"cm/s^2 of {st['scale']:.4g})",
         passed=not found,  # paper inconsistency: the quoted claim holds unless its test finds the inconsistency
-        evidence=f"isaflow.methods.mps.step_check.one_step on results/runs/mps/{key.split(':', 1)[1]}.nc "
-                 f"(results/mps/step_check_{key.split(':', 1)[1]}.nc); "
+        evidence=f"isaflow.methods.mps.derived.one_step on results/runs/mps/{key.split(':', 1)[1]}.nc "
+                 f"(results/derived/mps/step_check_{key.split(':', 1)[1]}.nc); "
                  "tests/test_mps.py::test_pressure_gradient_at_new_positions_equals_the_one_used (strict xfail)",
         why=(f"eqs. (5)-(6) as printed: the step satisfies eq. (1) with the gradient at U* (residual "
              f"{st['res1_star']:.3g}), not at U[n+1] ({st['res1_new']:.3g} > {tol:g})") if found else "",
@@ -252,8 +222,8 @@ def measure_mps_step(ctx, entry):
                  f"residual {st['solve_residual']:.2g}) from {_run_text(key, ds)}: relative residual of eq. (1) "
                  f"(grad P at U*, rho0 for Rho[n+1]) {st['res1_star']:.3g}, of eq. (2) {st['res2']:.3g}",
         passed=worst <= tol,
-        evidence=f"isaflow.methods.mps.step_check.one_step on results/runs/mps/{key.split(':', 1)[1]}.nc "
-                 f"(results/mps/step_check_{key.split(':', 1)[1]}.nc); "
+        evidence=f"isaflow.methods.mps.derived.one_step on results/runs/mps/{key.split(':', 1)[1]}.nc "
+                 f"(results/derived/mps/step_check_{key.split(':', 1)[1]}.nc); "
                  "tests/test_mps.py::test_eqs_3_and_5_add_up_to_the_discrete_navier_stokes_eqs_1_2",
         why="" if worst <= tol else f"a residual {worst:.3g} > {tol:g}",
         margin=f"largest residual {worst:.3g} against {tol:g}")

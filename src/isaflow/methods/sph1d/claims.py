@@ -26,7 +26,7 @@ from .sweep import variant_forms
 MEASURES, claim = measure_table()  # {claim id: measure(ctx, entry)}, each measure entered by @claim(id)
 
 SWEEP = "sph1d:sweep"
-LINEARITY = "sph1d:linearity"  # results/sph1d/linearity.nc (sweep.linearity)
+LINEARITY = "sph1d:linearity"  # results/derived/sph1d/linearity.nc (sweep.linearity; the registry's derived)
 EXTENDED = "sph1d:sweep_n8192"  # the sweep to N = 8192 (registry input n_window): sensitivity only
 SURFACE_TOP = "sph1d:sweep_surface_top"  # the top particle on the surface (registry input surface_placement)
 EVIDENCE = "results/sph1d/sweep.nc"
@@ -153,7 +153,7 @@ def measure_linear(ctx, entry):
     return Measurement(
         measured=f"{lin.attrs['variant']}, N = {int(lin.attrs['n'])}, the best-conditioned h/dx of each kernel: max "
                  f"|p(2 rho g) - 2 p(rho g)| / max |2 p(rho g)| = " + "; ".join(parts),
-        passed=ok, evidence="isaflow.methods.sph1d.sweep.linearity (results/sph1d/linearity.nc: A p = b, b linear "
+        passed=ok, evidence="isaflow.methods.sph1d.sweep.linearity (results/derived/sph1d/linearity.nc: A p = b, b linear "
                             "in rho g)",
         why="" if ok else f"a relative difference {worst:.3g} > {tol:g}",
         margin=f"largest difference {worst:.3g} against {tol:g}")

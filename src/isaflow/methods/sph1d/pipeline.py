@@ -43,16 +43,6 @@ def run_sweep(settings_path, outputs, resolution=None):
         log.removeHandler(handler)
 
 
-def run_linearity(sweep_nc, outputs):
-    """outputs: [the netCDF of sweep.linearity on the sweep (with provenance)], read by the claim mer-abs-linear."""
-    jit.use("sph1d")
-    started = runfile.now()
-    with xr.open_dataset(sweep_nc) as ds:
-        out = sweep.linearity(ds.load())
-    out.attrs.update(started=started, finished=runfile.now(), **runfile.provenance({"sweep": sweep_nc}))
-    runfile.write(out, outputs[0])
-
-
 def make_cases(sweep_nc, registry, outputs):
     """outputs: the case table and the summary table, classified by the rule of the claims registry file
     ``registry`` (claims.rule_of_file), over the sweep's window."""

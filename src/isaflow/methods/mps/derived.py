@@ -1,9 +1,13 @@
-"""One MPS step checked against Hattori et al.'s eqs. (1)-(2), from the final state of a run: the rule
-``mps_step_check`` writes results/mps/step_check_<run>.nc, which the claims read (hat-eq5-implicit,
-prj-hat-mps-step) as they read any run file.
+"""Numbers computed from an MPS run file for the claims on Hattori et al. (config/claims/hattori.yaml
+``derived``; rule ``derived`` writes each to results/derived/mps/<name>.nc, which the claims read as any run file):
 
-The step is the project's own (solver.step), the collision model off (it is no term of eqs. 1-3); every
-operator of eqs. (1)-(2) is then recomputed independently of the solver.  Units: cm, N, s.
+- :func:`step_check`: one MPS step from the run's final state checked against eqs. (1)-(2) (hat-eq5-implicit,
+  prj-hat-mps-step).  The step is the project's own (solver.step), the collision model off (it is no term of
+  eqs. 1-3); every operator of eqs. (1)-(2) is then recomputed independently of the solver;
+- :func:`dilation`: the run's source term on a uniformly dilated lattice of its spacing against eq. (6) with the
+  paper's Rho* and with the project's (hat-eq4-rho-star).
+
+Units: cm, N, s.
 """
 
 from pathlib import Path
@@ -11,7 +15,6 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from ... import runfile
 from ...core import units
 from ...tank import load as load_tank
 from . import model, settings, solver
@@ -90,19 +93,59 @@ def one_step(ds):
                 rho0_file=float(ds.attrs["rho0_N_s2_cm4"]))
 
 
-def checked(ds):
+def step_check(ds):
     """The Dataset of :func:`one_step` on run Dataset ds: one scalar variable per VARIABLES entry."""
     st = one_step(ds)
     return xr.Dataset({k: ((), np.float64(st[k]) if k != "particles" else np.int64(st[k]), {"units": u, "long_name": n})
                        for k, u, n in VARIABLES})
 
 
-def write(run, outputs):
-    """Rule mps_step_check: the check of run file ``run`` written to outputs[0] (with provenance; the rule binds
-    the MPS kernel generation, params.kernels)."""
-    started = runfile.now()
-    ds = runfile.read(run)
-    out = checked(ds)
-    out.attrs.update(method="mps", checked_run=str(ds.attrs.get("run_id", Path(run).stem)), started=started,
-                     finished=runfile.now(), **runfile.provenance({"checked_run": run}))
-    runfile.write(out, outputs[0])
+
+DILATION = 1e-4  # the dilation e of :func:`dilation` (measurement design, not a tolerance)
+
+
+def dilation(ds, e=DILATION):
+    """The run's source term on a uniform dilation, as a Dataset: on a square lattice of the run's spacing dilated
+    uniformly by (1 + e) in 2D (det(dU*/dxi) = (1 + e)^2, V* = e U[n] / dt, div V* = 2 e / ((1 + e) dt) with
+    respect to U*), the project's source of the run's variant (model.source_term, unrelaxed) at the centre
+    particle (s_model), eq. (6) with Rho* = rho0 / det (s_det) and with Rho* = rho0 n*/n0 (s_nd) [N/cm^4], and
+    the sensitivity d ln(n*/n0) / d ln(1/det) (1; central difference); the run's relaxation and its scope."""
+    cfg = run_settings(ds)
+    l0, dt, rho0 = float(ds.attrs["spacing"]), float(ds.attrs["dt_s"]), float(ds.attrs["rho0_N_s2_cm4"])
+    re = cfg["model.re_density"] * l0
+    k = int(np.ceil(cfg["model.re_density"])) + 2
+    grid = np.arange(-k, k + 1) * l0
+    x, y = np.meshgrid(grid, grid)
+    base = np.column_stack([x.ravel(), y.ravel()])
+    centre = int(np.argmin(np.hypot(*base.T)))
+
+    def density(scale):
+        pos = base * scale
+        kind = np.zeros(len(pos), np.int64)
+        box = np.array([pos[:, 0].min() - l0, pos[:, 1].min() - l0, pos[:, 0].max() + l0, pos[:, 1].max() + l0])
+        start, nbr = model.neighbour_list(pos, kind, box, re, np.full(len(pos), -1, np.int64),
+                                          np.ones(len(pos), np.int64), np.zeros((0, 4)))
+        return float(model.number_density(start, nbr, model.distances(pos, start, nbr), re)[centre])
+
+    n0 = density(1.0)
+    n_star = density(1.0 + e)
+    det = (1.0 + e) ** 2
+    div = 2.0 * e / ((1.0 + e) * dt)
+    source = model.SOURCES[str(ds.attrs["source_term"])]
+    s_model = float(model.source_term(n_star, div, n0, rho0, dt, source, cfg["model.gamma_mixed"], 1.0))
+
+    def eq6(rho_star):
+        return (rho0 - rho_star) / dt**2 + (rho0 - rho_star) / dt * div
+
+    sens = (np.log(density(1.0 + e)) - np.log(density(1.0 - e))) / (2 * np.log(1 - e) - 2 * np.log(1 + e))
+    values = (("dilation", e, "1", "uniform dilation e of the lattice (positions times 1 + e)"),
+              ("s_model", s_model, "N cm-4", "the run's source term (unrelaxed) at the centre particle"),
+              ("s_det", eq6(rho0 / det), "N cm-4", "eq. (6) with Rho* = rho0 / det(dU*/dxi)"),
+              ("s_nd", eq6(rho0 * n_star / n0), "N cm-4", "eq. (6) with Rho* = rho0 n*/n0"),
+              ("sensitivity", float(sens), "1", "d ln(n*/n0) / d ln(1/det), central difference (1 for the Jacobian)"),
+              ("n0", n0, "1", "number density of the undilated lattice at the centre particle"),
+              ("n0_file", float(ds.attrs["n0_density"]), "1", "reference number density the run file records"),
+              ("relaxation", cfg["model.relaxation"], "1", "the run's relaxation coefficient"))
+    out = xr.Dataset({k: ((), np.float64(v), {"units": u, "long_name": n}) for k, v, u, n in values})
+    out.attrs.update(relaxation_scope=str(cfg["model.relaxation_scope"]), source_term=str(ds.attrs["source_term"]))
+    return out
