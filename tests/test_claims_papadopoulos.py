@@ -9,7 +9,7 @@ import math
 import numpy as np
 import pytest
 
-from isaflow import claims, claims_registry, runfile
+from isaflow import claims, claims_registry, derived, runfile
 from isaflow.core.units import G
 from isaflow.methods.isa import claims as PC
 from isaflow.methods.isa import dynamics as D
@@ -105,15 +105,27 @@ def test_measures_on_the_paper_lattices(small_runs):
     assert df["verdict"].iloc[0].startswith("not testable") and "isa:flow_complete" in df["measured"].iloc[0]
 
 
-def test_replay_repeats_the_run_bit_for_bit(small_runs):
+def test_replay_repeats_the_run_bit_for_bit(small_runs, tmp_path):
     """The step-by-step replay of the paper's update ends exactly where the run ended; no coordinate moves more
-    than du in a step; a pair reaction changes by at most k_p x 2 sqrt(2) du."""
+    than du in a step; a pair reaction changes by at most k_p x 2 sqrt(2) du.  The du rule's measure reads the
+    replays as the registry's derived files (rule derived) and finds the rule kept (0.18 w coarse, the tie 0.2 w
+    refined)."""
     ds = small_runs.run("isa:single_coarse")
     r = replay.pair_increments(ds)
     du, kp = float(ds.attrs["du"]), float(ds.attrs["pair_r_u"]) / float(ds.attrs["pair_l_u"])
     assert r["identical"] and r["steps"] == int(ds["steps"])
     assert r["max_component_move_cm"] <= du * (1 + 1e-10)
     assert 0 < r["max_pair_increment_N"] <= kp * 2 * math.sqrt(2) * du
+    d = replay.increments(ds)  # the registry's derived file holds the same numbers, with units
+    assert d["max_pair_increment"].item() == r["max_pair_increment_N"] and d["steps"].item() == r["steps"]
+    assert all("units" in v.attrs for v in d.data_vars.values())
+    paths = dict(small_runs.paths)
+    for k in ("single_coarse", "single_refined"):
+        paths[f"isa:replay_{k}"] = str(tmp_path / f"replay_{k}.nc")
+        derived.write(paths[f"isa:{k}"], [paths[f"isa:replay_{k}"]], f"isa:replay_{k}", "methods.isa.replay.increments")
+    m = PC.MEASURES["pap-6.1-du-rule"](claims.Context(paths), BY_ID["pap-6.1-du-rule"])
+    _check(m)
+    assert m.passed is True and "0.179839147 w" in m.measured and "results/derived" not in m.measured
 
 
 def test_hydrostatic_loads_against_their_own_level_have_no_error():

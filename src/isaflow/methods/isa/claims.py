@@ -3,9 +3,9 @@
 ``MEASURES = {claim id: function(ctx, entry) -> isaflow.claims.Measurement}``: every testable claim of the
 paper's registry file, including the few whose runs are SPH or MPS runs (read as ``sph:<run>``,
 ``mps:<run>``).  A measure reads run files through the context (``ctx.run('<method>:<run id>')``,
-``ctx.group('isa:error_vs_runtime')``), computes its quantity with the shared measures (isaflow.metrics)
-and ISA's (methods.isa.metrics, theory, replay), applies the entry's tolerance (``entry['tolerance']``)
-and compares with the paper's numbers the entry holds (``entry['numbers']``): no tolerance and no
+``ctx.group('isa:error_vs_runtime')``, the step-by-step replays as the registry's derived files
+``ctx.run('isa:replay_<run id>')``), computes its quantity with the shared measures (isaflow.metrics) and
+ISA's (methods.isa.metrics, theory), applies the entry's tolerance (``entry['tolerance']``) and compares with the paper's numbers the entry holds (``entry['numbers']``): no tolerance and no
 paper number lives here.  It returns whether the test passed, never a verdict: isaflow.claims.verdict
 turns the boolean into one.
 
@@ -36,7 +36,6 @@ from ... import claims_registry, metrics as M, theory as T
 from ...claims import Measurement, Missing, measure_table, number
 from ...core.units import G
 from . import metrics as IM
-from . import replay
 
 MEASURES, claim = measure_table()  # {claim id: measure(ctx, entry)}, each measure entered by @claim(id)
 
@@ -740,16 +739,13 @@ def du_rule(view, e):
     rows, worst, ok = [], 0.0, True
     typed = float(e["tolerance"]["parameters"]["typed_precision"])
     for k in ("single_coarse", "single_refined"):
-        ds = view.run(k)
-        r = replay.pair_increments(ds)
-        if not r["identical"]:
-            raise RuntimeError(f"replay of {k} did not repeat the run")
+        ds, r = view.run(k), view.run(f"replay_{k}")  # the run and its replay (the registry's derived)
         w = float(ds["weight"].values.max())
-        x = r["max_pair_increment_N"] / w
+        x = r["max_pair_increment"].item() / w
         worst = max(worst, x)
         ok &= x <= tol(e) * (1 + typed)
-        rows.append(f"{k}: largest pair-reaction change in one step {r['max_pair_increment_N']:.9g} N = {x:.9f} w "
-                    f"(step {r['at_step']:,} of {r['steps']:,}; 2 k_p du = "
+        rows.append(f"{k}: largest pair-reaction change in one step {r['max_pair_increment'].item():.9g} N = {x:.9f} w "
+                    f"(step {r['at_step'].item():,} of {r['steps'].item():,}; 2 k_p du = "
                     f"{2 * float(ds.attrs['pair_r_u']) / float(ds.attrs['pair_l_u']) * float(ds.attrs['du']):.3g} N)")
     return Out(ok, "; ".join(rows), short=f"worst {worst:.9f} w",
                margin=f"flips above {tol(e):g} w x (1 + {typed:g}), the precision R_pu and l_pu are typed with",

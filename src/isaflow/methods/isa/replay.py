@@ -11,9 +11,10 @@ Units: cm, N.
 """
 
 import numpy as np
-from ...core.jit import njit
+import xarray as xr
 
 from ...core.geometry import bounding_box
+from ...core.jit import njit
 from ...core.neighbours import build_pairs
 from . import relax as R
 from .forces import law_over_d
@@ -106,3 +107,18 @@ def pair_increments(ds):
         k0, v0 = k1, v1
     return dict(max_pair_increment_N=worst, at_step=at, max_component_move_cm=move, steps=steps,
                 identical=bool(np.array_equal(pos, ds["pos"].values)))
+
+
+def increments(ds):
+    """:func:`pair_increments` of run file ds as a Dataset (the registry's derived 'isa:replay_<run>'); a replay
+    that does not end where the run ended is refused (RuntimeError), so no file holds a replay of another run."""
+    r = pair_increments(ds)
+    if not r["identical"]:
+        raise RuntimeError(f"replay of {ds.attrs.get('run_id', 'the run')} did not repeat the run")
+    values = (("max_pair_increment", np.float64(r["max_pair_increment_N"]), "N",
+               "largest change of any pair reaction in one step"),
+              ("at_step", np.int64(r["at_step"]), "1", "the step of that change"),
+              ("max_component_move", np.float64(r["max_component_move_cm"]), "cm",
+               "largest displacement component of any particle in one step"),
+              ("steps", np.int64(r["steps"]), "1", "steps replayed"))
+    return xr.Dataset({k: ((), v, {"units": u, "long_name": n}) for k, v, u, n in values})
