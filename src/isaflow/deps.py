@@ -68,7 +68,8 @@ def imports(path, by_name=True):
 
 def closure(*modules):
     """Sorted source files (``src/isaflow/...``, relative to the project) of modules and everything they import,
-    with the package __init__ files on their way and the JSON schemas beside them."""
+    with the package __init__ files on their way and the JSON schemas beside them that they name (a module
+    reading ``tank.schema.json`` depends on it; editing the claims schema reruns no solver run)."""
     todo = [m if m.startswith(PACKAGE + ".") or m == PACKAGE else f"{PACKAGE}.{m}" for m in modules]
     files = set()
     seen = set()
@@ -83,7 +84,8 @@ def closure(*modules):
         if path is None:
             continue
         files.add(path)
-        files.update(path.parent.glob("*.json"))
+        text = path.read_text()
+        files.update(p for p in path.parent.glob("*.json") if p.name in text)  # the schemas it reads by name
         todo.extend(imports(path))
     return sorted(str(p.relative_to(ROOT.parents[1])) for p in files)
 
