@@ -182,7 +182,7 @@ def test_the_solve_is_linear_in_rho_g_and_the_claim_reads_the_check():
     lin = sweep.linearity(ds)
     assert list(lin.kernel.values) == KERNELS and float(lin.ratio.sel(kernel="wendland_c2")) != 1.3
     assert float(lin.rel_diff.max()) < 1e-12 and lin.attrs["n"] == NS[-1]
-    m = sph1d_claims.measure_linear(FakeContext(None, **{sph1d_claims.LINEARITY: lin}), REGISTRY["mer-abs-linear"])
+    m = sph1d_claims.measure_linear(FakeContext(None, **{"sph1d:linearity": lin}), REGISTRY["mer-abs-linear"])
     assert m.passed and "C2 h/dx 0.80" in m.measured
 
 

@@ -415,6 +415,8 @@ PARSE_ARGS = {
     **{f"undeclared_{m}_run": (["-c1", f"results/runs/{m}/no_such_run.nc"], f"config/methods/{m}.yaml: field 'runs'")
        for m in DEFAULT},
     "run_of_another_method": (["-c1", "results/runs/mps/single_coarse.nc"], "no mps run 'single_coarse'"),
+    "derived_of_another_method": (["-c1", "results/derived/sph1d/step_check_single_hattori_dx3.45.nc"],
+                                  "config/claims: field 'derived': no entry 'sph1d:step_check_single_hattori_dx3.45'"),
 }
 
 

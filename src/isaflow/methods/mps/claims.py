@@ -189,15 +189,16 @@ def measure_rho_star(ctx, entry):
 
 
 def _stepped(ctx, entry):
-    """(tolerance, run key, run, the step check of its final state) of a row judged on one MPS step: its runs
-    are the run and its check (results/derived/mps/step_check_<run>.nc, methods.mps.derived.step_check)."""
-    key, _, ds, st = _with_derived(ctx, entry)
-    return entry["tolerance"]["value"], key, ds, st
+    """(tolerance, run key, run, the step check of its final state, the evidence) of a row judged on one MPS
+    step: its runs are the run and its check (the registry's derived, methods.mps.derived.step_check)."""
+    key, check, ds, st = _with_derived(ctx, entry)
+    where = f"isaflow.methods.mps.derived.one_step on results/runs/mps/{key.split(':', 1)[1]}.nc ({derived.path(check)}); "
+    return entry["tolerance"]["value"], key, ds, st, where
 
 
 @claim("hat-eq5-implicit")
 def measure_eq5_implicit(ctx, entry):
-    tol, key, ds, st = _stepped(ctx, entry)
+    tol, key, ds, st, where = _stepped(ctx, entry)
     found = st["res1_new"] > tol and st["res1_star"] <= tol  # the registry's test: the inconsistency is there
     return Measurement(
         measured=f"one step (dt = {st['dt']:.4g} s, {st['particles']} particles, collision off) from {_run_text(key, ds)}: "
@@ -205,9 +206,7 @@ def measure_eq5_implicit(ctx, entry):
                  f"(U[n+1] - U* up to {st['shift']:.3g} cm; grad P / rho0 changes by up to {st['grad_change']:.3g} "
                  f"cm/s^2 of {st['scale']:.4g})",
         passed=not found,  # paper inconsistency: the quoted claim holds unless its test finds the inconsistency
-        evidence=f"isaflow.methods.mps.derived.one_step on results/runs/mps/{key.split(':', 1)[1]}.nc "
-                 f"(results/derived/mps/step_check_{key.split(':', 1)[1]}.nc); "
-                 "tests/test_mps.py::test_pressure_gradient_at_new_positions_equals_the_one_used (strict xfail)",
+        evidence=where + "tests/test_mps.py::test_pressure_gradient_at_new_positions_equals_the_one_used (strict xfail)",
         why=(f"eqs. (5)-(6) as printed: the step satisfies eq. (1) with the gradient at U* (residual "
              f"{st['res1_star']:.3g}), not at U[n+1] ({st['res1_new']:.3g} > {tol:g})") if found else "",
         margin=f"residual at U[n+1] {st['res1_new']:.3g} and at U* {st['res1_star']:.3g} against {tol:g}")
@@ -215,15 +214,13 @@ def measure_eq5_implicit(ctx, entry):
 
 @claim("prj-hat-mps-step")
 def measure_mps_step(ctx, entry):
-    tol, key, ds, st = _stepped(ctx, entry)
+    tol, key, ds, st, where = _stepped(ctx, entry)
     worst = max(st["res1_star"], st["res2"])
     return Measurement(
         measured=f"one step (dt = {st['dt']:.4g} s, {st['particles']} particles, collision off, pressure-solve "
                  f"residual {st['solve_residual']:.2g}) from {_run_text(key, ds)}: relative residual of eq. (1) "
                  f"(grad P at U*, rho0 for Rho[n+1]) {st['res1_star']:.3g}, of eq. (2) {st['res2']:.3g}",
         passed=worst <= tol,
-        evidence=f"isaflow.methods.mps.derived.one_step on results/runs/mps/{key.split(':', 1)[1]}.nc "
-                 f"(results/derived/mps/step_check_{key.split(':', 1)[1]}.nc); "
-                 "tests/test_mps.py::test_eqs_3_and_5_add_up_to_the_discrete_navier_stokes_eqs_1_2",
+        evidence=where + "tests/test_mps.py::test_eqs_3_and_5_add_up_to_the_discrete_navier_stokes_eqs_1_2",
         why="" if worst <= tol else f"a residual {worst:.3g} > {tol:g}",
         margin=f"largest residual {worst:.3g} against {tol:g}")

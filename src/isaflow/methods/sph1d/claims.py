@@ -17,7 +17,7 @@ import numpy as np
 import pandas as pd
 from scipy import stats
 
-from ... import claims_registry
+from ... import claims_registry, derived
 from ...claims import Measurement, measure_table
 from ...inputs import InputError, load as load_yaml
 from . import closed_form, sweep
@@ -26,7 +26,6 @@ from .sweep import variant_forms
 MEASURES, claim = measure_table()  # {claim id: measure(ctx, entry)}, each measure entered by @claim(id)
 
 SWEEP = "sph1d:sweep"
-LINEARITY = "sph1d:linearity"  # results/derived/sph1d/linearity.nc (sweep.linearity; the registry's derived)
 EXTENDED = "sph1d:sweep_n8192"  # the sweep to N = 8192 (registry input n_window): sensitivity only
 SURFACE_TOP = "sph1d:sweep_surface_top"  # the top particle on the surface (registry input surface_placement)
 EVIDENCE = "results/sph1d/sweep.nc"
@@ -145,7 +144,7 @@ def measure_setup(ctx, entry):
 @claim("mer-abs-linear")
 def measure_linear(ctx, entry):
     tol = entry["tolerance"]["value"]
-    lin = ctx.run(LINEARITY)
+    lin = ctx.run(entry["runs"][1]["id"])  # the registry's derived linearity of the sweep (sweep.linearity)
     worst = float(lin.rel_diff.max())
     parts = [f"{SHORT[str(k)]} h/dx {float(lin.ratio.sel(kernel=k)):.2f}: {float(lin.rel_diff.sel(kernel=k)):.3g}"
              for k in lin.kernel.values]
@@ -153,8 +152,8 @@ def measure_linear(ctx, entry):
     return Measurement(
         measured=f"{lin.attrs['variant']}, N = {int(lin.attrs['n'])}, the best-conditioned h/dx of each kernel: max "
                  f"|p(2 rho g) - 2 p(rho g)| / max |2 p(rho g)| = " + "; ".join(parts),
-        passed=ok, evidence="isaflow.methods.sph1d.sweep.linearity (results/derived/sph1d/linearity.nc: A p = b, b linear "
-                            "in rho g)",
+        passed=ok, evidence=f"isaflow.methods.sph1d.sweep.linearity ({derived.path(entry['runs'][1]['id'])}: A p = b, "
+                            "b linear in rho g)",
         why="" if ok else f"a relative difference {worst:.3g} > {tol:g}",
         margin=f"largest difference {worst:.3g} against {tol:g}")
 
