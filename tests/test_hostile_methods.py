@@ -372,6 +372,11 @@ PARSE_CASES = {
                                "'probes.flow'"),
     "sph1d_huge_n": ("config/methods/sph1d.yaml", "[32, 64, 128, 256, 512, 1024, 2048]",
                      "[32, 64, 128, 256, 512, 1024, 1000000000000]", "memory"),
+    # a claims' derived number computed from a run nobody makes (was a KeyError while the DAG was built)
+    "derived_from_no_run": ("config/claims/hattori.yaml", 'from: "mps:single_standard_dx3.45"', 'from: "mps:no_such_run"',
+                            "config/claims/hattori.yaml: field 'derived.1.from'"),
+    "derived_unread": ("config/claims/hattori.yaml", '- id: "mps:dilation_single_hattori_dx3.45"\n',
+                       '- id: "mps:dilation_nobody"\n', "derived.2 ('mps:dilation_nobody'): no row or input"),
 }
 
 

@@ -270,18 +270,8 @@ def _derived_of(files):
                 raise InputError(f"{where}: defined twice")
             if d["id"] not in named:
                 raise InputError(f"{where}: no row or input of its file reads it (name it among a row's runs)")
-            out[d["id"]] = d
+            out[d["id"]] = d | {"_path": spec["_path"], "_where": f"derived.{k}"}
     return out
-
-
-def run_ids(prefix, directory=DEFAULT_DIRECTORY):
-    """Sorted run keys starting with ``prefix`` ('<method>:<run id>...') that any row, deviation or input of the
-    registry names (its runs and controls): the workflow builds the checks the rows declare, and no others."""
-    keys = set()
-    for spec in load_files(directory).values():
-        for _, node in _run_nodes(spec):
-            keys |= {r["id"] for field in ("runs", "controls") for r in node.get(field, []) if r["id"].startswith(prefix)}
-    return sorted(keys)
 
 
 def inputs(directory=DEFAULT_DIRECTORY):

@@ -360,7 +360,7 @@ def check_inputs():
     """Every input checked before any job starts (the Snakefile calls this after every rules file declared
     its runs): the comparison's tanks; every declared run of every tank method (tank, variant, resolution,
     overrides, start run, outcomes, plausibility, cost: isaflow.preflight); the settings of the methods
-    without tanks (preflight.check_file).  The first error stops the workflow with one line.  Each run's
+    without tanks (preflight.check_file); the run each derived number of the claims is computed from.  The first error stops the workflow with one line.  Each run's
     estimate then gives its job's mem_mb and runtime (RUN_RESOURCES, isaflow.budget.job_resources)."""
     from isaflow import budget as _budget
     from isaflow import preflight as _preflight
@@ -382,6 +382,12 @@ def check_inputs():
         for name, m in REGISTRY.items():
             if not m.tank:
                 _preflight.check_file(name)
+        runs = claim_runs()
+        for key, entry in DERIVED.items():  # a derived number is computed from a run the workflow makes
+            if entry["from"] not in runs:
+                raise _inputs.InputError(f"{entry['_path']}: field '{entry['_where']}.from': '{entry['from']}' is no run "
+                                         "of the workflow (a declared run '<method>:<run id>' or a product such as "
+                                         "'sph1d:sweep')")
     except _inputs.InputError as err:
         refuse(err)
     RUN_RESOURCES.update({key: _budget.job_resources(cost) for key, cost in d.costs.items()})
