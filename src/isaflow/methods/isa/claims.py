@@ -934,8 +934,9 @@ def improved(view, e):
                    f"{rms_c:.3f} -> {rms_r:.3f} gamma h a ({view.level})" + ("; " + "; ".join(rep) if rep else ""),
                short=f"side {side_c:.1%} -> {side_r:.1%}, RMS {rms_c:.3f} -> {rms_r:.3f}",
                margin="both measures must fall from coarse to refined",
-               why="the refined lattice's side-wall deficit is larger: the wall law near the walls (l_bu = 5 cm, twice "
-                   "the refined row pitch) and the lattice's stress ratio set the side loads, not the resolution")
+               why=f"the refined lattice's side-wall deficit is larger: the wall law near the walls (l_bu = "
+                   f"{float(view.run('single_refined').attrs['wall_l_u']):g} cm on the refined lattice) and the "
+                   "lattice's stress ratio set the side loads, not the resolution")
 
 
 # ================================================================================ sections 6.3-6.4: the flows
@@ -984,7 +985,8 @@ def not_equilibrium(view, e):
     ds = view.run("flow_incomplete")
     r = float(ds["residual"])
     return Out(r >= tol(e), f"max|F| = {r:.3g} N at step {int(ds['steps']):,}", short=f"{r:.3g} N",
-               margin=f"flips below {tol(e):g} N", why="the residual forces are not much larger than 0.1 N")
+               margin=f"flips below {tol(e):g} N",
+               why=f"the residual forces are not much larger than the run's stop threshold {float(ds.attrs['f_tol']):g} N")
 
 
 @measured("pap-6.3-sum-fx", "figures/fig09_flow_incomplete.png")

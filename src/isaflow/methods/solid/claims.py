@@ -867,7 +867,7 @@ def eq27_guarantee(ctx, e):
         f"largest step move {move:.4g} dx (per increment {fmt_list(per, '{:.3g}')}) up to the run's end ({status(ds)}, "
         f"step {int(ds['steps'])})", move <= lim,
         evidence="results/solid/hertz_eq27_paper.nc max_step_move_over_dx (dt from the speeds at the step's start)",
-        why="" if move <= lim else "dt is chosen from the speeds before the step's acceleration, so the move can exceed 0.1 dx",
+        why="" if move <= lim else f"dt is chosen from the speeds before the step's acceleration, so the move can exceed {lim:g} dx",
         margin=f"{move:.3g} dx against {lim:g} dx")
 
 
