@@ -89,6 +89,7 @@ class State:
         self.div_mode = model.DIVERGENCES[cfg["model.divergence"]]
         self.n_prev = None  # number density at the start of the previous step (ECS)
         self.builds = 0
+        self.dist_memo = None  # (builds, positions, distances) of the last distances call
         self.start = self.nbr = self.list_pos = None
         self.surf = np.zeros(n, bool)
         self.solve_error = ""
@@ -108,9 +109,15 @@ class State:
     def distances(self, pos):
         """(M,) distance of every list entry at pos, inf where the pair does not see each other across a thin
         wall at pos (the lists hold every pair in range; visibility is that of the positions the operators
-        use, so a particle that grazes a thin wall's line between list builds sees, and is seen, as it is now)."""
-        return model.visible_distances(pos, self.start, self.nbr, self.tw, self.tside, self.thin, self.rmax + self.skin,
-                                       self.cfg["walls.thin_line_of_sight"])
+        use, so a particle that grazes a thin wall's line between list builds sees, and is seen, as it is now).
+        The last result is reused when pos equals, value for value, the positions it was computed at with the
+        same lists (the predicted positions that no collision or reflection moved): the same numbers, once."""
+        if self.dist_memo is not None and self.dist_memo[0] == self.builds and np.array_equal(self.dist_memo[1], pos):
+            return self.dist_memo[2]
+        d = model.visible_distances(pos, self.start, self.nbr, self.tw, self.tside, self.thin, self.rmax + self.skin,
+                                    self.cfg["walls.thin_line_of_sight"])
+        self.dist_memo = (self.builds, pos.copy(), d)
+        return d
 
     def list_valid(self, pos):
         """The lists still hold every pair closer than rmax at pos (nobody moved more than skin / 2)."""
