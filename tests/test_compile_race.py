@@ -129,13 +129,14 @@ def test_the_second_round_compiles_nothing(rounds):
 
 
 def test_a_damaged_cache_is_rebuilt_not_loaded(rounds):
-    """Every cache file overwritten with other bytes: the next run recompiles and gives the same numbers."""
+    """Every cache file overwritten with other bytes: the next run recompiles and gives the same numbers (the 1D
+    sweep: the process of the eleven with the shortest compile, about 8 s against the ISA kernels' 35 s)."""
     tmp, first, _, env = rounds
     for p in (tmp / "cache").rglob("*.nbc"):
         p.write_bytes(p.read_bytes()[::-1])
     folder = tmp / "damaged"
     folder.mkdir()
-    p = _start("isa_fire", str(folder / "isa_fire.nc"), env)
+    p = _start("sph1d", str(folder / "sph1d"), env)
     text, _ = p.communicate(timeout=900)
     assert p.returncode == 0, text[-2000:]
-    assert _same(_numbers(folder / "isa_fire.nc"), _numbers(tmp / "round1" / "isa_fire.nc"))
+    assert _same(_numbers(folder / "sph1d"), _numbers(tmp / "round1" / "sph1d.nc"))
