@@ -401,8 +401,8 @@ def check_cores(budget):
         cores = workflow.cores
     except Exception:  # a cluster run given no --cores: each job's threads are its rule's
         return
-    budget.check_threads("snakemake command line: field '--cores'", cores, max(cores, 1) if isinstance(cores, int)
-                         else None)
+    budget.check_threads("snakemake command line: field '--cores'", cores,
+                         max(cores, budget.machine_cores()) if isinstance(cores, int) else None)
 
 
 def workflow_timing(cores):
