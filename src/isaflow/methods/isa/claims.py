@@ -5,8 +5,8 @@ paper's registry file, including the few whose runs are SPH or MPS runs (read as
 ``mps:<run>``).  A measure reads run files through the context (``ctx.run('<method>:<run id>')``,
 ``ctx.group('isa:error_vs_runtime')``, the step-by-step replays as the registry's derived files
 ``ctx.run('isa:replay_<run id>')``), computes its quantity with the shared measures (isaflow.metrics) and
-ISA's (methods.isa.metrics, theory), applies the entry's tolerance (``entry['tolerance']``) and compares with the paper's numbers the entry holds (``entry['numbers']``): no tolerance and no
-paper number lives here.  It returns whether the test passed, never a verdict: isaflow.claims.verdict
+ISA's (methods.isa.metrics, theory), applies the entry's tolerance (``entry['tolerance']``) and compares
+with the paper's numbers the entry holds (``entry['numbers']``): no tolerance and no paper number lives here.  It returns whether the test passed, never a verdict: isaflow.claims.verdict
 turns the boolean into one.
 
 Sensitivity.  Each inferred input of the registry that has runs (or a reading) for other values of its
@@ -986,7 +986,8 @@ def not_equilibrium(view, e):
     r = float(ds["residual"])
     return Out(r >= tol(e), f"max|F| = {r:.3g} N at step {int(ds['steps']):,}", short=f"{r:.3g} N",
                margin=f"flips below {tol(e):g} N",
-               why=f"the residual forces are not much larger than the run's stop threshold {float(ds.attrs['f_tol']):g} N")
+               why=f"the residual forces are not much larger than the run's stop threshold "
+                   f"{float(ds.attrs['f_tol']):g} N")
 
 
 @measured("pap-6.3-sum-fx", "figures/fig09_flow_incomplete.png")

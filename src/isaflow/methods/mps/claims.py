@@ -150,13 +150,12 @@ def measure_eq6_derivation(ctx, entry):
 
 
 def _with_derived(ctx, entry):
-    """(run key, product key, run, {name: value} of the product) of a row whose runs are a run and a number
-    derived from it (its registry file's ``derived``, isaflow.derived): variables, then the product's text
-    attributes."""
+    """(run key, product key, run, product) of a row whose runs are a run and a number derived from it (its
+    registry file's ``derived``, isaflow.derived): the product as {variable: value}, with its attributes
+    under 'attrs'."""
     key, product = (r["id"] for r in entry["runs"][:2])
     ds, d = ctx.run(key), ctx.run(product)
-    return key, product, ds, {k: d[k].item() for k in d.data_vars} | {k: v for k, v in d.attrs.items()
-                                                                   if k in ("relaxation_scope", "source_term")}
+    return key, product, ds, {k: d[k].item() for k in d.data_vars} | {"attrs": d.attrs}
 
 
 @claim("hat-eq4-rho-star")
@@ -167,18 +166,19 @@ def measure_rho_star(ctx, entry):
     off_det = abs(d["s_model"] - d["s_det"]) / abs(d["s_det"])
     off_nd = abs(d["s_model"] - d["s_nd"]) / abs(d["s_det"])
     ok = off_det < off_nd
-    a_d, a_v = model.relaxation_factors(model.SOURCES["hattori"], model.RELAX_SCOPES[d["relaxation_scope"]],
-                                       d["relaxation"])
+    scope = d["attrs"]["relaxation_scope"]
+    a_d, a_v = model.relaxation_factors(model.SOURCES["hattori"], model.RELAX_SCOPES[scope], d["relaxation"])
     relax = (f"; the run also multiplies eq. (6)'s density term by {a_d:g} and its divergence term by {a_v:g} "
-             f"(model.relaxation {d['relaxation']:g}, relaxation_scope '{d['relaxation_scope']}'), which eq. (6) does not have"
+             f"(model.relaxation {d['relaxation']:g}, relaxation_scope '{scope}'), which eq. (6) does not have"
              ) if (a_d, a_v) != (1.0, 1.0) else ""
     return Measurement(
-        measured=f"source term '{d['source_term']}' of {key.split(':', 1)[1]} on a uniform dilation e = {d['dilation']:g} of its "
-                 f"lattice (l0 = {float(ds.attrs['spacing']):.4g} cm): differs from eq. (6) with Rho* = rho0/det by "
-                 f"{off_det:.3g} and from eq. (6) with Rho* = rho0 n*/n0 by {off_nd:.3g} (relative); "
+        measured=f"source term '{d['attrs']['source_term']}' of {key.split(':', 1)[1]} on a uniform dilation e = "
+                 f"{d['dilation']:g} of its lattice (l0 = {float(ds.attrs['spacing']):.4g} cm): differs from eq. (6) "
+                 f"with Rho* = rho0/det by {off_det:.3g} and from eq. (6) with Rho* = rho0 n*/n0 by {off_nd:.3g} (relative); "
                  f"d ln(n*/n0) / d ln(1/det) = {d['sensitivity']:.4f} (1 for the Jacobian){relax}",
         passed=bool(ok),
-        evidence=f"isaflow.methods.mps.derived.dilation ({derived.path(product)}); model.source_term (Rho* = rho0 n*/n0)",
+        evidence=f"isaflow.methods.mps.derived.dilation ({derived.path(product)}); model.source_term "
+                 "(Rho* = rho0 n*/n0)",
         why="" if ok else ("the project's Rho* is rho0 n*/n0 (number density), not rho0 / det(dU*/dxi): to first order "
                            f"it responds {d['sensitivity']:.3f} times as strongly to a dilation"),
         margin=f"first-order sensitivity {d['sensitivity']:.4f} against 1 (the two definitions agree only at 1)",
@@ -192,7 +192,8 @@ def _stepped(ctx, entry):
     """(tolerance, run key, run, the step check of its final state, the evidence) of a row judged on one MPS
     step: its runs are the run and its check (the registry's derived, methods.mps.derived.step_check)."""
     key, check, ds, st = _with_derived(ctx, entry)
-    where = f"isaflow.methods.mps.derived.one_step on results/runs/mps/{key.split(':', 1)[1]}.nc ({derived.path(check)}); "
+    where = (f"isaflow.methods.mps.derived.one_step on results/runs/mps/{key.split(':', 1)[1]}.nc "
+             f"({derived.path(check)}); ")
     return entry["tolerance"]["value"], key, ds, st, where
 
 
