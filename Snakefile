@@ -2,6 +2,7 @@
 #   snakemake -c2                                   everything
 #   snakemake -c2 paper                             the paper's own outputs (Figures 5-10, Table 1; the claims need the full run)
 #   snakemake -c1 figures/fig06_single_coarse.png   one figure and only what it needs
+#   snakemake -c2 vtk                               the flows of every method as VTK files for ParaView (results/vtk/)
 # Parses with only Snakemake installed: the project's source is read from src/ (workflow/rules/common.smk).
 import glob
 
@@ -17,6 +18,7 @@ include: "workflow/rules/common.smk"
 # the template of every rule calling one package function (use rule call as <name> with:)
 include: "workflow/rules/templates.smk"
 include: "workflow/rules/compare.smk"
+include: "workflow/rules/export.smk"
 include: "workflow/rules/report.smk"
 include: "workflow/rules/claims.smk"
 

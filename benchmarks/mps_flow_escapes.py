@@ -55,7 +55,7 @@ def main(args):
                                   cfg["time.single_time"], cfg["probes.single"], threads=1, log=quiet)
             early, late = side_loads(single)
             rows.append(dict(run=f"single_{variant}_{res}", status=single.status, t_end_s=single.sim_time,
-                             time_to_rest_s=single.params["time_to_rest"],
+                             time_to_rest_s=float(single.measures["time_to_rest"][1]),
                              side_err_early=early, side_err_late=late, reflected=single.params["reflected_particles"],
                              ms_per_step=1e3 * (time.perf_counter() - w0) / single.steps))
             print(rows[-1], flush=True)

@@ -6,7 +6,8 @@ summed; compile excluded).  The ratio is the median
 of this checkout's process medians over the base's.
 
 Writes benchmarks/results/mps_step_ratio.csv (one row per process).  Run:
-python benchmarks/mps_step_ratio.py [--base REV] [--rounds R] [--n N]   (REV default: 2041002, before issue 30)
+python benchmarks/mps_step_ratio.py [--base REV] [--rounds R] [--n N]   (REV default: 509ae75, before issue 42's fused
+MPS step; 2041002: before issue 30)
 """
 
 import argparse
@@ -46,7 +47,7 @@ def run(root, n):
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--base", default="2041002")
+    ap.add_argument("--base", default="509ae75")
     ap.add_argument("--rounds", type=int, default=4)
     ap.add_argument("--n", type=int, default=5000)
     args = ap.parse_args()

@@ -19,10 +19,15 @@ SRC = ROOT / "src" / "isaflow"
 NAMES = ({m for m in methods.PACKAGES} | {v for m in methods.registry().values() for v in m.variants}) - {"paper"}
 LAYERS = [  # a module may import its own layer and the ones above it in this list, never one below
     ("core",),
-    ("inputs", "settings", "tank", "contract", "rest", "deps", "theory", "methods"),  # 'methods': the registry
-    ("metrics", "runfile", "tables", "run", "cli", "figures", "report", "timing"),
+    # what reads and checks inputs, the registry ('methods'), the contract and the driver: pure Python but the driver
+    ("inputs", "settings", "tank", "contract", "rest", "at_rest", "deps", "theory", "methods", "plausible", "budget", "preflight",
+     "claims_registry", "driver", "html", "timing"),
+    # what writes, reads and judges run files, and the paths into a run: the run, the command line, tables,
+    # figures, claims, derived numbers and the report
+    ("metrics", "runfile", "tables", "run", "cli", "figures", "report", "claims", "judge", "quantities", "derived", "export", "compare"),
     ("methods.",),  # a method package
 ]
+ARCHITECTURE = ROOT / "docs" / "architecture.md"
 
 
 def _layer(module):
@@ -32,6 +37,31 @@ def _layer(module):
             if prefix.endswith(".") and rel.startswith(prefix) or rel == prefix or rel.startswith(prefix + "."):
                 return k
     return 0 if rel in ("", "__init__") else None
+
+
+def test_every_module_is_in_a_layer_and_every_layer_name_a_module():
+    """Every module of the package (deps.graph) belongs to a layer; every name of LAYERS is a module or package."""
+    modules = sorted(deps.graph())
+    assert len(modules) > 100
+    assert [m for m in modules if _layer(m) is None] == []
+    assert [n for layer in LAYERS for n in layer if not n.endswith(".") and deps.module_file(f"isaflow.{n}") is None] == []
+    top = {p.stem for p in SRC.glob("*.py")} | {p.name for p in SRC.iterdir() if (p / "__init__.py").is_file()}
+    named = {n for layer in LAYERS for n in layer if not n.endswith(".")}
+    assert top - {"__init__"} == named
+
+
+def test_the_architecture_doc_states_the_layers_of_this_test():
+    """docs/architecture.md's layer sentence ('The layers (checked by tests/test_architecture.py): `a, b` <- ...')
+    lists exactly LAYERS, in order."""
+    text = " ".join(ARCHITECTURE.read_text().split())
+    start = text.index("The layers (checked by `tests/test_architecture.py`): ") + 54
+    inside, end = False, start
+    while inside or text[end] != ".":  # the sentence ends at the first full stop outside a code span
+        inside ^= text[end] == "`"
+        end += 1
+    groups = [re.search(r"`([^`]+)`", part).group(1) for part in text[start:end].split("<-")]
+    stated = [tuple(n.strip() for n in g.split(",")) for g in groups]
+    assert stated == [tuple("methods.<name>" if n == "methods." else n for n in layer) for layer in LAYERS]
 
 
 def shared_sources():

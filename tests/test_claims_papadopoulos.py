@@ -1,19 +1,19 @@
-"""The paper's claims measured (methods.isa.claims): a measure for every testable claim of the registry, booleans
-and numbers only (no verdict string anywhere but isaflow.claims), measures on small runs, the sensitivity views,
-the force-law shapes and lattice kinds of the sweeps, and the overdamped variant's physics (critical damping
-does not overshoot, it ends at rest where the capped update ends)."""
+"""The paper's claims as executable rows (config/claims/papadopoulos2016.yaml checks, quantities of
+methods.isa.quantities, judged by isaflow.judge): every testable row declares its checks, the paper's arithmetic and
+inconsistencies from the printed numbers alone, quantities on small runs, the paper's version as the headline with the
+project's kept runs beside it, the replay of the du rule, the force-law shapes and lattice kinds of the sweeps, and the
+overdamped variant's physics (critical damping does not overshoot, it ends at rest where the capped update ends)."""
 
-import ast
 import math
 
 import numpy as np
 import pytest
 
-from isaflow import claims, claims_registry, derived, runfile
+from isaflow import claims, claims_registry, derived, judge as J, runfile
 from isaflow.core.units import G
-from isaflow.methods.isa import claims as PC
 from isaflow.methods.isa import dynamics as D
 from isaflow.methods.isa import forces as F
+from isaflow.methods.isa import quantities as IQ
 from isaflow.methods.isa import replay, scene, solver
 from isaflow.methods.isa.settings import overdamped_dt
 
@@ -23,52 +23,47 @@ from test_metrics import lattice_run
 PAPER = "papadopoulos2016"
 REGISTRY = [c for c in claims_registry.load() if c["paper"] == PAPER]
 BY_ID = {c["id"]: c for c in REGISTRY}
-VERDICT_WORDS = ("reproduced", "not testable")
+VERSIONS = claims_registry.paper_versions()[PAPER]
 
 
-def test_every_testable_claim_of_the_paper_has_a_measure():
-    testable = {c["id"] for c in REGISTRY if c["testable"]}
-    assert set(PC.MEASURES) == testable
-    assert set(claims.measures()) >= testable  # found by the verdict engine
+def test_every_testable_claim_of_the_paper_is_an_executable_row():
+    """No measure code: each testable row declares its checks (quantity, runs, reduction, comparison), and every
+    role the paper's version maps is an ISA run the workflow declares."""
+    assert all("checks" in c for c in REGISTRY if c["testable"])
+    assert not (ROOT / "src/isaflow/methods/isa/claims.py").exists()
+    import yaml
+
+    declared = set(yaml.safe_load((ROOT / "config/methods/isa.yaml").read_text())["runs"])
+    derived_ids = set(claims_registry.derived())
+    for role, run in VERSIONS.items():
+        assert role.startswith("isa:") and run.startswith("isa:") and run != role
+        assert run.split(":")[1] in declared or run in derived_ids, run
 
 
-def test_no_verdict_string_outside_the_verdict_function():
-    """No string constant of the ISA claims, figures or report code names a verdict: the measures return booleans."""
-    srcs = [ROOT / "src/isaflow/methods/isa/claims.py", *(ROOT / "src/isaflow/methods/isa/figures").glob("*.py"),
-            *(ROOT / "src/isaflow/methods/isa/report").glob("*.py")]
-    found = []
-    for p in srcs:
-        for node in ast.walk(ast.parse(p.read_text())):
-            if isinstance(node, ast.Constant) and isinstance(node.value, str):
-                found += [f"{p.name}: {node.value[:60]!r}" for w in VERDICT_WORDS if w in node.value.lower()]
-    assert not found, found
-
-
-def _check(m):
-    assert isinstance(m, claims.Measurement)
-    assert m.passed is None or isinstance(m.passed, bool)
-    for text in (m.measured, m.why, m.margin, m.sensitivity):
-        assert not any(w in text.lower() for w in VERDICT_WORDS), text
+def _judged(cid, paths):
+    inputs = {i["id"]: i for lst in claims_registry.inputs().values() for i in lst}
+    return claims.judge(claims.Context(paths), [BY_ID[cid]], inputs, versions={PAPER: VERSIONS}).iloc[0]
 
 
 def test_rows_that_need_no_run_are_computed_from_the_registry_alone():
-    """Paper arithmetic and inconsistencies read the paper's numbers from the registry (numbers)."""
-    ctx = claims.Context({})
-    # passed: the quoted claim holds; the paper-inconsistency rows find their inconsistency, so they fail
-    expect = {"pap-5-area-ratio": True, "pap-5-mechanism-limit": True, "pap-6.4-expected-arith": True,
-              "pap-6.2-same-liquid": False, "pap-6.1-steps-vs-descent": False, "pap-5-levels-vs-bound": False,
-              "pap-4-fortran": True, "pap-6.4-confirms-circular": False}
-    for cid, passed in expect.items():
-        m = PC.MEASURES[cid](ctx, BY_ID[cid])
-        _check(m)
-        assert m.passed is passed, (cid, m.measured)
-    # the steps-vs-descent row: 8,500 x 0.025 mm = 21.25 cm cannot carry the refined surface 23.75 cm down
-    assert "21.25 cm reachable, 23.75 cm" in PC.MEASURES["pap-6.1-steps-vs-descent"](ctx, BY_ID["pap-6.1-steps-vs-descent"]).measured
+    """Paper arithmetic and inconsistencies read the paper's numbers from the registry (numbers); an inconsistency
+    found means the quoted claim does not hold."""
+    expect = {"pap-5-area-ratio": "reproduced", "pap-5-mechanism-limit": "reproduced", "pap-6.4-expected-arith":
+              "reproduced", "pap-6.2-same-liquid": "not reproduced", "pap-6.1-steps-vs-descent": "not reproduced",
+              "pap-5-levels-vs-bound": "not reproduced", "pap-4-fortran": "reproduced",
+              "pap-6.4-confirms-circular": "not reproduced", "pap-5-mechanism-kinematics": "not reproduced"}
+    for cid, verdict in expect.items():
+        row = _judged(cid, {})
+        assert row["verdict"] == verdict, (cid, row["measured"])
+    # the steps-vs-descent row: (8,000 + 500) x 0.025 mm = 21.25 cm cannot carry the refined surface 23.75 cm down
+    assert "= -2.5" in _judged("pap-6.1-steps-vs-descent", {})["measured"]
+    # the levels imply a quarter of the area lost: 1 - (72.5 + 2.5) / 100
+    assert "25.0%" in _judged("pap-5-levels-vs-bound", {})["measured"]
 
 
 @pytest.fixture(scope="module")
 def small_runs(tmp_path_factory):
-    """Run files of applications 1 and 2 (paper's update) and application 1 capped, as a claims Context."""
+    """Run files of applications 1 and 2 (paper's update, the project's kept inputs) and application 1 capped."""
     tmp = tmp_path_factory.mktemp("claims")
     paths = {}
     for key, res, var in (("single_coarse", "coarse", "paper"), ("single_refined", "refined", "paper"),
@@ -76,41 +71,33 @@ def small_runs(tmp_path_factory):
         p = tmp / f"{key}.nc"
         assert run_isa(p, "single", res, var) == 0
         paths[f"isa:{key}"] = str(p)
-    return claims.Context(paths)
+    return paths
 
 
-def test_measures_on_the_paper_lattices(small_runs):
-    """The per-step bound holds to round-off; the coarse level on the one surface misses 72.5 cm by 0.13 cm beyond
-    a/4 while the top centres (the calibration's reading) match it, so the verdict is fragile in level_definition;
-    a run the sweeps lack shows as 'no run'; the update ends in a cycle (never at 0.1 N), and the rows resting on
-    the cycle stop are judged on the paper's version (the stop off; here its stand-in, the same run)."""
-    m = PC.MEASURES["pap-3.3-step-bound"](small_runs, BY_ID["pap-3.3-step-bound"])
-    _check(m)
-    assert m.passed is True
-    m = PC.MEASURES["pap-6.1-level-coarse"](small_runs, BY_ID["pap-6.1-level-coarse"])
-    _check(m)
-    assert m.passed is False and "75.13 cm" in m.measured
-    assert "k_pair: 250 N/cm: no run" in m.sensitivity and "top centres + 0 (the reading the k_p calibration used): " \
-        "passes (72.63 cm)" in m.sensitivity
-    rob, flips, _ = claims.robustness(BY_ID["pap-6.1-level-coarse"], m)
-    assert rob == "fragile" and flips.startswith("level_definition: top centres + 0")
-    with pytest.raises(claims.Missing, match="single_coarse_nocycle"):
-        PC.MEASURES["pap-6.1-equilibrium-coarse"](small_runs, BY_ID["pap-6.1-equilibrium-coarse"])
-    paper = claims.Context({**small_runs.paths, "isa:single_coarse_nocycle": small_runs.paths["isa:single_coarse"]})
-    m = PC.MEASURES["pap-6.1-equilibrium-coarse"](paper, BY_ID["pap-6.1-equilibrium-coarse"])
-    _check(m)
-    assert m.passed is False and "period-2 cycle" in m.measured and "judged at the paper's version" in m.evidence
-    # the verdict engine turns a missing run into a claim it cannot judge, naming the run
-    df = claims.judge(small_runs, [BY_ID["pap-6.4-fourteen"]], {})
-    assert df["verdict"].iloc[0].startswith("not testable") and "isa:flow_complete" in df["measured"].iloc[0]
+def test_rows_on_the_paper_lattices(small_runs):
+    """The per-step bound holds to round-off; the coarse level on the one surface (75.13 cm) misses 72.5 cm by
+    0.13 cm beyond a/4, the top centres (the calibration's reading, 72.63 cm) match it, so the verdict is fragile in
+    level_definition; the update ends in a cycle, never at 0.1 N.  Here the kept runs stand in for the paper's
+    version; without it the row says which run it needs."""
+    paper = {VERSIONS[k]: p for k, p in small_runs.items() if k in VERSIONS}
+    paths = {**small_runs, **paper}
+    row = _judged("pap-3.3-step-bound", paths)
+    assert row["verdict"] == "holds" or row["verdict"].startswith("reproduced")
+    row = _judged("pap-6.1-level-coarse", paths)
+    assert row["verdict"] == "not reproduced" and "75.13 cm" in row["measured"]
+    assert "top centres + 0 (the reading the k_p calibration used): passes" in row["sensitivity"]
+    assert row["robustness"] in ("fragile", "unswept") and "level_definition: top centres + 0" in row["flips"]
+    row = _judged("pap-6.1-equilibrium-coarse", paths)
+    assert row["verdict"] == "not reproduced" and "cycle" in row["measured"]
+    row = _judged("pap-6.1-level-coarse", small_runs)  # no paper's version: not testable, naming the run
+    assert row["verdict"] == "not testable here" and VERSIONS["isa:single_coarse"] in row["measured"]
 
 
 def test_replay_repeats_the_run_bit_for_bit(small_runs, tmp_path):
     """The step-by-step replay of the paper's update ends exactly where the run ended; no coordinate moves more
-    than du in a step; a pair reaction changes by at most k_p x 2 sqrt(2) du.  The du rule's measure reads the
-    replay as the registry's derived file (rule derived) and finds the rule kept (0.18 w on the coarse lattice,
-    which stands in for both of its runs here)."""
-    ds = small_runs.run("isa:single_coarse")
+    than du in a step; a pair reaction changes by at most k_p x 2 sqrt(2) du.  The du rule's quantity reads the
+    replay as the registry's derived file (rule derived): 0.18 w on the coarse lattice at the kept k_p."""
+    ds = runfile.read(small_runs["isa:single_coarse"])
     r = replay.pair_increments(ds)
     du, kp = float(ds.attrs["du"]), float(ds.attrs["pair_r_u"]) / float(ds.attrs["pair_l_u"])
     assert r["identical"] and r["steps"] == int(ds["steps"])
@@ -120,52 +107,18 @@ def test_replay_repeats_the_run_bit_for_bit(small_runs, tmp_path):
     assert d["max_pair_increment"].item() == r["max_pair_increment_N"] and d["steps"].item() == r["steps"]
     assert all("units" in v.attrs for v in d.data_vars.values())
     replay_file = str(tmp_path / "replay.nc")
-    derived.write(small_runs.paths["isa:single_coarse"], [replay_file], "isa:replay_single_coarse",
+    derived.write(small_runs["isa:single_coarse"], [replay_file], "isa:replay_single_coarse",
                   "methods.isa.replay.increments")
-    paths = {"isa:single_coarse": small_runs.paths["isa:single_coarse"], "isa:replay_single_coarse": replay_file}
-    paths |= {"isa:single_refined": paths["isa:single_coarse"], "isa:replay_single_refined": replay_file}  # (its time)
-    m = PC.MEASURES["pap-6.1-du-rule"](claims.Context(paths), BY_ID["pap-6.1-du-rule"])
-    _check(m)
-    assert m.passed is True and "0.179839147 w" in m.measured and "replay.nc" in m.evidence
+    v = IQ.pair_increment([ds, runfile.read(replay_file)], typed_precision=3e-7)
+    assert v.value * (1 + 3e-7) == pytest.approx(0.179839147, abs=1e-9) and "0.179839147 w" in v.text
 
 
 def test_hydrostatic_loads_against_their_own_level_have_no_error():
-    """loads_at: the exact hydrostatic contact loads of a lattice are judged exact at its own surface."""
+    """The exact hydrostatic contact loads of a lattice are judged exact at its own surface."""
     ds = lattice_run(72.5, 2.5, 2.5)
-    e = PC.loads_at(ds, 72.5)
-    assert abs(e["side_err"]) < 1e-12 and abs(e["floor_err"]) < 1e-12 and e["contact_rms"] < 1e-12
-    assert set(e["side_walls"]) == {"left", "right"}
-    e = PC.loads_at(ds, 75.0)  # read 2.5 cm too high, the side walls seem to carry too little
-    assert e["side_err"] == pytest.approx((72.5 / 75.0) - 1, rel=1e-9)
-
-
-def test_a_view_substitutes_runs_and_refuses_the_ones_a_value_changes():
-    ctx = claims.Context({"isa:a": "x.nc"})
-    v = PC.View(ctx, {"isa:a": "isa:b"}, lambda k: k == "isa:c")
-    assert v.key("a") == "isa:b" and v.key("isa:d") == "isa:d"
-    with pytest.raises(PC.NoRun):
-        v.key("c")
-    assert v.opt("isa:c") is None
-
-
-def test_a_longer_time_limit_keeps_a_run_that_ended_at_rest(tmp_path):
-    """sph_rest's 't_max x 3': a liquid that stopped at rest before its t_max runs step for step the same with a
-    longer one, so it stands for itself; one cut off at t_max (step_limit) has no stand-in."""
-    import xarray as xr
-
-    paths = {}
-    for key, status in (("sph:rested", "converged"), ("sph:cut", "step_limit")):
-        paths[key] = str(tmp_path / f"{status}.nc")
-        xr.Dataset({"x": ("n", np.zeros(1), {"units": "1"})}, attrs={"status": status}).to_netcdf(paths[key])
-    ctx = claims.Context(paths)
-    value = next(v for v in PC.sweeps()["sph_rest"] if v.label == "t_max x 3")
-    subs, affected, params = value.subs, value.affected, value.params
-    v = PC.View(ctx, subs, affected, params)
-    assert v.key("sph:rested") == "sph:rested"
-    with pytest.raises(PC.NoRun):
-        v.key("sph:cut")
-    with pytest.raises(PC.NoRun):  # without the longer time limit (any other value) the rule does not apply
-        PC.View(ctx, subs, affected, {}).key("sph:rested")
+    sides, rms, floor, h = IQ.loads(ds, level="top centres + a/4")
+    assert max(abs(x) for x in sides.values()) < 1e-12 and abs(floor) < 1e-12 and rms < 1e-12
+    assert set(sides) == {"left", "right"} and h == pytest.approx(72.5)
 
 
 def test_force_law_shapes():

@@ -242,7 +242,7 @@ RESOURCE_CASES = {
     "snapshots_of_1e6_particles": ([("particles.lattice.rows", 1000), ("particles.lattice.row_lengths", [1000]),
                                     ("walls", vessel(11000, 6000)),
                                     ("particles.lattice.center_x", 5500.0), ("solver.max_steps", 10**15),
-                                    ("solver.history", {"snapshots": 10**6})], "'solver.history.snapshots'"),
+                                    ("solver.snapshot_megabytes", 1e9)], "'solver.snapshot_megabytes'"),
     "grid_of_1e15_cells": ([("forces.pair.l_u", 1e-6), ("forces.pair.r_u", 1e-3), ("solver.du", 1e-7)],
                            "'forces.pair.l_u'"),
 }
@@ -276,6 +276,14 @@ SET_CASES = {
     "inf_value": ("solver.f_tol=.inf", "'solver.f_tol"),
     "replace_a_block_with_a_scalar": ("solver=5", "no such setting"),
     "two_documents": ("solver.du=1\n---\n2", "more than one YAML document"),
+    # a comment after the value was dropped silently (the run used 0.02 and recorded no reason)
+    "trailing_comment": ("solver.du=0.02 # half the step", "a comment ('# half the step') is not part of a value"),
+    "quote_and_comment": ("forces.pair.law='linear' # kept", "a comment ('# kept')"),
+    "only_a_comment": ("solver.f_ref=# the default", "a comment"),
+    # YAML 1.1 reads these as other values than YAML 1.2 (and the user): 010 = 8, 1:30 = 90, yes = true
+    "octal_looking": ("solver.max_steps=010", "the octal number 8"),
+    "base_60": ("solver.max_steps=1:30", "base-60"),
+    "yes_for_true": ("solver.stop_on_cycle=yes", "a boolean in YAML 1.1"),
 }
 
 
@@ -365,6 +373,18 @@ def test_bad_start_files_are_refused(tmp_path, capsys, tiny_run, case):
     assert "start" in line
 
 
+@pytest.mark.parametrize("case, variable", [("nan_pos", "pos"), ("outside_walls", "pos"), ("nan_state", "state_vel"),
+                                            ("steps_float", "steps")])
+def test_a_bad_variable_of_a_start_file_names_the_start_file_and_the_variable(tmp_path, capsys, tiny_run, case,
+                                                                               variable):
+    """NaN positions or positions outside the walls are the start file's, not the settings file's: the line was
+    '<settings>: field 'start': positions must be finite' (no settings file has a field 'start')."""
+    start, extra, expect = start_case(tmp_path, tiny_run, case)
+    line, _ = refused_spec(tmp_path, capsys, TINY, "--start", str(start), field=expect)
+    assert line.startswith(f"error: {start}: field '{variable}': "), line
+    assert "settings.yaml" not in line
+
+
 def test_a_good_start_file_continues(tmp_path, capsys, tiny_run):
     tank, settings = files(tmp_path)
     out = tmp_path / "cont.nc"
@@ -434,7 +454,10 @@ def test_output_onto_an_input_is_refused(tmp_path, capsys, tiny_run):
 def test_settings_file_must_exist(tmp_path, capsys):
     tank, _ = files(tmp_path)
     out = tmp_path / "out" / "r.nc"
-    refused(tmp_path, capsys, argv_of(tank, tmp_path / "none.yaml", out), out, field="no such file")
+    line, _ = refused(tmp_path, capsys, argv_of(tank, tmp_path / "none.yaml", out), out, field="no such file")
+    assert line.startswith(f"error: argument --settings: '{tmp_path / 'none.yaml'}': ")  # the option was not named
+    line, _ = refused(tmp_path, capsys, argv_of(tmp_path / "none.yaml", _, out), out, field="no such file")
+    assert line.startswith("error: argument --tank: ")
 
 
 # ---- the real command line: no traceback, exit 2 ---------------------------------------------

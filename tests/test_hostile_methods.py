@@ -67,9 +67,7 @@ TANK_CASES = {
                        "'walls'"),
     "self_intersecting": (_tank(walls=[W[0], W[1], {"name": "right", "from": [100, 0], "to": [-20, 60]}]),
                           "'walls'"),
-    "no_floor": (_tank(walls=[{"name": "l", "from": [0, 100], "to": [0, 0]},
-                              {"name": "slope", "from": [0, 0], "to": [100, 10]},
-                              {"name": "r", "from": [100, 10], "to": [100, 100]}]), "no horizontal wall"),
+    # a floorless or sloping-floored vessel is a tank of one's own since issue 40 (tests/test_compare.py)
     "walls_not_joined": (_tank(walls=[W[0], {"name": "floor", "from": [5, 0], "to": [100, 0]}, W[2]]), "'walls'"),
     "vessel_outside": (_tank(vessels=[{"name": "v", "x": [200.0, 300.0]}]), "'vessels' (v)"),
     "vessels_overlap": (_tank(vessels=[{"name": "a", "x": [0.0, 60.0]}, {"name": "b", "x": [40.0, 100.0]}]),
@@ -148,8 +146,8 @@ SETTINGS_CASES = {
     "mps_panels_of_1e-320_cm": ("mps", ["walls.panel_length=1e-320"], "'walls.panel_length'", "not a finite"),
     "sph_panels_of_5e-5_cm": ("sph", ["settings.panel_length=5e-5"], "'settings.panel_length'", "memory"),
     "sph_30000_snapshots_of_1e6_particles": ("sph", ["resolution.particles=1000000", "settings.t_max_single=0.5",
-                                                     "settings.snapshot_times=[" + "0, " * 29999 + "0]"],
-                                             "'settings.snapshot_times'", "memory", ["--max-hours", "1000"]),
+                                                     "settings.snapshot_megabytes=1300000.0"],
+                                             "'settings.snapshot_megabytes'", "memory", ["--max-hours", "1000"]),
     # a spacing whose particle count overflows (an internal error, exit 70, before)
     "mps_spacing_1e-320": ("mps", ["resolution.spacing=1e-320"], "'resolution.spacing'", "particle count"),
     "sph_spacing_1e-320": ("sph", ["resolution.particles=null", "resolution.spacing=1e-320"], "'resolution.spacing'",
@@ -222,6 +220,14 @@ CLI_CASES = {
     "set_backticks": (method_argv("sph", "settings.kernel=`id`"), "settings.kernel"),
     "set_quote_comment": (method_argv("sph", "settings.cfl=0.25' # ; rm -rf ~"), "'settings.cfl"),
     "set_newline": (method_argv("sph", "settings.cfl=0.25\nsettings.alpha=9"), "settings.cfl"),
+    "set_comment": (method_argv("mps", "time.courant=0.1 # smaller"), "a comment ('# smaller')"),
+    "set_twice": (method_argv("sph", "settings.cfl=0.25", "settings.cfl=0.2"), "'settings.cfl' is given twice"),
+    # --run with --tank / --variant / --resolution: they were ignored without a word
+    "run_with_tank": (["--method", "isa", "--run", "single_coarse", "--tank", str(FLOW)], "--tank: not with --run"),
+    "run_with_variant": (["--method", "sph", "--run", "single_wcsph_n180", "--variant", "wcsph_eq6"],
+                         "--variant: not with --run"),
+    # an empty --accept was the default (converged) without a word
+    "accept_empty": (method_argv("sph", extra=["--accept", ""]), "unknown outcome ''"),
     "tank_is_a_directory": (["--method", "sph", "--tank", str(ROOT / "config"), "--variant", "wcsph",
                              "--resolution", "n180"], "a directory"),
     "threads_zero": (method_argv("isa", extra=["--threads", "0"]), "--threads"),
@@ -236,6 +242,20 @@ def test_bad_command_lines_are_refused(tmp_path, capsys, case):
     argv, field = CLI_CASES[case]
     cli_refuses(capsys, tmp_path, argv, field)
     assert not (tmp_path / "pwned").exists()
+
+
+@pytest.mark.parametrize("argv, field", [
+    (method_argv("isa", extra=["--threads", "1.5"]), "argument --threads: invalid int value: '1.5'"),
+    (method_argv("isa", extra=["--config", "x.yaml"]), "unrecognized arguments: --config x.yaml"),  # gone option
+    (method_argv("sph", extra=["--max-hours", "many"]), "argument --max-hours: invalid float value"),
+    (["--tank", str(SINGLE)], "the following arguments are required: --method"),
+])
+def test_argument_parser_refusals_are_one_line(tmp_path, capsys, argv, field):
+    """argparse's refusals were a usage block of several lines and its message: now one line, exit 2."""
+    with pytest.raises(SystemExit) as exc:
+        cli.main(["run", *argv, "-o", str(tmp_path / "run.nc")])
+    err = capsys.readouterr().err.strip().splitlines()
+    assert exc.value.code == 2 and len(err) == 1 and err[0].startswith("error: ") and field in err[0], err
 
 
 @pytest.mark.parametrize("value", ["0", "-3", "abc", str(budget.machine_cores() + 1)])
@@ -310,6 +330,11 @@ OTHER_CASES = {
     "solid_floor_dx_1e-320": ("solid", "floor.dx_cm", 1e-320, "'floor.dx_cm'"),
     "sph1d_column_overflow": ("sph1d", "column.height", 1e308, "'column.height'"),
     "sph1d_n_below_8": ("sph1d", "n", [2, 4, 8, 16], "'n"),
+    # step counts costed under another field's name (solver.max_steps, vessel.history_us) or not at all
+    "solid_hertz_dt_check_steps_1e15": ("solid", "hertz.dt_check_steps", 10**15, "'hertz.dt_check_steps'"),
+    "solid_vessel_steps_1e15": ("solid", "vessel.steps", 10**15, "'vessel.steps'"),
+    "solid_mechanism_steps_1e15": ("solid", "solver.max_steps_mechanism", 10**15, "'solver.max_steps_mechanism'"),
+    "solid_vessel_record_every_1e15": ("solid", "vessel.record_every", 10**15, "'vessel.record_every'"),
 }
 
 
@@ -377,6 +402,43 @@ PARSE_CASES = {
                             "config/claims/hattori.yaml: field 'derived.1.from'"),
     "derived_unread": ("config/claims/hattori.yaml", '- id: "mps:dilation_single_hattori_dx3.45"\n',
                        '- id: "mps:dilation_nobody"\n', "derived.2 ('mps:dilation_nobody'): no row or input"),
+    # a study case's override string with a comment ran without it; its errors named config/methods/isa.yaml
+    "study_override_comment": ("config/methods/isa_study.yaml", "set: [solver.du=10.0]", 'set: ["solver.du=10.0 # a"]',
+                               "config/methods/isa_study.yaml: field 'study.cases.value.list.du_large.set.0': "
+                               "override 'solver.du=10.0 # a': a comment"),
+    "study_override_quote_comment": ("config/methods/isa_study.yaml", "set: [solver.du=10.0]",
+                                     "set: [\"solver.du='10.0' # a\"]", "list.du_large.set.0': override"),
+    "study_override_unknown": ("config/methods/isa_study.yaml", "set: [solver.du=10.0]", "set: [solver.dx=10.0]",
+                               "config/methods/isa_study.yaml: field 'study.cases.value.list.du_large.set.0': "
+                               "override field 'solver.dx': no such setting"),
+    # YAML 1.1 reads 010 as 8: a file value the user typed as ten
+    "octal_in_a_settings_file": ("config/methods/mps.yaml", "time.courant: {value: 0.1,", "time.courant: {value: 010,",
+                                 "the octal number 8"),
+    # the study's names of nothing: a KeyError ("config/methods/isa_study.yaml: 'nosuch'"), or the line named
+    # config/methods/isa.yaml's field or a generated run's; a repeated value was a ValueError traceback (exit 1)
+    "study_lattice_unknown": ("config/methods/isa_study.yaml", "- {lattices: [coarse, refined], variants",
+                              "- {lattices: [coarse, nosuch], variants",
+                              "isa_study.yaml: field 'study.error_runtime.value.blocks.0.lattices': no lattice 'nosuch'"),
+    "study_resolution_unknown": ("config/methods/isa_study.yaml", "coarse: {resolution: coarse,",
+                                 "coarse: {resolution: nosuch,",
+                                 "isa_study.yaml: field 'study.lattices.value.coarse.resolution'"),
+    "study_case_tank_unknown": ("config/methods/isa_study.yaml", "tank: study_on_wall", "tank: nosuch",
+                                "isa_study.yaml: field 'study.cases.value.list.on_wall.tank': no tank 'nosuch'"),
+    "study_value_twice": ("config/methods/isa_study.yaml", "du_factors: [0.1, 0.3, 1, 3, 10, 100]}", "du_factors: [1, 1]}",
+                          "isa_study.yaml: field 'study.error_runtime': run 'er_coarse_paper_du1' is planned twice"),
+    # a claim id twice or of another paper's prefix passed until the claims job
+    "claim_id_twice": ("config/claims/marko2017.yaml", "  - id: mar-1-spam-tensile", "  - id: mar-abs-stable",
+                       "claim id 'mar-abs-stable' occurs 2 times"),
+    "claim_id_of_another_paper": ("config/claims/marko2017.yaml", "  - id: mar-1-spam-tensile",
+                                  "  - id: hat-1-spam-tensile", "id must start with 'mar-'"),
+    # a run that continues itself was planned without its start; the job failed on the missing start file
+    "run_starts_from_itself": ("config/methods/sph.yaml", "single_wcsph_n180: {tank: single, variant: wcsph, "
+                               "resolution: n180, compare: true}", "single_wcsph_n180: {tank: single, variant: wcsph, "
+                               "resolution: n180, compare: true, start: flow_wcsph_n180}",
+                               "single_wcsph_n180 -> flow_wcsph_n180 -> single_wcsph_n180"),
+    # the run files record the tank's name and the comparison reads it: single.yaml named 'other' left the figures
+    "tank_named_otherwise": ("config/tanks/single.yaml", "name: single", "name: other",
+                             "config/tanks/single.yaml: field 'name': 'other', but the file is tank 'single'"),
 }
 
 
@@ -398,6 +460,20 @@ def test_the_workflow_refuses_bad_inputs_while_it_is_parsed(tmp_path, case):
     rel, old, new, field = PARSE_CASES[case]
     proj = _project(tmp_path)
     _edit(proj / rel, old, new)
+    _parse_refuses(proj, field, "-c1")
+
+
+@pytest.mark.parametrize("old, new, field", [
+    ("value: 1.0e-5", "value: .nan", "rest.yaml: field 'rest.energy_ratio.value': numbers must be finite"),
+    ("value: 1.2", "value: 0", "rest.yaml: field 'rest.window.value'"),
+])
+def test_the_rest_criterion_is_checked_while_the_workflow_is_parsed(tmp_path, old, new, field):
+    """config/rest.yaml (read by the dynamic runs from the package's checkout, so the copy holds its own src/): a
+    NaN or zero passed the parse and stopped every dynamic run's job."""
+    proj = _project(tmp_path)
+    (proj / "src").unlink()
+    shutil.copytree(ROOT / "src", proj / "src", ignore=shutil.ignore_patterns("__pycache__", "*.egg-info"))
+    _edit(proj / "config" / "rest.yaml", old, new)
     _parse_refuses(proj, field, "-c1")
 
 

@@ -169,8 +169,8 @@ def test_solve_records_its_threads_and_gives_the_same_run_on_one_and_two(variant
     assert one.steps == two.steps == 1500 and one.force_evals == two.force_evals
     for a, b in ((one.pos, two.pos), (one.fields["force"][1], two.fields["force"][1])):
         assert np.array_equal(a, b)
-    for k, v in one.history.items():
-        assert np.array_equal(v[1], two.history[k][1]), k
+    for k, v in one.history.items():  # the first snapshot's force is not evaluated yet in either (NaN)
+        assert np.array_equal(v[1], two.history[k][1], equal_nan=v[1].dtype.kind == "f"), k
     assert numba.get_num_threads() == numba.config.NUMBA_NUM_THREADS  # restored after the solve
 
 

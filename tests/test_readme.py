@@ -1,6 +1,7 @@
 """README.md tells the truth: its layout names paths that exist, its one-run examples run, its one-figure
 example plans exactly that figure's run, and its workflow commands plan."""
 
+import os
 import re
 import shlex
 import subprocess
@@ -54,3 +55,21 @@ def test_the_one_figure_example_plans_that_figure_and_its_run_only():
     assert proc.returncode == 0, proc.stderr[-2000:]
     table = proc.stdout.split("Job stats:")[1].split("total")[0]
     assert {r.split()[0] for r in table.splitlines()[3:] if r.strip()} == {"compile", "run", "isa_fig_single"}
+
+
+def test_the_python_example_plots_a_run(tmp_path):
+    """The README's xarray example draws its figure from the run file the first one-run example writes (made here
+    by that command, its output path moved into the test's folder)."""
+    code = re.search(r"## Open a run in Python.*?```python\n(.*?)```", README, re.S).group(1)
+    assert len(code.strip().splitlines()) <= 14
+    first = shlex.split(_block("Running one run")[0])
+    path = first[first.index("-o") + 1]
+    assert f'"{path}"' in code and 'fig.savefig("run.png")' in code
+    first[first.index("-o") + 1] = str(tmp_path / "run.nc")
+    proc = subprocess.run([sys.executable, "-m", "isaflow.cli", *first[1:]], cwd=ROOT, capture_output=True, text=True,
+                          timeout=600)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    proc = subprocess.run([sys.executable, "-c", code.replace(f'"{path}"', repr(str(tmp_path / "run.nc")))],
+                          cwd=tmp_path, capture_output=True, text=True, timeout=300, env={**os.environ, "MPLBACKEND": "Agg"})
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert (tmp_path / "run.png").stat().st_size > 10_000

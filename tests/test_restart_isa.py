@@ -11,8 +11,10 @@ settled vessel where it cycles, steps inside the window that detects the
 cycle.
 Compared exactly (np.array_equal): every data variable of the uninterrupted
 run, except pos0 / start_step / force_evals / wall_time (they describe the
-continued run itself) and snapshots (none here); records (hist_*) from the
-split step on, chunk-end samples after it.
+continued run itself); records (hist_*) from the split step on, chunk-end samples
+after it, snapshots (snap_*, each run's own from its start) at the steps both runs
+keep, the stop among them (the force of the continued run's first snapshot is not
+evaluated yet: NaN, said so).
 """
 
 import numpy as np
@@ -63,6 +65,14 @@ def assert_continues(whole, leg2, split):
             a = a.isel(record=whole["hist_step"].values >= split)
         if "sample" in a.dims:
             a = a.isel(sample=whole["sample_step"].values > split)
+        if "snapshot" in a.dims:  # each run keeps snapshots on its own clock, from its start: the steps both keep
+            common = np.intersect1d(whole["snap_step"].values, leg2["snap_step"].values)
+            assert common[-1] == int(whole["steps"]), "the stop is a snapshot of both"
+            if name == "snap_force":  # the continued run's start: its force is not evaluated yet (NaN, said so)
+                assert np.isnan(b.values[0]).all() and "missing" in b.attrs
+                common = common[common != split]
+            a = a.isel(snapshot=np.isin(whole["snap_step"].values, common))
+            b = b.isel(snapshot=np.isin(leg2["snap_step"].values, common))
         assert a.shape == b.shape, (name, a.shape, b.shape)
         assert np.array_equal(a.values, b.values), f"{name} differs after a restart at step {split}"
         compared += 1
@@ -122,5 +132,5 @@ def test_chunks_replayed_inside_an_exact_cycle_change_no_output(monkeypatch):
     for group in ("history", "fields"):
         a, b = getattr(memo, group), getattr(plain, group)
         assert a.keys() == b.keys()
-        for k in a:
-            assert np.array_equal(a[k][1], b[k][1]), k
+        for k in a:  # the first snapshot's force is not evaluated yet in either (NaN, said so)
+            assert np.array_equal(a[k][1], b[k][1], equal_nan=np.asarray(a[k][1]).dtype.kind == "f"), k

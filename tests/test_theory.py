@@ -92,3 +92,47 @@ def test_stiffness_matrix_is_the_force_jacobian():
         d[k] = eps
         J[:, k] = -(force(pos + d.reshape(-1, 2)) - force(pos - d.reshape(-1, 2))) / (2 * eps)
     np.testing.assert_allclose(H, J, atol=1e-3 * np.abs(H).max())
+
+
+@pytest.mark.parametrize("theta_deg", [30.0, 45.0, 60.0, 75.0, 90.0])
+def test_a_sloping_wall_carries_the_closed_form_normal_load(theta_deg):
+    """A plane wall of slope theta from the horizontal wetted to depth h carries gamma h^2 / (2 sin theta) normal
+    to it per unit thickness; the liquid pushes it outwards by gamma h^2 / 2 and down by gamma h^2 / (2 tan theta)
+    (the weight of the liquid above it); its contacts' tributary shares add up to it."""
+    gamma, h, length = 1.25, 60.0, 150.0  # every wall reaches above the surface (75 cm at 30 degrees)
+    t = np.radians(theta_deg)
+    right = np.array([0.0, 0.0, length * np.cos(t), length * np.sin(t)])  # right-hand wall: up, liquid on its left
+    left = np.array([-length * np.cos(t), length * np.sin(t), 0.0, 0.0])  # left-hand wall: down to the floor
+    closed = gamma * h**2 / (2 * np.sin(t))
+    for wall, sign in ((right, 1.0), (left, -1.0)):
+        assert theory.wall_total(wall, gamma, h) == pytest.approx(closed, rel=1e-12)
+        fx, fy = theory.wall_force(wall, gamma, h)
+        assert fx == pytest.approx(sign * gamma * h**2 / 2, rel=1e-12)
+        assert fy == pytest.approx(-gamma * h**2 / (2 * np.tan(t)), rel=1e-12, abs=1e-9 * closed)
+        assert np.hypot(fx, fy) == pytest.approx(closed, rel=1e-12)
+    s = np.linspace(2.5, length - 2.5, 30)  # contacts every 5 cm along the right wall
+    cp = np.column_stack([s * np.cos(t), s * np.sin(t)])
+    th = theory.contact_theory(right[None], np.zeros(len(s), int), cp, gamma, h)
+    assert th.sum() == pytest.approx(closed, rel=1e-12)
+    assert th[-1] == 0.0  # above the surface
+
+
+def test_polygon_areas_and_rest_levels_follow_the_walls():
+    """The liquid's area below a level over a vessel's polygon: B h in closed form for a rectangle (the number
+    every tank's rho g took before polygons, bit for bit), h^2 / tan(theta) for a V; the level at rest solves the
+    area the weight needs: rectangles by the closed form, a V and a trapezoid to round-off."""
+    from isaflow import tank as T
+
+    box = T.vessel_polygon([(0, 100, 0, 0), (0, 0, 100, 0), (100, 0, 100, 100)], (0.0, 100.0))
+    assert T.is_box(box) and T.liquid_area(box, 0.0, 72.5) == 100.0 * 72.5
+    vee = T.vessel_polygon([(-100, 100, 0, 0), (0, 0, 100, 100)], (-100.0, 100.0))
+    assert T.liquid_area(vee, 0.0, 60.0) == pytest.approx(3600.0, rel=1e-12)
+    assert theory.rest_level([vee], [0.0], 1.25 * 3600.0, 1.25) == pytest.approx(60.0, rel=1e-12)
+    assert theory.rest_level([box], [0.0], 9000.0, 9000.0 / 7250.0) == theory.rest_levels([0.0], [100.0], 9000.0,
+                                                                                       9000.0 / 7250.0) == 72.5
+    # a vessel 150 cm wide at its floor (y = -50) whose right wall leans out by 1/3 cm per cm of height:
+    # 150 t + t^2 / 6 = A at depth t
+    trap = [(100.0, 100.0), (100.0, -50.0), (250.0, -50.0), (300.0, 100.0)]
+    t = (-900 + np.sqrt(900**2 + 4 * 6 * 6720.0)) / 2
+    assert theory.rest_level([box, trap], [0.0, -50.0], 8400.0, 1.25) == pytest.approx(t - 50.0, rel=1e-12)
+    assert np.isnan(theory.rest_level([vee], [0.0], 1.25 * 3600.0 * 10, 1.25))  # more than the V holds

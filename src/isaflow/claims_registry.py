@@ -78,10 +78,15 @@ def load_files(directory=DEFAULT_DIRECTORY):
 TANK_METHOD = "{tank_method}"
 
 
+def paper_versions(directory=DEFAULT_DIRECTORY):
+    """{paper: {role: run}} of each file's paper's version (its ``versions.paper.runs``; {} where none)."""
+    return {p: spec.get("versions", {}).get("paper", {}).get("runs", {}) for p, spec in load_files(directory).items()}
+
+
 def _expand_runs(spec, path):
-    """Every ``runs`` and ``controls`` list of a registry file in place: '{tank_method}' entries become one per
-    tank method (registry order); a run naming no registered method is refused (InputError naming the file and
-    entry)."""
+    """Every ``runs`` and ``controls`` list and every check's runs of a registry file in place: '{tank_method}'
+    entries become one per tank method (registry order); a run naming no registered method is refused (InputError
+    naming the file and entry)."""
     methods = registry()
     tank = [name for name, m in methods.items() if m.tank]
     for where, node in _run_nodes(spec):
@@ -96,6 +101,14 @@ def _expand_runs(spec, path):
                                      f"(choose from {', '.join(methods)})")
                 runs += [dict(r, id=r["id"].replace(TANK_METHOD, m)) for m in tank] if TANK_METHOD in r["id"] else [r]
             node[field] = runs
+        for k, chk in enumerate(node.get("checks", [])):  # a check's runs too ('<method>:<id>' strings)
+            for r in chk.get("runs", []):
+                if r.split(":", 1)[0] not in methods:
+                    raise InputError(f"{path}: {where}.checks.{k}.runs: '{r}' names no registered method "
+                                     f"(choose from {', '.join(methods)})")
+            if "runs" in chk:
+                chk["runs"] = [r.replace(TANK_METHOD, m) for r in chk["runs"]
+                               for m in (tank if TANK_METHOD in r else [""])]
 
 
 def _run_nodes(spec):
@@ -115,17 +128,15 @@ def _check_file(paper, spec, ids):
         raise InputError(f"{path}: input id '{dup[0]}' is defined twice")
     for i in spec.get("inputs", []):
         values = [str(v) for v in i["range"]["values"]]
-        if "paper_version" in i and i["paper_version"] not in values:
+        if "versions" in spec and ("paper_version" in i) == ("paper_states" in i):
+            raise InputError(f"{path}: input '{i['id']}': say what the paper states: paper_version (its value) or "
+                             "paper_states: none")
+        if "paper_version" in i and str(i["paper_version"]) not in values:
             raise InputError(f"{path}: input '{i['id']}': paper_version '{i['paper_version']}' is not a value of its range")
         for c in i.get("calibrated_against", []):
             if c not in ids:
                 raise InputError(f"{path}: input '{i['id']}': calibrated_against names no claim '{c}'")
         _check_sweep(path, i, values)
-    own = {c["id"] for c in spec["claims"]}
-    for k, f in enumerate(spec.get("findings", [])):
-        for c in f["claims"]:
-            if c not in own:
-                raise InputError(f"{path}: findings.{k}: names no claim '{c}' of this file")
     for k, c in enumerate(spec["claims"]):
         where = f"{path}: claims.{k} ('{c['id']}')"
         if c["paper"] != paper:
@@ -138,20 +149,32 @@ def _check_file(paper, spec, ids):
         for d in c.get("depends_on", []):
             if d not in ids or d == c["id"]:
                 raise InputError(f"{where}: depends_on names no other claim '{d}'")
-        for name in c.get("robustness", {}):
-            if name not in c["inferred_inputs"]:
-                raise InputError(f"{where}: robustness argues for '{name}', which is not among its inferred_inputs")
         if c["testable"]:
             t = c["tolerance"]
-            for field in ("derivation", "source", "test"):
+            for field in ("derivation", "source") + (() if "checks" in c else ("test",)):
                 if not t.get(field, "").strip():
                     raise InputError(f"{where}: a testable claim needs tolerance.{field}")
-            if c["kind"] == "method result" and not c["runs"]:
+            if c["kind"] == "method result" and not c.get("runs") and not any(chk.get("runs") for chk in c.get("checks", [])):
                 raise InputError(f"{where}: a testable method result needs the runs it is judged on")
         elif not c.get("why_not", "").strip():
             raise InputError(f"{where}: an untestable claim needs why_not")
+        for j, chk in enumerate(c.get("checks", [])):
+            if isinstance(chk.get("target"), str) and chk["target"] not in c.get("numbers", {}) and chk["op"] not in ("==", "!="):
+                raise InputError(f"{where}: checks.{j}.target: '{chk['target']}' is no printed number of the row")
+        for name in c.get("not_readings", {}):
+            if name not in c["inferred_inputs"]:
+                raise InputError(f"{where}: not_readings names '{name}', which is not among its inferred_inputs")
         if "quote" in c and "..." in c["quote"] and any(not f.strip() for f in c["quote"].split("...")):
             raise InputError(f"{where}: quote has an empty fragment around '...'")
+
+
+def _check_findings(paper, spec):
+    """A finding names claims of its own file, and each of its sentences one of them."""
+    own = {c["id"] for c in spec["claims"]}
+    for k, f in enumerate(spec.get("findings", [])):
+        for c in f["claims"] + [snt["row"] for snt in f.get("sentences", [])]:
+            if c not in own:
+                raise InputError(f"{spec['_path']}: findings.{k}: names no claim '{c}' of this file")
 
 
 def _check_sweep(path, i, values):
@@ -174,7 +197,11 @@ def _check_sweep(path, i, values):
 def load(directory=DEFAULT_DIRECTORY):
     """Every registry entry of every paper, in file then file order: a list of dicts (InputError
     naming the file and entry on any violation)."""
-    files = load_files(directory)
+    return _checked(load_files(directory))
+
+
+def _checked(files):
+    """The claims of the loaded files, after every check across them (:func:`load`)."""
     claims = [c for p in PAPERS for c in files[p]["claims"]]
     seen = Counter(c["id"] for c in claims)
     dup = [k for k, n in seen.items() if n > 1]
@@ -183,6 +210,7 @@ def load(directory=DEFAULT_DIRECTORY):
     ids = set(seen)
     for p in PAPERS:
         _check_file(p, files[p], ids)
+        _check_findings(p, files[p])
     cycle = _depends_cycle(claims)
     if cycle:
         raise InputError(f"depends_on forms a cycle: {' -> '.join(cycle)}")
@@ -231,16 +259,20 @@ def roots(claims):
     return out
 
 
-def declared_runs(entry, inputs, entries=None):
+def declared_runs(entry, inputs, entries=None, versions=None):
     """The run keys ('<method>:<run id>' or a group '<method>:<group>') a claim's measure may read: its runs and
-    controls, its deviation's runs and the runs of each of its inferred inputs (inputs: {input id: input}); with
-    entries ({claim id: entry}), also those of the rows it depends on, transitively (an aggregate measures through
-    theirs)."""
+    controls, its checks' runs and their paper's versions (versions: {role: run} of its file), its deviation's runs
+    and the runs of each of its inferred inputs (inputs: {input id: input}); with entries ({claim id: entry}), also
+    those of the rows it depends on, transitively (an aggregate measures through theirs)."""
     keys, todo, seen = set(), [entry], set()
     while todo:
         e = todo.pop()
         seen.add(e["id"])
-        keys |= {r["id"] for r in e.get("runs", []) + e.get("controls", [])}
+        if "checks" in e:  # an executable row reads what its checks name
+            keys |= {r for c in e["checks"] for r in c.get("runs", [])}
+        else:
+            keys |= {r["id"] for r in e.get("runs", []) + e.get("controls", [])}
+        keys |= {(versions or {}).get(k) for k in set(keys)} - {None}
         keys |= {r["id"] for r in e.get("deviation", {}).get("runs", [])}
         for name in e.get("inferred_inputs", []):
             keys |= {r["id"] for r in inputs.get(name, {}).get("runs", [])}
@@ -248,10 +280,30 @@ def declared_runs(entry, inputs, entries=None):
     return keys
 
 
+def paper_runs(directory=DEFAULT_DIRECTORY):
+    """{paper: set of run keys} every row of the paper's file may read (declared_runs of each, with its inputs, the rows
+    it depends on in any file and its file's paper's version): the inputs of that paper's claims job."""
+    files = load_files(directory)
+    claims = [c for p in PAPERS for c in files[p]["claims"]]
+    by_id = {c["id"]: c for c in claims}
+    inputs = {i["id"]: i for spec in files.values() for i in spec.get("inputs", [])}
+    out = {}
+    for p in PAPERS:
+        versions = files[p].get("versions", {}).get("paper", {}).get("runs", {})
+        keys = set()
+        for c in files[p]["claims"]:
+            keys |= declared_runs(c, inputs, by_id, versions)
+        out[p] = keys
+    return out
+
+
 def derived(directory=DEFAULT_DIRECTORY):
-    """{id: entry} of every file's ``derived`` entries (isaflow.derived), in file order (checked as :func:`load`
-    checks them)."""
-    return _derived_of(load_files(directory))
+    """{id: entry} of every file's ``derived`` entries (isaflow.derived), in file order, after every check of
+    :func:`load` (the workflow reads them while it is parsed, so a bad registry file stops it before any job: a
+    claim id twice or of another paper's prefix passed until the claims job)."""
+    files = load_files(directory)
+    _checked(files)
+    return _derived_of(files)
 
 
 def _derived_of(files):
@@ -260,6 +312,8 @@ def _derived_of(files):
     methods, out = registry(), {}
     for spec in files.values():
         named = {r["id"] for _, node in _run_nodes(spec) for f in ("runs", "controls") for r in node.get(f, [])}
+        named |= {r for c in spec["claims"] for chk in c.get("checks", []) for r in chk.get("runs", [])}
+        named |= set(spec.get("versions", {}).get("paper", {}).get("runs", {}).values())
         for k, d in enumerate(spec.get("derived", [])):
             where = f"{spec['_path']}: derived.{k} ('{d['id']}')"
             for field in ("id", "from"):

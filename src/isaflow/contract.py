@@ -25,7 +25,8 @@ in ``Result.params`` (run-file attributes), so that no difference is silent:
   nothing), e.g. "depth rounded to whole rows: 75 cm (tank 72.5 cm), weight held
   at 9000 N".
 Dynamic methods judge rest with isaflow.rest (one criterion for all) and
-record ``rest_energy_ratio``, ``rest_window`` and ``time_to_rest`` [s]: the start
+record ``rest_energy_ratio`` and ``rest_window`` (attributes: the criterion) and the
+variable ``time_to_rest`` [s] (at_rest.AT_REST, written by the driver): the start
 of the quiet stretch that made the run at rest, counted from the start of this run
 (its own t0: the release of its liquid, the opening for a flow), in every method.
 """
@@ -47,6 +48,15 @@ SHARED_HISTORY = {  # name -> (dims, units)
     "sample_wall_resultant": (("sample", "wall", "xy"), "N"),  # force of each wall on the liquid
     "sample_rms_speed": (("sample",), "cm s-1"),
     "sample_kinetic": (("sample",), "N cm"),
+    # the driver's snapshots (driver.Recording): every method's stored states, one set of names
+    "snap_time": (("snapshot",), "s"),  # chain time of the snapshot (methods with a clock)
+    "snap_step": (("snapshot",), "1"),  # step of the snapshot, counted from the start of the chain
+    "snap_pos": (("snapshot", "particle", "xy"), "cm"),
+    "snap_velocity": (("snapshot", "particle", "xy"), "cm s-1"),
+    "snap_pressure": (("snapshot", "particle"), "N cm-2"),
+    "snap_force": (("snapshot", "particle", "xy"), "N"),  # out-of-balance force (static methods)
+    "snap_vessel": (("snapshot", "particle"), "1"),  # index of the vessel whose x range holds it, -1 none
+    "snap_status": (("snapshot", "particle"), "1"),  # at_rest.STATUS: 0 in the tank, 1 past its walls
 }
 
 
@@ -66,11 +76,12 @@ def history_problems(history):
 class Result:
     """Outcome of one run of any method (arrays in cm, N, s).
 
-    history / fields map a run-file variable name to (dims, array, units,
+    history / fields / measures map a run-file variable name to (dims, array, units,
     long_name[, attrs]); history names start with hist_ (dims ("record",), per
     record), sample_ (("sample", ...), per diagnostic sample) or snap_
     (("snapshot", ...)), the quantities of SHARED_HISTORY under their shared
-    names; fields dims start with "particle".  A run file holds no NaN: a variable whose values may be
+    names; fields dims start with "particle"; measures are the at-rest and wall numbers
+    every driven run gets from the driver (at_rest.AT_REST: their names, dims and units).  A run file holds no NaN: a variable whose values may be
     missing says why in attrs {"missing": "..."} (runfile.finite).
     """
 
@@ -96,6 +107,7 @@ class Result:
     history: dict = field(default_factory=dict)
     fields: dict = field(default_factory=dict)
     params: dict = field(default_factory=dict)  # scalar settings, written as attributes
+    measures: dict = field(default_factory=dict)  # at_rest.AT_REST variables (driver.drive writes them)
 
     def __post_init__(self):
         if self.status not in OUTCOMES:

@@ -1,4 +1,4 @@
-"""Every input file (scenes, tanks, method settings) is read and validated here, once.
+"""Every input file (tanks, method settings, the workflow's and the claims' files) is read and validated here, once.
 
 :func:`read_yaml` refuses, with one line naming the file (and field where there
 is one), anything that is not a small, plain YAML mapping: unreadable or
@@ -52,11 +52,38 @@ _StrictLoader.add_implicit_resolver(
     "tag:yaml.org,2002:float", re.compile(r"^[-+]?[0-9][0-9_]*[eE][-+]?[0-9]+$"), list("-+0123456789"))
 
 
+# plain scalars YAML 1.1 (this reader, PyYAML) and YAML 1.2 read as different values: a leading-zero integer
+# (octal in 1.1: 010 is 8), a base-60 number (1:30 is 90 in 1.1, a string in 1.2), the 1.1 booleans yes/no/on/off
+_OCTAL = re.compile(r"[-+]?0[0-7_]+\Z")
+_BASE60 = re.compile(r"[-+]?[0-9][0-9_]*(?::[0-5]?[0-9])+(?:\.[0-9_]*)?\Z")
+_BOOL11 = {"yes", "no", "on", "off"}
+_SUSPECT = re.compile(r"[-+]?0[0-7_]|[-+]?[0-9][0-9_]*:|(?i:yes|no|on|off)\Z")  # a quick first test of all three
+
+
+def _ambiguous(value):
+    """Why a plain scalar reads differently in YAML 1.1 and 1.2, or None."""
+    if not _SUSPECT.match(value):
+        return None
+    if _OCTAL.match(value) and int(value.replace("_", ""), 8) != int(value.replace("_", ""), 10):
+        return (f"'{value}' is the octal number {int(value.replace('_', ''), 8)} in YAML 1.1 (this reader) and "
+                f"{int(value.replace('_', ''), 10)} in YAML 1.2; write it without leading zeros")
+    if _BASE60.match(value):
+        return f"'{value}' is a base-60 number in YAML 1.1 (this reader) and a string in YAML 1.2; quote it or write the number"
+    if value.lower() in _BOOL11:
+        return f"'{value}' is a boolean in YAML 1.1 (this reader) and a string in YAML 1.2; write true / false, or quote it"
+    return None
+
+
 def _check_events(text):
-    """Refuse anchors, aliases, explicit tags, several documents and deep nesting before building anything."""
+    """Refuse anchors, aliases, explicit tags, several documents, deep nesting and plain scalars YAML 1.1 and 1.2
+    read differently (_ambiguous) before building anything."""
     depth = docs = 0
     for ev in yaml.parse(text, Loader=yaml.SafeLoader):
         line = f"line {ev.start_mark.line + 1}"
+        if ev.__class__ is yaml.ScalarEvent and ev.style is None and ev.implicit[0] and _SUSPECT.match(ev.value):
+            why = _ambiguous(ev.value)
+            if why:
+                raise InputError(f"{why} ({line})")
         if isinstance(ev, yaml.AliasEvent) or getattr(ev, "anchor", None):
             raise InputError(f"anchors and aliases are not accepted ({line})")
         tag = getattr(ev, "tag", None)
@@ -102,13 +129,37 @@ def _parse_yaml(text):
         raise InputError(f"not valid YAML: {' '.join(str(why).split())}{where}") from None
 
 
+def yaml_comment(text):
+    """The first YAML comment in text ('# ...' outside every scalar, at a line's start or after a blank), or None.
+    A value typed with a comment (an override string, 'key=0.1 # why') would lose the comment silently."""
+    if "#" not in text:
+        return None
+    try:
+        spans = [(tok.start_mark.index, tok.end_mark.index) for tok in yaml.scan(text, Loader=yaml.SafeLoader)
+                 if isinstance(tok, yaml.ScalarToken)]
+    except yaml.YAMLError:
+        return None  # not YAML: parse_yaml says so
+    for m in re.finditer(r"(?:^|(?<=\s))#", text, re.M):
+        if not any(a <= m.start() < b for a, b in spans):
+            return text[m.start():].split("\n", 1)[0]
+    return None
+
+
+def not_a_file(path):
+    """Why path is no regular file to read ('no such file', 'a directory', 'not a regular file'), or None."""
+    p = Path(path)
+    if p.is_file():
+        return None
+    return "a directory" if p.is_dir() else "not a regular file" if p.exists() else "no such file"
+
+
 def read_yaml(path, what="file"):
     """(text, mapping) of a YAML file; InputError naming the file otherwise."""
     path = str(path)
     p = Path(path)
     try:
-        if not p.is_file():
-            kind = "a directory" if p.is_dir() else "not a regular file" if p.exists() else "no such file"
+        kind = not_a_file(p)
+        if kind:
             raise InputError(f"{path}: cannot read {what}: {kind}")
         if p.stat().st_size > MAX_BYTES:
             raise InputError(f"{path}: {what} is larger than {MAX_BYTES} bytes")

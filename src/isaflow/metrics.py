@@ -14,10 +14,12 @@ the ISA pair stiffness was calibrated on), never a second convention.
 
 **Two theories of every wall load** (:func:`load_errors`):
 - ``reference="tank"``: the tank's liquid (run-file attributes ``tank_*``):
-  rho g = W / (B h) fixed by the tank file and the free surface at rest where
-  the tank's liquid ends (theory.rest_levels; the single vessel: h = 72.5 cm);
+  rho g = W / A fixed by the tank file (A: the first vessel's polygon below its
+  depth, B h in a rectangle) and the free surface at rest where the tank's
+  liquid ends (theory.rest_level; the single vessel: h = 72.5 cm);
 - ``reference="own"``: the method's own liquid: the weight its particles hold
-  in the vessel and the depth of its own free surface, gamma = W_v / (B h_v);
+  in the vessel and the depth of its own free surface, gamma = W_v / A_v, A_v the
+  vessel's polygon below that surface (B h_v in a rectangular vessel);
 - ``reference="level"``: as "own" with the top-centre level as the surface
   (a reading kept for sensitivity only; no table or figure uses it).
 Errors: ``floor_err`` (computed floor total - theory) / theory; ``side_err``
@@ -25,11 +27,18 @@ Errors: ``floor_err`` (computed floor total - theory) / theory; ``side_err``
 over wetted contacts of (computed - theory) / (gamma h a) (units of one floor
 contact load, a = panel_length); ``side_height_err`` height of the side
 resultant minus h / 3 [cm].
+
+**At rest and on the walls**: the numbers every run driven by isaflow.driver holds as variables with units
+(time to rest, residual rms speed over sqrt(g h), surface drift, wall crossings, each wall's load over the
+rest window, ISA's max|F| and rms|F|) are defined once in isaflow.at_rest (at_rest.AT_REST): the runs write them,
+so their definition is in every run's code, and a change to a measure here reruns no run.
+:func:`at_rest_row` reads them as the comparison table's columns.
 """
 
 import numpy as np
 
-from . import theory
+from . import at_rest, theory
+from . import tank as T
 from .core import neighbours as NB
 
 
@@ -38,9 +47,10 @@ def vessel_view(ds, vessel=None):
 
     vessel: name in ds.vessel, or None for the whole scene.  A wall belongs to
     the vessel when its x-extent touches the vessel's [xmin, xmax]; the floor
-    is the lowest horizontal wall among them.  Returns dict with x_range (cm),
-    width B (cm), floor_y (cm), wall_in (W,) and horizontal (W,) bool masks,
-    inside (N,) bool mask of the particles in the vessel.
+    is the lowest horizontal wall among them (none: the lowest wall point, a V's
+    vertex).  Returns dict with x_range (cm), width B (cm), floor_y (cm), wall_in
+    (W,) and horizontal (W,) bool masks, inside (N,) bool mask of the particles in
+    the vessel, polygon [(x, y)] cm (tank.vessel_polygon: the theory's liquid fills it).
     """
     walls = ds["wall_segment"].values
     pos = ds["pos"].values
@@ -55,9 +65,12 @@ def vessel_view(ds, vessel=None):
     wall_in = (overlap > eps) | (vertical & (overlap >= -eps))
     horiz = np.isclose(walls[:, 1], walls[:, 3])
     floors = wall_in & horiz
-    floor_y = walls[floors, 1].min() if floors.any() else walls[:, [1, 3]].min()
+    # no horizontal wall (a V): the lowest point of the vessel's walls (tank.vessel_floor)
+    floor_y = walls[floors, 1].min() if floors.any() else T.vessel_floor(walls.tolist(), x0, x1)
+    floor_y = walls[:, [1, 3]].min() if floor_y is None else floor_y
     inside = (pos[:, 0] >= x0) & (pos[:, 0] < x1)
-    return dict(x_range=(x0, x1), width=x1 - x0, floor_y=floor_y, wall_in=wall_in, horizontal=horiz, inside=inside)
+    return dict(x_range=(x0, x1), width=x1 - x0, floor_y=floor_y, wall_in=wall_in, horizontal=horiz, inside=inside,
+                polygon=T.vessel_polygon(walls.tolist(), (float(x0), float(x1))))
 
 
 def vessels(ds):
@@ -83,11 +96,11 @@ def surface_of(ds, vessel=None):
 
 def tank_levels(ds):
     """{vessel name (None for a single vessel): free surface [cm] at rest of the tank's liquid}
-    (theory.rest_levels; a vessel whose floor lies above the common level is empty: its floor)."""
+    (theory.rest_level; a vessel whose floor lies above the common level is empty: its floor)."""
     names = vessels(ds)
     views = [vessel_view(ds, v) for v in names]
-    H = theory.rest_levels([v["floor_y"] for v in views], [v["width"] for v in views],
-                           float(ds.attrs["tank_weight"]), float(ds.attrs["tank_rho_g"]))
+    H = theory.rest_level([v["polygon"] for v in views], [v["floor_y"] for v in views],
+                          float(ds.attrs["tank_weight"]), float(ds.attrs["tank_rho_g"]))
     return {n: max(H, float(v["floor_y"])) for n, v in zip(names, views)}
 
 
@@ -97,11 +110,11 @@ def _theory(ds, vessel, reference):
     if reference == "tank":
         rho_g = float(ds.attrs["tank_rho_g"])
         level = tank_levels(ds)[vessel]
-        return rho_g, level, rho_g * v["width"] * max(level - v["floor_y"], 0.0)
+        return rho_g, level, rho_g * theory.liquid_area(v["polygon"], v["floor_y"], level - v["floor_y"])
     weight = float(ds["weight"].values[v["inside"]].sum())
     level = level_of(ds, vessel) if reference == "level" else surface_of(ds, vessel)
     depth = level - v["floor_y"]
-    gamma = weight / (v["width"] * depth) if depth > 0 else np.nan
+    gamma = weight / theory.liquid_area(v["polygon"], v["floor_y"], depth) if depth > 0 else np.nan
     return gamma, level, weight
 
 
@@ -174,6 +187,36 @@ def contact_in_vessel(ds, x_range):
         side = ds["contact_side"].values if "contact_side" in ds else np.zeros(len(seg))
         x = ds["contact_point"].values[:, 0] + 1e-6 * left_nx * (1 - 2 * side)
     return (x >= x_range[0]) & (x < x_range[1])
+
+
+def normal_loads(ds, vessel=None):
+    """{wall name: normal load [N]} of the walls of a vessel (None: the whole scene): the contacts of the vessel's
+    liquid (contact_loads) resolved on each wall's normal into that liquid (the left normal; a thin wall's back
+    face, contact_side 1, the right one), the load the hydrostatic theory gives (theory.wall_total); the contacts'
+    magnitudes (load_errors' load_<wall>) add any tangential part a discrete wall carries."""
+    v = vessel_view(ds, vessel)
+    walls = ds["wall_segment"].values
+    cw = np.where(contact_in_vessel(ds, v["x_range"]), ds["contact_wall"].values, -1)
+    force = ds["contact_force"].values
+    side = ds["contact_side"].values if "contact_side" in ds else np.zeros(len(cw))
+    out = {}
+    for w, name in enumerate(str(n) for n in ds["wall"].values):
+        if not v["wall_in"][w]:
+            continue
+        e = walls[w, 2:] - walls[w, :2]
+        n = np.array([-e[1], e[0]]) / np.hypot(e[0], e[1])
+        on = cw == w
+        out[name] = float(np.sum((force[on] @ n) * (1 - 2 * side[on])))
+    return out
+
+
+def weight_on_walls(ds):
+    """The weight the walls carry: walls_vertical_N, the vertical resultant [N] of every wall contact on the liquid,
+    and walls_weight_err = walls_vertical_N / the weight the run holds - 1 (0 for a liquid at rest: the walls carry
+    its weight, however they slope)."""
+    fy = float(np.asarray(ds["contact_force"].values, float)[:, 1].sum())
+    held = float(ds["weight"].values.sum())
+    return dict(walls_vertical_N=fy, walls_weight_err=fy / held - 1 if held > 0 else np.nan)
 
 
 def panel_length(ds):
@@ -253,7 +296,9 @@ def hydrostatic_errors(ds, paper_level=None, vessel=None, reference="own"):
 
 
 def comparison_row(ds):
-    """The methods' comparison row of a run file: identity, outcome, and for every vessel its surface
+    """The methods' comparison row of a run file: identity, outcome, its at-rest and wall numbers
+    (at_rest_row: time to rest, residual speed, surface drift, wall crossings, each wall's load mean and
+    standard deviation over the rest window, ISA's max|F| and rms|F|), and for every vessel its surface
     (own and the tank's at rest), weight held and particles, slope and range, and the wall-load
     errors against the tank's theory and against the method's own depth.  Columns per vessel are
     prefixed with the vessel's name (single vessel: no prefix)."""
@@ -267,8 +312,8 @@ def comparison_row(ds):
                held_weight_N=float(ds["weight"].values.sum()), tank_weight_N=float(a["tank_weight"]),
                tank_depth_cm=float(a["tank_depth"]), initial_depth_cm=float(a.get("initial_depth", np.nan)),
                tank_difference=str(a.get("tank_difference", "")),
-               time_to_rest_s=float(a.get("time_to_rest", np.nan)),
-               rest_energy_ratio=float(a.get("rest_energy_ratio_final", np.nan)))
+               final_energy_ratio=float(a.get("final_energy_ratio", np.nan)))
+    row.update({"time_to_rest_s": np.nan, **at_rest_row(ds)})  # the AT_REST numbers (time to rest first)
     finite = np.isfinite(ds["pos"].values).all()
     names = vessels(ds)
     levels = tank_levels(ds)
@@ -315,4 +360,25 @@ def run_row(ds, vessel=None):
     if np.isfinite(ds["pos"].values).all():
         row.update(load_errors(ds, vessel, "own"))
         row.update(surface_measures(ds, vessel))
+    return row
+
+
+# --- the at-rest and wall numbers of a run file, as table columns (defined in isaflow.rest) ------------------------
+
+def at_rest_row(ds):
+    """The at-rest and wall numbers of a run file (at_rest.AT_REST) as table columns (units in the names; one column
+    per wall and vessel): what the comparison table shows.  Absent numbers (a run no driver made) are left out."""
+    row = {}
+    units = {"s": "_s", "cm": "_cm", "N": "_N", "1": ""}
+    for name, (dims, u, _) in at_rest.AT_REST.items():
+        if name not in ds:
+            continue
+        v = ds[name]
+        if not dims:
+            row[f"{name}{units[u]}"] = float(v) if name != "wall_crossings" else int(v)
+            continue
+        # per wall: '<wall>_<name>'; per vessel: '<vessel>_<name>', no prefix for a tank of one unnamed vessel
+        prefixes = [f"{n}_" for n in ds[dims[0]].values] if dims[0] in ds.coords else [""] * v.size
+        for prefix, val in zip(prefixes, np.atleast_1d(v.values)):
+            row[f"{prefix}{name}{units[u]}"] = float(val)
     return row

@@ -17,7 +17,7 @@ and the same checks, each error one line naming the file, the run and the
 setting.  Pure Python (yaml, jsonschema).
 """
 
-from . import budget, inputs, methods, settings
+from . import budget, inputs, methods, rest, settings
 from . import tank as tanks
 from .inputs import InputError
 
@@ -37,6 +37,7 @@ def check(method, tank, s, accept=("converged",), stability=False, max_hours=Non
     None; s: resolved settings.Settings; particles: a start file's count (None: the resolution's).  Returns the
     largest of its costs (budget.Cost).  field: how a refusal of ``accept`` names it."""
     budget.check_environment()
+    rest.load()  # the rest criterion every dynamic run reads (config/rest.yaml): refused here, not in the job
     bad = unstable_accepted(accept, stability)
     if bad:
         raise InputError(f"{field}: outcome '{bad}' {UNSTABLE_RULE}")
@@ -65,8 +66,15 @@ class Declarations:
         self.costs = {}  # {(method, run id): budget.Cost} of every checked run
 
     def tank(self, name):
+        """The tank config/tanks/<name>.yaml, whose ``name`` must be <name>: the run files record the file's name
+        and the comparison reads it (a single.yaml named 'other' dropped its runs from the figures)."""
         if name not in self._tanks:
-            self._tanks[name] = tanks.load(tanks.path_of(name))
+            path = tanks.path_of(name)
+            t = tanks.load(path)
+            if t.name != name:
+                raise InputError(f"{path}: field 'name': '{inputs.printable(t.name)}', but the file is tank '{name}' "
+                                 f"(a tank's name is its file's)")
+            self._tanks[name] = t
         return self._tanks[name]
 
     def spec(self, method):
@@ -94,6 +102,13 @@ class Declarations:
                              f"'{inputs.printable(decl['variant'])}' (choose from {', '.join(m.variants)})")
         if decl.get("start") and decl["start"] not in runs:
             raise InputError(f"{where}.start': no declared {method} run '{inputs.printable(decl['start'])}'")
+        chain, at = [run_id], decl.get("start")
+        while at in runs:  # a run that continues itself, through others or directly, was planned without its start
+            if at in chain:
+                raise InputError(f"{where}.start': the runs continue each other ({' -> '.join([*chain, at])}); a "
+                                 f"run cannot start from its own result")
+            chain.append(at)
+            at = runs[at].get("start")
         try:
             tank = self.tank(decl["tank"])
         except InputError as err:

@@ -1,9 +1,11 @@
-"""The rest criterion of every dynamic method, defined once (settings in config/rest.yaml).
+"""The rest criterion of every dynamic method, defined once (pure Python: read while the workflow is parsed).
 
 A liquid is at rest when e = KE / (W h) -- its kinetic energy over its weight
 times its depth, i.e. <|v|^2> / (2 g h) for equal masses, the dynamic pressure
 rho v^2 / 2 in units of the hydrostatic pressure rho g h -- stays below
-``energy_ratio`` at every sample over the last ``window`` seconds.
+``energy_ratio`` at every sample over the last ``window`` seconds (settings in config/rest.yaml).
+
+The at-rest and wall numbers every run file holds are isaflow.at_rest's.
 Units: cm, N, s.
 """
 

@@ -127,7 +127,7 @@ def to_dataset(result, tank, prov, started, finished, spacing=None, references="
     }
     if np.isfinite(r.sim_time):
         data["sim_time"] = _var((), r.sim_time, "s", "physical time simulated")
-    for name, (dims, arr, units, long_name, *extra) in {**r.fields, **r.history}.items():
+    for name, (dims, arr, units, long_name, *extra) in {**r.fields, **r.history, **r.measures}.items():
         data[name] = _var(dims, arr, units, long_name, **(extra[0] if extra else {}))
     coords = {"xy": ["x", "y"], "wall": tank.wall_names, "end": ["x0", "y0", "x1", "y1"]}
     if vessels:
@@ -278,6 +278,9 @@ def write(ds, path):
     _remove_stale(path)
     tmp = _partial_name(path, os.getpid())
     ds = finite(ds, path)
+    for var in ds.variables.values():  # the snapshots are most of a run file: compressed (lossless, deterministic)
+        if var.dims[:1] == ("snapshot",):
+            var.encoding.update(zlib=True, complevel=4, shuffle=True)
     ds.attrs["isaflow_complete"] = "no"
     try:
         ds.to_netcdf(tmp, engine="netcdf4")

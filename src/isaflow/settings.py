@@ -165,8 +165,10 @@ def flatten(node, prefix=""):
     return out
 
 
-def _parse(item, path, what):
-    """(key, leaf) of one override: a 'key=value' string (value as hardened YAML)."""
+def _parse(item, path, what, source=None):
+    """(key, leaf) of one override: a 'key=value' string (value as hardened YAML, without a comment: one would be
+    dropped silently).  path: what an error names first (a file, '--set', or a file's field); source: the leaf's
+    (default: an override on the command line)."""
     if not isinstance(item, str) or "=" not in item:
         raise InputError(f"{path}: {what} '{inputs.printable(str(item))}' is not of the form key=value")
     key, value = item.split("=", 1)
@@ -177,15 +179,31 @@ def _parse(item, path, what):
         parsed = inputs.parse_yaml(value)
     except InputError as err:
         raise InputError(f"{path}: {what} '{inputs.printable(item)}': {err}") from None
-    return key.strip(), {"value": parsed, "source": f"inferred: {what} on the command line"}
+    comment = inputs.yaml_comment(value)
+    if comment is not None:
+        raise InputError(f"{path}: {what} '{inputs.printable(item)}': a comment ('{inputs.printable(comment, 30)}') is "
+                         f"not part of a value and would be dropped; give the value alone")
+    return key.strip(), {"value": parsed, "source": source or f"inferred: {what} on the command line"}
+
+
+def parse_overrides(items, path, what="override"):
+    """{key: leaf} of 'key=value' strings (:func:`_parse`); a key given twice is refused (which one would win is
+    not what the user meant to say)."""
+    out = {}
+    for item in items:
+        key, leaf = _parse(item, path, what)
+        if key in out:
+            raise InputError(f"{path}: {what} field '{inputs.printable(key)}' is given twice; give it once")
+        out[key] = leaf
+    return out
 
 
 def apply(settings, overrides, values, path, what="override"):
     """Set every override in place, checking key and value against ``values``.
 
-    overrides: a list of 'key=value' strings, or a mapping {key: leaf or plain value}.
+    overrides: a list of 'key=value' strings (:func:`parse_overrides`), or a mapping {key: leaf or plain value}.
     """
-    items = (overrides.items() if isinstance(overrides, dict) else (_parse(o, path, what) for o in overrides))
+    items = (overrides if isinstance(overrides, dict) else parse_overrides(overrides, path, what)).items()
     for key, item in items:
         if key not in values:
             raise InputError(f"{path}: {what} field '{inputs.printable(key)}': no such setting")

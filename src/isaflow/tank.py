@@ -4,9 +4,13 @@ A tank file is validated against ``tank.schema.json`` and checked by functions
 of one signature, ``check_*(path, spec)`` (:func:`check_walls`,
 :func:`check_geometry`, :func:`check_depth`); positions of another file (a
 method's points and probes) by :func:`check_points` / :func:`check_positions`
-``(path, field, points, walls)``; errors name the file and the field.  The tank's liquid (weight W per unit thickness and depth h in
-the first vessel) fixes the hydrostatic theory every method is judged against
-(theory.py): rho g = W / (B h), B the first vessel's width.  Units: cm, N.
+``(path, field, points, walls)``; errors name the file and the field.  Walls may
+slope; a vessel's polygon is the outline between its x bounds
+(:func:`vessel_polygon`).  The tank's liquid (weight W per unit thickness and
+depth h in the first vessel) fills that vessel's polygon below floor + h and
+fixes the hydrostatic theory every method is judged against (theory.py):
+rho g = W / A, A that area (:func:`liquid_area`; B h in a rectangular vessel of
+width B).  Units: cm, N.
 The checks are pure Python (the workflow checks tanks while it is parsed);
 the arrays a solver needs come from NumPy, imported when asked for.
 """
@@ -42,10 +46,29 @@ def vessel_counts(pos, vessels):
 
 
 def vessel_floor(walls, x0, x1):
-    """y [cm] of the floor of a vessel over (x0, x1): the lowest horizontal wall running inside that range (a
-    floor only touching its end belongs to the next vessel); None if there is none.  walls: [(x0, y0, x1, y1)]."""
-    ys = [s[1] for s in walls if abs(s[1] - s[3]) <= TOL and min(max(s[0], s[2]), x1) - max(min(s[0], s[2]), x0) > TOL]
+    """y [cm] of the floor of a vessel over (x0, x1): the lowest point of the walls that are not vertical over the
+    part of them running inside that range (a floor only touching its end belongs to the next vessel): the lowest
+    horizontal wall, or the bottom of sloping walls (a V's vertex); None if there is none.
+    walls: [(x0, y0, x1, y1)]."""
+    ys = []
+    for s in walls:
+        lo, hi = max(min(s[0], s[2]), x0), min(max(s[0], s[2]), x1)
+        if hi - lo <= TOL:
+            continue
+        if abs(s[1] - s[3]) <= TOL:
+            ys.append(s[1])
+        else:  # a sloping wall: its lowest point over [lo, hi] is at one end of that part
+            ys.append(min(_y_at(s, lo), _y_at(s, hi)))
     return min(ys) if ys else None
+
+
+def _y_at(s, x):
+    """y [cm] of the (not vertical) wall segment s at x."""
+    if x <= min(s[0], s[2]):
+        return s[1] if s[0] <= s[2] else s[3]
+    if x >= max(s[0], s[2]):
+        return s[3] if s[0] <= s[2] else s[1]
+    return s[1] + (s[3] - s[1]) * (x - s[0]) / (s[2] - s[0])
 
 
 def side_top(walls, x):
@@ -141,14 +164,24 @@ class Tank:
         return float(self.spec["liquid"]["depth"])
 
     def floor_y(self, vessel=0):
-        """y [cm] of a vessel's floor: the lowest horizontal wall over its x range."""
+        """y [cm] of a vessel's floor: the lowest wall point over its x range (vessel_floor)."""
         return vessel_floor(_segments(self.spec), *self.vessels[vessel][1])
+
+    def vessel_polygon(self, vessel=0):
+        """[(x, y)] cm of a vessel's polygon (vessel_polygon: the outline cut to the vessel's x range)."""
+        return vessel_polygon(_segments(self.spec), self.vessels[vessel][1])
+
+    @property
+    def liquid_area(self):
+        """Area [cm^2] the tank's liquid fills at rest in the first vessel: its polygon below floor + h
+        (liquid_area: B h for a rectangular vessel)."""
+        return liquid_area(self.vessel_polygon(0), self.floor_y(0), self.depth)
 
     @property
     def rho_g(self):
-        """Specific weight rho g [N/cm^2] of the tank's liquid: W / (B h), B the first vessel's width."""
-        x0, x1 = self.vessels[0][1]
-        return self.weight / ((x1 - x0) * self.depth)
+        """Specific weight rho g [N/cm^2] of the tank's liquid: W / A, A the first vessel's polygon below floor + h
+        (B h in a rectangular vessel of width B)."""
+        return self.weight / self.liquid_area
 
     def escape_box(self):
         """(4,) xmin, ymin, xmax, ymax [cm] of the region a dynamic method's particle must stay in: the walls'
@@ -197,11 +230,11 @@ def _horizontal(s):
 
 def _chain(walls):
     """Indices of the outline: the chain of walls joined end to start, head to tail, that runs through the
-    lowest horizontal wall; in traversal order (None if no wall is horizontal)."""
-    floors = [k for k, s in enumerate(walls) if _horizontal(s)]
-    if not floors:
+    lowest wall point (from the wall reaching it, a horizontal one first: the lowest floor, or a V's vertex); in
+    traversal order (None if there is no wall)."""
+    if not walls:
         return None
-    order = [min(floors, key=lambda k: walls[k][1])]
+    order = [min(range(len(walls)), key=lambda k: (min(walls[k][1], walls[k][3]), not _horizontal(walls[k]), k))]
     while True:  # walk back: the one wall whose end is this one's start
         prev = [k for k, s in enumerate(walls) if k not in order and _same(s[2:], walls[order[0]][:2])]
         if len(prev) != 1:
@@ -235,6 +268,93 @@ def _cross(a, b):
     return inside and not ends
 
 
+def outline_points(walls, order=None):
+    """[(x, y)] cm of the outline's vertices (the chain _chain finds: down the left side, along the floors, up the
+    right side), closed across the top from its last point back to its first (pure Python)."""
+    order = _chain(walls) if order is None else order
+    return [tuple(walls[order[0]][:2])] + [tuple(walls[k][2:]) for k in order]
+
+
+def _signed_area(points):
+    """Shoelace signed area [cm^2] of a closed polygon (positive: counter-clockwise), about its first vertex."""
+    x0, y0 = points[0]
+    rel = [(x - x0, y - y0) for x, y in points]
+    return 0.5 * sum(a[0] * b[1] - b[0] * a[1] for a, b in zip(rel, rel[1:] + rel[:1]))
+
+
+def _clip(points, inside, cross):
+    """Sutherland-Hodgman: the part of a closed polygon where inside(p) holds, cross(p, q) the crossing point."""
+    out = []
+    for k, q in enumerate(points):
+        p = points[k - 1]
+        if inside(q):
+            if not inside(p):
+                out.append(cross(p, q))
+            out.append(q)
+        elif inside(p):
+            out.append(cross(p, q))
+    return out
+
+
+def _tidy(points):
+    """The polygon without repeated vertices and without vertices on the line through their neighbours (straight
+    runs and the zero-width spikes clipping leaves along a boundary)."""
+    pts = list(points)
+    changed = True
+    while changed and len(pts) > 2:
+        changed = False
+        for k in range(len(pts)):
+            a, b, c = pts[k - 1], pts[k], pts[(k + 1) % len(pts)]
+            ab, bc = math.hypot(b[0] - a[0], b[1] - a[1]), math.hypot(c[0] - b[0], c[1] - b[1])
+            if ab <= TOL or bc <= TOL or abs((b[0] - a[0]) * (c[1] - b[1]) - (b[1] - a[1]) * (c[0] - b[0])) <= TOL * ab * bc:
+                del pts[k]
+                changed = True
+                break
+    return pts if len(pts) > 2 else []
+
+
+def vessel_polygon(walls, x_range):
+    """[(x, y)] cm, counter-clockwise: a vessel's polygon, the tank's outline (outline_points: closed across the
+    top of its end walls) cut to the vessel's [xmin, xmax] (pure Python).  The liquid of every method starts in
+    the first vessel's polygon; the tank's theory integrates over it (liquid_area)."""
+    x0, x1 = x_range
+
+    def at_x(x):
+        return lambda p, q: (x, p[1] + (q[1] - p[1]) * (x - p[0]) / (q[0] - p[0]))
+
+    pts = _clip(outline_points(walls), lambda p: p[0] >= x0, at_x(x0))
+    pts = _clip(pts, lambda p: p[0] <= x1, at_x(x1))
+    return _tidy(pts)
+
+
+def below(polygon, level):
+    """The part of a polygon [(x, y)] below y = level (pure Python)."""
+    cut = _clip(polygon, lambda p: p[1] <= level,
+                lambda p, q: (p[0] + (q[0] - p[0]) * (level - p[1]) / (q[1] - p[1]), level))
+    return _tidy(cut)
+
+
+def is_box(polygon):
+    """True if the polygon is an axis-aligned rectangle (four corners of its bounding box)."""
+    if len(polygon) != 4:
+        return False
+    xs, ys = sorted({round(x / TOL) for x, _ in polygon}), sorted({round(y / TOL) for _, y in polygon})
+    return len(xs) == 2 and len(ys) == 2
+
+
+def liquid_area(polygon, floor, depth):
+    """Area [cm^2] of a vessel's polygon below floor + depth [cm]: width x depth in closed form where that part is a
+    rectangle (a vessel of vertical sides on a flat floor), else the polygon's area (shoelace)."""
+    if depth <= 0:
+        return 0.0
+    part = below(polygon, floor + depth)
+    if not part:
+        return 0.0
+    if is_box(part):
+        return (max(x for x, _ in part) - min(x for x, _ in part)) * depth
+    return abs(_signed_area(part))
+
+
 def check_geometry(path, spec):
     """A tank that can hold its liquid: one outline of joined walls (down the left side, along the floors, up
     the right side: the liquid on every wall's left), no crossing walls, every vessel inside the outline on a
@@ -242,10 +362,8 @@ def check_geometry(path, spec):
     walls, names = _segments(spec), [w["name"] for w in spec["walls"]]
     where = f"{path}: field 'walls'"
     order = _chain(walls)
-    if order is None:
-        raise InputError(f"{where}: no horizontal wall: a tank needs a floor")
     first, last = walls[order[0]], walls[order[-1]]
-    if not (first[1] > first[3] and last[3] > last[1]):
+    if not (first[1] > first[3] and last[3] > last[1]) or _signed_area(outline_points(walls, order)) <= 0:
         raise InputError(f"{where}: the walls joined to the floor do not run down one side and up the other "
                          f"({names[order[0]]} ... {names[order[-1]]}): the tank is not closed below its top, or a "
                          f"wall is reversed (walls are oriented with the liquid on their left)")

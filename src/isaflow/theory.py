@@ -2,13 +2,18 @@
 
 Units: length cm, force N, pressure N/cm (2D: force per unit wall length).
 A hydrostatic liquid of specific weight gamma [N/cm^2] with its free surface
-at ``level`` loads a wall with gamma (level - y)_+ per unit length.  The
-tank's theory (:func:`rest_levels`) fixes gamma = rho g and the levels at rest
-from the tank's liquid alone; a method's own theory takes the weight it holds
-and the depth of its own free surface (metrics.load_errors).
+at ``level`` loads a wall with gamma (level - y)_+ per unit length, normal to
+the wall whatever its slope (:func:`wall_total`, :func:`wall_force`: a plane
+wall of slope theta wetted to depth h carries gamma h^2 / (2 sin theta)).  The
+tank's theory (:func:`rest_level`) fixes gamma = rho g and the levels at rest
+from the tank's liquid alone, over the vessels' polygons (tank.vessel_polygon);
+a method's own theory takes the weight it holds and the depth of its own free
+surface (metrics.load_errors).
 """
 
 import numpy as np
+
+from . import tank as T
 
 
 def surface_profile(pos, a, x_range):
@@ -62,9 +67,25 @@ def _pressure_integral(wall, s0, s1, gamma, level):
 
 
 def wall_total(wall, gamma, level):
-    """Hydrostatic force magnitude [N] on a whole wall segment (x0, y0, x1, y1)."""
+    """Hydrostatic force magnitude [N] on a whole wall segment (x0, y0, x1, y1): the pressure integrated along it,
+    normal to it (a plane wall of slope theta from the horizontal wetted to depth h: gamma h^2 / (2 sin theta))."""
     L = np.hypot(wall[2] - wall[0], wall[3] - wall[1])
     return _pressure_integral(wall, 0.0, L, gamma, level)
+
+
+def wall_force(wall, gamma, level):
+    """(2,) hydrostatic force [N] of the liquid on a wall segment (x0, y0, x1, y1), oriented with the liquid on
+    its left: wall_total along the wall's right-hand normal (into the wall).  Its horizontal part is gamma h^2 / 2
+    on any plane wall wetted to depth h, its vertical part the weight of the liquid above the wall."""
+    x0, y0, x1, y1 = (float(c) for c in wall)
+    L = np.hypot(x1 - x0, y1 - y0)
+    return wall_total(wall, gamma, level) * np.array([(y1 - y0) / L, -(x1 - x0) / L])
+
+
+def liquid_area(polygon, floor_y, depth):
+    """Area [cm^2] of a vessel's polygon [(x, y)] below floor_y + depth (tank.liquid_area: width x depth in a
+    rectangular vessel)."""
+    return T.liquid_area(polygon, floor_y, depth)
 
 
 def contact_theory(walls, contact_wall, contact_point, gamma, level, wall_mask=None):
@@ -123,3 +144,30 @@ def rest_levels(floors, widths, weight, rho_g):
         if k == len(f) - 1 or h <= f[k + 1]:
             return float(h)
     return float("nan")
+
+
+def rest_level(polygons, floors, weight, rho_g):
+    """Free-surface level [cm] of a liquid at rest in communicating vessels of any polygonal shape.
+
+    polygons: each vessel's polygon [(x, y)] (tank.vessel_polygon), floors (V,) cm their floors; the level H
+    solves sum_v A_v(H) = W / rho_g, A_v the vessel's polygon below H (liquid_area).  Vessels that are all
+    rectangles take the closed form (rest_levels); any other by bisection to round-off (the areas grow with H).
+    NaN if the vessels cannot hold the liquid below their tops."""
+    boxes = [T.is_box(p) for p in polygons]
+    if all(boxes):
+        widths = [max(x for x, _ in p) - min(x for x, _ in p) for p in polygons]
+        return rest_levels(floors, widths, weight, rho_g)
+    target = weight / rho_g
+
+    def held(H):
+        return sum(liquid_area(p, f, H - f) for p, f in zip(polygons, floors) if H > f)
+
+    lo, hi = float(min(floors)), float(max(y for p in polygons for _, y in p))
+    if held(hi) < target:
+        return float("nan")
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        if mid <= lo or mid >= hi:
+            break
+        lo, hi = (mid, hi) if held(mid) < target else (lo, mid)
+    return float(hi)

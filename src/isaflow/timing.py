@@ -42,13 +42,14 @@ def job_start(job):
 
 
 def process_start():
-    """Epoch time [s] this process started (Linux /proc; the current time elsewhere)."""
+    """Epoch time [s] this process started (Linux: its start in clock ticks since boot, /proc/self/stat, on the boot
+    time read to the nanosecond from CLOCK_BOOTTIME, not /proc/stat's btime, which is truncated to whole seconds and
+    charged every job up to a second it never ran; the current time elsewhere)."""
     try:
         ticks = int(Path("/proc/self/stat").read_text().rsplit(")", 1)[1].split()[19])
-        boot = next(float(line.split()[1]) for line in Path("/proc/stat").read_text().splitlines()
-                    if line.startswith("btime"))
+        boot = time.time() - time.clock_gettime(time.CLOCK_BOOTTIME)
         return boot + ticks / os.sysconf("SC_CLK_TCK")
-    except (OSError, ValueError, IndexError, StopIteration):
+    except (OSError, ValueError, IndexError, AttributeError):
         return time.time()
 
 

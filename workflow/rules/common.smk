@@ -234,6 +234,27 @@ def compare_runs():
     return [run_file(m, r) for m in TANK_METHODS for r, d in RUNS[m].items() if d.get("compare") and d["tank"] in tanks]
 
 
+# the runs the target `vtk` exports for ParaView (export.smk)
+@functools.cache
+def _vessel_count(tank):
+    """Vessels of a tank of config/tanks/ (its file read by the project's reader; refused with one line)."""
+    from isaflow import tank as _tank
+
+    try:
+        return len(_tank.load(_tank.path_of(tank)).spec.get("vessels", []))
+    except _inputs.InputError as err:
+        refuse(err)
+
+
+def flow_runs():
+    """(method, run id) of every compared run of a tank method on a tank of two or more vessels."""
+    return [(m, r) for m in TANK_METHODS for r, d in RUNS[m].items() if d.get("compare") and _vessel_count(d["tank"]) > 1]
+
+
+def vtk_file(method, run):
+    return f"results/vtk/{method}/{run}/{run}.pvd"
+
+
 def figure(name):
     """PNG and PDF paths of a figure."""
     return [f"figures/{name}.png", f"figures/{name}.pdf"]
@@ -255,9 +276,10 @@ REPORT_FIGURES = read_config("workflow/report/figures.yaml", "report_figures.sch
 
 
 def with_report_copies(paths):
-    """paths, then results/report/figures/<name>.png of every figures/<name>.png among them that has a caption."""
-    names = [os.path.basename(p)[:-4] for p in paths if p.startswith("figures/") and p.endswith(".png")]
-    return list(paths) + [f"results/report/figures/{n}.png" for n in names if n in REPORT_FIGURES]
+    """paths, then results/report/figures/<name>.<png|gif> of every figures/<name>.<png|gif> (a figure, an
+    animation) among them that has a caption."""
+    names = [os.path.basename(p) for p in paths if p.startswith("figures/") and p.endswith((".png", ".gif"))]
+    return list(paths) + [f"results/report/figures/{n}" for n in names if n[:-4] in REPORT_FIGURES]
 
 
 def _rst(text, limit=None):
@@ -326,6 +348,18 @@ def _derived_entries():
 
 
 DERIVED = _derived_entries()  # {'<method>:<name>': entry}
+
+
+def _paper_run_keys():
+    from isaflow import claims_registry  # noqa: E402
+
+    try:
+        return claims_registry.paper_runs()
+    except _inputs.InputError as err:
+        refuse(err)
+
+
+PAPER_RUN_KEYS = _paper_run_keys()  # {paper: set of '<method>:<run>' its rows may read}
 OTHER_RUN_FILES.update({k: _derived.path(k) for k in DERIVED})
 
 
@@ -347,6 +381,21 @@ def claim_runs(wc=None):
     out.update(OTHER_RUN_FILES)
     out.update(RUN_GROUPS)
     return out
+
+
+def paper_claim_runs(wc):
+    """The run files one paper's rows read (isaflow.claims_registry.paper_runs: their runs, checks, inputs' runs and
+    the paper's version of each), as the claims job's inputs and its run mapping."""
+    runs = claim_runs()
+    keys = PAPER_RUN_KEYS[wc.paper]
+    return {k: v for k, v in runs.items() if k in keys}
+
+
+def paper_claim_files(wc):
+    files = []
+    for v in paper_claim_runs(wc).values():
+        files += v if isinstance(v, list) else [v]
+    return sorted(set(files))
 
 
 def claim_inputs(wc):

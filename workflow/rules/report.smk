@@ -23,6 +23,7 @@ use rule call as replication_report with:
         findings="results/report/findings.md",
         registry=sorted(glob.glob("config/claims/*.yaml")),
         figures="workflow/report/figures.yaml",
+        baseline="docs/tables/claims_baseline.csv",
         code=code("report", "report.claims"),
     output:
         "docs/replication.md",
@@ -68,14 +69,14 @@ rule benchmarks:
         lambda wc: TARGETS["bench"] + ["docs/benchmarks.md"],
 
 
-# The report's copy of a figure, with its own caption (workflow/report/figures.yaml, the verdicts of the claims
+# The report's copy of a figure (or an animation, .gif), with its own caption (workflow/report/figures.yaml, the verdicts of the claims
 # it bears on from this run's claims registry), category and subcategory.  Only a run of this checkout makes
 # it, so a report never shows a committed figure the run did not make.
 rule report_figure_copy:
     input:
-        "figures/{name}.png",
+        "figures/{name}.{ext}",
     output:
-        report("results/report/figures/{name}.png", caption="../report/figure.rst",
+        report("results/report/figures/{name}.{ext}", caption="../report/figure.rst",
                category=lambda wc: REPORT_FIGURES[wc.name]["category"],
                subcategory=lambda wc: REPORT_FIGURES[wc.name]["subcategory"]),
     message:
@@ -84,9 +85,10 @@ rule report_figure_copy:
     resources:
         **SMALL,
     log:
-        "logs/report/figures/{name}.log",
+        "logs/report/figures/{name}.{ext}.log",
     wildcard_constraints:
         name="|".join(REPORT_FIGURES),
+        ext="png|gif",  # a figure or an animation
     conda:
         "../envs/isaflow.yaml"
     shell:

@@ -67,3 +67,45 @@ def outside_box(pos, box, eps=1e-9):
     inside = ((pos[:, 0] >= box[0] - eps) & (pos[:, 0] <= box[2] + eps)
               & (pos[:, 1] >= box[1] - eps) & (pos[:, 1] <= box[3] + eps))
     return ~inside
+
+
+def point_segment_distance(pts, segs):
+    """(N,) distance [cm] of each point (N, 2) to the nearest of the segments (S, 4) x0, y0, x1, y1 (inf if none)."""
+    pts = np.asarray(pts, float).reshape(-1, 2)
+    out = np.full(len(pts), np.inf)
+    for x0, y0, x1, y1 in np.asarray(segs, float).reshape(-1, 4):
+        ex, ey = x1 - x0, y1 - y0
+        L2 = ex * ex + ey * ey
+        t = np.clip(((pts[:, 0] - x0) * ex + (pts[:, 1] - y0) * ey) / L2, 0.0, 1.0) if L2 > 0 else 0.0
+        out = np.minimum(out, np.hypot(pts[:, 0] - (x0 + t * ex), pts[:, 1] - (y0 + t * ey)))
+    return out
+
+
+def inside_polygon(pts, polygon):
+    """(N,) bool: the point (N, 2) lies inside the closed polygon [(x, y)] (even-odd rule; a point on an edge may
+    fall either way: ask for a clearance, inside_vessel)."""
+    pts = np.asarray(pts, float).reshape(-1, 2)
+    poly = np.asarray(polygon, float).reshape(-1, 2)
+    x, y = pts[:, 0], pts[:, 1]
+    inside = np.zeros(len(pts), bool)
+    for k in range(len(poly)):
+        (ax, ay), (bx, by) = poly[k - 1], poly[k]
+        if ay == by:
+            continue
+        spans = (ay > y) != (by > y)
+        xc = ax + (y - ay) * (bx - ax) / (by - ay)
+        inside ^= spans & (x < xc)
+    return inside
+
+
+def inside_vessel(pts, polygon, walls, clearance):
+    """(N,) bool: the point (N, 2) [cm] lies inside a vessel's polygon (isaflow.tank.vessel_polygon) at least
+    ``clearance`` cm from its edges and from every wall (W, 4) (a point at the clearance to round-off counts as
+    at it): the one test by which every method's initial liquid fills its vessel.  A lattice of cells (dx, dy)
+    from a rectangle's corner, tested at half a cell, keeps every cell: its centres lie half a cell from its sides."""
+    pts = np.asarray(pts, float).reshape(-1, 2)
+    poly = np.asarray(polygon, float).reshape(-1, 2)
+    edges = np.column_stack([np.roll(poly, 1, axis=0), poly])
+    segs = np.concatenate([edges, np.asarray(walls, float).reshape(-1, 4)])
+    scale = max(1.0, float(np.abs(poly).max()))
+    return inside_polygon(pts, poly) & (point_segment_distance(pts, segs) >= clearance * (1 - 1e-9) - 1e-12 * scale)

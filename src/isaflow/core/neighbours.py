@@ -1,4 +1,9 @@
-"""Neighbour lists shared by every method: one cell-list builder (numba), serial or in parallel blocks.
+"""The shared neighbour lists (numba): a cell-list builder, serial or in parallel blocks.
+
+Used by ISA's loops (relax, newton, replay, theory), the solid, the measures of isaflow.metrics and SPH's
+setup and claims.  Not every method's: SPH's pair list (methods/sph/pairs.py) takes :func:`cell_grid` and
+builds its own column-ordered list with wall visibility; SPH's periodic block (methods/sph/block.py) and MPS
+(methods/mps/operators.py) sort particles into cells of their own.
 
 ``cell_rows`` finds all pairs closer than a cutoff, each once (a half list),
 stored by rows of a cell-sorted particle order (counting sort into the cells of

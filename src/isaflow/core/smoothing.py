@@ -9,6 +9,9 @@ Convention (all kernels): support radius 2 h, q = r / h in [0, 2].
   codes use in every dimension; Dehnen & Aly 2012), with s = q / 2:
   C2 (1 - s)^4 (1 + 4 s); C4 (1 - s)^6 (1 + 6 s + 35/3 s^2);
   C6 (1 - s)^8 (1 + 8 s + 25 s^2 + 32 s^3).
+- ``wendland_c2_1d``, ``wendland_c4_1d``, ``wendland_c6_1d``: the 1D forms, Wendland functions psi_{2,1},
+  psi_{3,2}, psi_{4,3} (positive definite in 1D; Dehnen & Aly 2012, Table 1, nu = 1), s = q / 2:
+  C2 (1 - s)^3 (1 + 3 s); C4 (1 - s)^5 (1 + 5 s + 8 s^2); C6 (1 - s)^7 (1 + 7 s + 19 s^2 + 21 s^3).
 Normalisations sigma_d / h^d are computed exactly (polynomial integration) at
 import, so that the integral of W over R^d is 1 in d = 1, 2, 3.
 
@@ -24,8 +27,8 @@ from numpy.polynomial import Polynomial as P
 
 JIT = dict(cache=True, nogil=True)
 
-NAMES = ("cubic_spline", "wendland_c2", "wendland_c4", "wendland_c6")
-CUBIC, WC2, WC4, WC6 = range(4)
+NAMES = ("cubic_spline", "wendland_c2", "wendland_c4", "wendland_c6", "wendland_c2_1d", "wendland_c4_1d", "wendland_c6_1d")
+CUBIC, WC2, WC4, WC6, WC2_1D, WC4_1D, WC6_1D = range(7)
 SUPPORT = 2.0  # support radius in units of h
 
 
@@ -37,7 +40,10 @@ def _pieces(kind):
     one = 1.0 - s
     poly = {WC2: one**4 * (1 + 4 * s),
             WC4: one**6 * (1 + 6 * s + 35.0 / 3.0 * s**2),
-            WC6: one**8 * (1 + 8 * s + 25 * s**2 + 32 * s**3)}[kind]
+            WC6: one**8 * (1 + 8 * s + 25 * s**2 + 32 * s**3),
+            WC2_1D: one**3 * (1 + 3 * s),
+            WC4_1D: one**5 * (1 + 5 * s + 8 * s**2),
+            WC6_1D: one**7 * (1 + 7 * s + 19 * s**2 + 21 * s**3)}[kind]
     return [(0.0, 2.0, poly)]
 
 
@@ -78,7 +84,13 @@ def w(kind, q):
         return o**4 * (1.0 + 4.0 * s)
     if kind == 2:
         return o**6 * (1.0 + 6.0 * s + 35.0 / 3.0 * s * s)
-    return o**8 * (1.0 + 8.0 * s + 25.0 * s * s + 32.0 * s * s * s)
+    if kind == 3:
+        return o**8 * (1.0 + 8.0 * s + 25.0 * s * s + 32.0 * s * s * s)
+    if kind == 4:
+        return o**3 * (1.0 + 3.0 * s)
+    if kind == 5:
+        return o**5 * (1.0 + 5.0 * s + 8.0 * s * s)
+    return o**7 * (1.0 + 7.0 * s + 19.0 * s * s + 21.0 * s * s * s)
 
 
 @njit(**JIT)
@@ -98,7 +110,13 @@ def dw(kind, q):
         return 0.5 * (-20.0 * s * o**3)
     if kind == 2:
         return 0.5 * (-(56.0 / 3.0) * s * (1.0 + 5.0 * s) * o**5)
-    return 0.5 * (-22.0 * s * (1.0 + 7.0 * s + 16.0 * s * s) * o**7)
+    if kind == 3:
+        return 0.5 * (-22.0 * s * (1.0 + 7.0 * s + 16.0 * s * s) * o**7)
+    if kind == 4:
+        return 0.5 * (-12.0 * s * o**2)
+    if kind == 5:
+        return 0.5 * (-14.0 * s * (1.0 + 4.0 * s) * o**4)
+    return 0.5 * (-6.0 * s * (3.0 + 18.0 * s + 35.0 * s * s) * o**6)
 
 
 def W(name, r, h, dim):

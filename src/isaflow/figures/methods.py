@@ -9,6 +9,7 @@ import numpy as np
 import pandas as pd
 
 from .style import OUTCOME_STYLE, method_marker, plt, save, variant_style
+from ..report.methods import at_rest
 
 FLOOR = 1e-4  # smallest |error| drawn on log axes
 
@@ -26,7 +27,8 @@ def _vessels(g):
 def tanks_figure(table, outputs, tanks=()):
     """Columns = tanks (in the order given, then any other); rows: free-surface error against the tank's
     level at rest [cm], side-wall and floor errors of the receiving vessel against the tank's theory (the
-    method's marker) and the run's own depth ('+').  Filled: the run met its stop criterion."""
+    method's marker) and the run's own depth ('+').  Filled: the run met its stop criterion; a dynamic run still moving at
+    its time limit is not drawn (report.methods.at_rest)."""
     df = pd.read_csv(table)
     df = df[df["compare"].astype(bool)]
     tanks = [t for t in tanks if t in set(df["tank"])] + [t for t in dict.fromkeys(df["tank"]) if t not in tanks]
@@ -43,6 +45,8 @@ def tanks_figure(table, outputs, tanks=()):
             mk = method_marker(r["method"])
             done = r["status"] == "converged"
             handles.setdefault(f"{r['method']}: {label}", plt.Line2D([], [], ls="", marker=mk, color=colour))
+            if not at_rest(r):  # a dynamic run still moving at its time limit: no end state to compare
+                continue
             for v, shift in zip(vess, np.linspace(-0.15, 0.15, len(vess))):
                 y = r.get(f"{v}surface_err_tank_cm", np.nan)
                 first = v != recv
@@ -53,6 +57,12 @@ def tanks_figure(table, outputs, tanks=()):
                                     color=colour, mfc=colour if done else "none")
                 axes[row, col].plot(k + 0.12, r.get(f"{recv}{key}_own", np.nan), marker="+", ls="", ms=9, mew=1.6,
                                     color=colour)
+        floorless = not g.get(f"{recv}floor_err_tank", pd.Series(dtype=float)).notna().any()
+        if floorless and "walls_weight_err" in g:  # no floor wall (a V): the walls' vertical load against the weight
+            for k, r in g.iterrows():
+                colour, _ = variant_style(r["method"], r["variant"])
+                axes[2, col].plot(k, r["walls_weight_err"], marker=method_marker(r["method"]), ls="", ms=7,
+                                  color=colour, mfc=colour if r["status"] == "converged" else "none")
         for row in range(3):
             ax = axes[row, col]
             ax.axhline(0, color="k", lw=0.6)
@@ -64,9 +74,10 @@ def tanks_figure(table, outputs, tanks=()):
         axes[0, col].set_ylabel("free surface - tank's level at rest (cm)" + (
             "\n(x: first vessel, marker: receiving vessel)" if len(vess) > 1 else ""))
         axes[1, col].set_ylabel(f"side-wall load error{where}\nmarker: vs tank theory; +: vs own depth")
-        axes[2, col].set_ylabel(f"floor load error{where}\nmarker: vs tank theory; +: vs own depth")
+        axes[2, col].set_ylabel(f"floor load error{where}\nmarker: vs tank theory; +: vs own depth" if not floorless
+                                else "no floor: the walls' vertical load\n/ the liquid's weight - 1")
         for row in (1, 2):
-            axes[row, col].yaxis.set_major_formatter(plt.FuncFormatter(lambda v, _: f"{v:+.0%}"))
+            _percent_axis(axes[row, col])
     handles["hollow marker, * after the label: the run did not meet its stop criterion (" + ", ".join(
         k for k in OUTCOME_STYLE if k != "converged") + ")"] = plt.Line2D([], [], ls="", marker="o", mfc="none", color="k")
     handles["+: the same load against the run's own weight and depth; x: the first vessel's surface"] = \
@@ -77,6 +88,17 @@ def tanks_figure(table, outputs, tanks=()):
                  "half a layer pitch;\ntheory = the tank's liquid (W, rho g) at rest in its vessels, or the run's own "
                  "weight and depth", y=0.93)
     save(fig, outputs)
+
+
+def _percent_axis(ax):
+    """Tick labels of a fractional error axis in signed percent, with as many decimals as the tick step needs."""
+    ticks = ax.get_yticks()
+    step = 100 * float(np.min(np.diff(ticks))) if len(ticks) > 1 else 1.0
+    digits = int(min(3, max(0, -np.floor(np.log10(step) + 1e-9)))) if step > 0 else 0
+    # a step such as 0.25 % needs two decimals: as many as it has
+    while digits < 3 and abs(round(step, digits) - step) > 1e-9 * step:
+        digits += 1
+    ax.yaxis.set_major_formatter(plt.FuncFormatter(lambda v, _: f"{v:+.{digits}%}"))
 
 
 PANELS = [

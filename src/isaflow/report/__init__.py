@@ -1,14 +1,17 @@
 """docs/replication.md, assembled from fragments the workflow generates.
 
-Each part of the workflow writes a Markdown fragment under results/report/
-(one module per section here: single, flow, study, speed, inferred; added
-methods write their own); :func:`assemble` joins them in name order under a
-generated header.  Nothing in docs/replication.md is typed by hand.
+Each part of the workflow writes a Markdown fragment under results/report/ (here:
+``inferred``, the inferred inputs, and ``methods``, the methods' comparison; every method
+its own, e.g. methods/isa/report/ ``single``, ``flow``, ``study``); :func:`assemble` puts
+the claims part first (``claims``, from the claims rule's tables) and joins the fragments
+in name order under a generated header.  ``speed`` assembles docs/timing.md from the
+timing fragments.  Nothing in docs/replication.md is typed by hand.
 """
 
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 
 from .. import claims_registry
 from ..claims import VERDICTS, verdict_class as _verdict_class
@@ -106,7 +109,7 @@ def changes(df, registry=None):
     return out
 
 
-def assemble(parts, claims, counts, findings, outputs, registry=None, figures=None):
+def assemble(parts, claims, counts, findings, outputs, registry=None, figures=None, baseline=None):
     """docs/replication.md: the first screen per paper (method results with robust / fragile, the findings that
     matter), the separately counted lists, every row by paper (counts by kind, one table per paper), why not
     reproduced, what changed from the former table, the findings, the fragments in name order, and the closing
@@ -126,7 +129,7 @@ def assemble(parts, claims, counts, findings, outputs, registry=None, figures=No
     for paper in PAPERS:
         head += RC.first_screen(paper, df, reg, found)
     head += RC.lists(df, reg)
-    head += ["## Every row, by paper", "", "### Counts by paper and kind", "", counts_table(counts), ""]
+    head += ["## Every row, by paper", "", RC.SURFACE, "", "### Counts by paper and kind", "", counts_table(counts), ""]
     for paper, g in df.groupby("paper", sort=False):
         head += [f"### {PAPERS.get(paper, paper)}: every row", "", claims_table(g), ""]
     why = df[df["verdict"].map(_verdict_class).eq(VERDICTS[2]) & df["why"].astype(bool)]
@@ -150,7 +153,8 @@ def assemble(parts, claims, counts, findings, outputs, registry=None, figures=No
         from ..inputs import read_yaml
 
         figs = read_yaml(figures)[1]
-    text = "\n".join(head + body + RC.closing(df, reg, figs))
+    base = pd.read_csv(baseline) if baseline else None
+    text = "\n".join(head + body + RC.closing(df, reg, figs, base))
     Path(outputs[0]).parent.mkdir(parents=True, exist_ok=True)
     Path(outputs[0]).write_text(text)
     if len(outputs) > 1:  # the same report as an HTML page (the Snakemake report shows it inline)

@@ -117,78 +117,85 @@ def headline(df, registry):
 
 
 def _verdict_cell(r):
-    flips = f" ({cell(r['flips'], 120)})" if r["robustness"] == "fragile" and r["flips"] else ""
-    return f"**{cell(r['verdict'])}**", f"{r['robustness']}{flips}"
+    flips = f" ({cell(r['flips'], FLIPS_CELL)})" if r["robustness"] == "fragile" and r["flips"] else ""
+    return f"**{SHORT.get(verdict_class(r['verdict']), r['verdict'])}**", f"{r['robustness']}{flips}"
 
 
-def _rows_word(n):
-    return f"{n} row" + ("" if n == 1 else "s")
+def _short(r):
+    return cell(r.get("short") if isinstance(r.get("short"), str) and r.get("short") else r["measured"], SHORT_CELL)
 
 
 def _unit_line(u):
-    """One table row of the first screen: a method result (with the rows grouped under it) or a root cause outside
-    the method results (the rows that fail for it)."""
+    """One table row of the first screen: a method result (with how many rows it stands for) or a root cause outside
+    the method results."""
     r = u["row"]
+    more = f" (+{len(u['members'])})" if u["members"] else ""
     if u["kind"] == "method result" and r is not None:
         v, rb = _verdict_cell(r)
-        if u["robustness"] != r["robustness"]:
-            rb = f"{rb}; the group: {_group_robustness(u)}"
-        same = f" (+ {_rows_word(len(u['members']))}, same cause: {', '.join(f'`{m}`' for m in u['members'])})" \
-            if u["members"] else ""
-        return f"| `{r['id']}` \"{cell(r['claim'], 70)}\"{same} | {cell(r['measured'], 110)} | {v} | {rb} |"
-    what = cell(r["measured"], 110) if r is not None else ""
-    return (f"| {len(u['members'])} rows for one cause, `{u['id']}` ({u['kind']}): "
-            f"{', '.join(f'`{m}`' for m in u['members'])} | {what} | **{u['verdict']}** | {_group_robustness(u)} |")
+        return f"| `{r['id']}`{more} \"{cell(r['claim'], QUOTE_CELL)}\" | {_short(r)} | {v} | {rb} |"
+    what = _short(r) if r is not None else ""
+    return f"| `{u['id']}`{more} ({u['kind']}) | {what} | **{SHORT.get(u['verdict'], u['verdict'])}** | {u['robustness']} |"
 
 
-def _group_robustness(u):
-    """The group's class, with the rows that make it fragile or unswept and where they flip."""
-    odd = [m for m in u["own"] if m["robustness"] != "robust"]
-    if not odd:
-        return u["robustness"]
-    return f"{u['robustness']} (" + "; ".join(f"`{m['id']}` {m['robustness']}" + (f": {cell(m['flips'], 90)}" if
-                                                                                   m["flips"] else "")
-                                             for m in odd) + ")"
+QUOTE_CELL, SHORT_CELL, FLIPS_CELL = 32, 48, 40  # characters of a first-screen cell (a test counts them)
+PAGE_WORDS = 55 * 14  # a paper's first screen fits one printed page: an A4 page of 10 pt holds about 55 lines of
+# 14 words, the table one line a row (tests/test_report.py counts its words, images aside)
+
+
+def status(head):
+    """The ReScience-style line of a paper: replicated (every tested method result reproduced), not replicated
+    (none), else partly replicated."""
+    tested = head["units"] - head[VERDICTS[3]]
+    good = head[VERDICTS[0]] + head[VERDICTS[1]]
+    return "no method results" if not tested else (
+        "replicated" if good == tested else ("not replicated" if good == 0 else "partly replicated"))
+
+
+def sentence_holds(sentence, rows):
+    """True when a finding's sentence is borne out by the judged row it names (its verdict class, and robustness if
+    stated); False if contradicted; None if that row was not judged."""
+    r = rows.get(sentence["row"])
+    if r is None:
+        return None
+    ok = verdict_class(r["verdict"]) == sentence["verdict"]
+    return ok and (sentence.get("robustness") in (None, r["robustness"]))
 
 
 def first_screen(paper, df, registry, findings):
-    """Markdown lines: one paper's first screen (fits on a page: short cells; the untestable ones on one line)."""
+    """Markdown lines: one paper's first screen, one printed page: its status line with the counts, the findings that
+    matter (each sentence checked against the judged row it names, its figure inline), then the method results."""
     us = units(df, registry).get(paper, [])
     head = headline(df, registry).get(paper, Counter())
     rows = _rows(df)
-    label = PAPERS.get(paper, paper)
-    lines = [f"### {label}", ""]
+    lines = [f"### {PAPERS.get(paper, paper)}", ""]
     if not us:
-        lines += ["No method results: every row of this paper is arithmetic, an input rule, an inconsistency found "
-                  "or a deviation of this project (the lists below).", ""]
+        lines += ["No method results: every row is arithmetic, an input rule, an inconsistency found or a deviation "
+                  "of this project (the lists below).", ""]
     else:
         parts = ", ".join(f"{head[k]} {SHORT[k]}" for k in ORDER if head[k])
         rob = ", ".join(f"{head[k]} {k}" for k in ("robust", "fragile", "unswept") if head[k])
-        grouped = (f" ({head['grouped']} rows that share a root cause are counted once, under it.)"
-                   if head["grouped"] else "")
-        lines += [f"Method results: {head['rows']} rows, counted as {head['units']}: {parts}; {rob}.{grouped}", "",
-                  "| claim (quoted) | what we measured | verdict | robust / fragile |", "|---|---|---|---|"]
+        lines += [f"**{status(head).capitalize()}** on the paper's version: {head['units']} method results ({parts}; "
+                  f"{rob}; of {head['rows']} rows).", ""]
+    for k, f in enumerate(findings.get(paper, []), 1):
+        said = []
+        for snt in f.get("sentences", []):
+            ok = sentence_holds(snt, rows)  # its numbers are the row's, in the table below
+            said.append(cell(snt["text"]) + ("" if ok else f" *[{'not judged' if ok is None else 'contradicted'} by "
+                                                            f"`{snt['row']}`]*"))
+        lines += [f"{k}. **{cell(f['title'])}** " + " ".join(said), "",
+                  f"   ![{cell(f['title'])}](../{f['figure']})", ""]
+    if us:
+        lines += ["| claim | measured (paper's version) | verdict | robust |", "|---|---|---|---|"]
         tested = [u for u in us if u["verdict"] != VERDICTS[3]]
-        for u in sorted(tested, key=lambda u: (FIRST.index(u["verdict"]), u["id"])):
-            lines.append(_unit_line(u))
+        lines += [_unit_line(u) for u in sorted(tested, key=lambda u: (FIRST.index(u["verdict"]), u["id"]))]
         untested = [u for u in us if u["verdict"] == VERDICTS[3]]
         lines.append("")
         if untested:
-            ids = ", ".join(f"`{u['id']}`" + (f" (+ {len(u['members'])})" if u["members"] else "") for u in untested)
-            lines += [f"Not testable here ({len(untested)}): {ids}; why: the full rows below.", ""]
+            ids = ", ".join(f"`{u['id']}`" for u in untested)
+            lines += [f"Not testable here: {ids}.", ""]
     apart = Counter(c["kind"] for c in registry if c["paper"] == paper and c["kind"] != "method result")
     if apart:
-        lines += ["Counted apart (the lists below): " + ", ".join(
-            f"{apart[k]} {t.lower()}" for k, t in LISTS if apart[k]) + ".", ""]
-    found = [f for f in findings.get(paper, [])]
-    if found:
-        lines += ["The findings that matter:", ""]
-        for k, f in enumerate(found, 1):
-            lead = rows.get(f["claims"][0])
-            state = f" (`{lead['id']}`: {cell(lead['verdict'])}, {lead['robustness']})" if lead is not None else ""
-            lines.append(f"{k}. **{cell(f['title'])}**{state}. {cell(f['text'])} "
-                         f"Figure: [`{f['figure']}`](../{f['figure']}).")
-        lines.append("")
+        lines += ["Apart (below): " + ", ".join(f"{apart[k]} {t.lower()}" for k, t in LISTS if apart[k]) + ".", ""]
     return lines
 
 
@@ -227,47 +234,55 @@ def post_hoc(registry):
 
 
 def opening(df, registry):
-    """The first paragraph of the claims part: what the first screen holds, and exactly which tolerances were
-    chosen after their measured values had been printed."""
+    """The claims part's first paragraph (short: the first screens follow): what a verdict is judged on, what robust
+    means, where the full rows and the post-hoc tolerances are."""
     marked = post_hoc(registry)
-    testable = sum(1 for c in registry if c.get("testable"))
-    ids = ", ".join(f"`{i}` ({c})" for i, c, _, _ in marked)
     return [
-        "Every claim is a row of the claims registry (`config/claims/<paper>.yaml`: the quote, its kind, the quantity, "
-        "the tolerance with its derivation, the runs, the inferred inputs it rests on); the claims rule measures it on "
-        "the run files and computes its verdict (`isaflow.claims.verdict`): `reproduced`, `reproduced only after "
-        "calibrating <input>` (an input was chosen to match that very number), `not reproduced`, `not testable here`. "
-        "A verdict is **robust** when it holds at both ends of every inferred input it rests on, **fragile** when a "
-        "value of an input's range flips it (the input and the values are named); the evidence is in the full rows "
-        "(`results/claims/registry/<paper>.csv`, column `robustness_evidence`), and "
-        "[`figures/claims_robustness.png`](../figures/claims_robustness.png) draws where each fragile method result "
-        "flips. Rows decided by this project's own choices are deviations of this project, listed apart and never "
-        "scored against a paper; where the paper's version could be run the claim is judged on it.",
-        "",
-        f"**Tolerances.** Of the {testable} testable rows' tolerances, {len(marked)} were chosen after the measured "
-        "value had been printed and are marked post hoc in their rows (with the commit that set them): "
-        f"{ids or 'none'}. Every other tolerance was derived from the sentence quoted (its wording or printed "
-        "precision) and the discretisation, physics, statistics or round-off named in its `source` field.",
-        "",
-        SURFACE,
+        "Each claim is a row of `config/claims/<paper>.yaml` (quote, kind, checks, tolerance with its derivation), "
+        "judged from run files by one judge (`isaflow.judge`) on **the paper's own version** (its stated inputs, update "
+        "and stop rule); the project's calibrated or completed runs are shown beside it (columns `kept_verdict`, "
+        "`kept_measured`). **Robust**: the verdict holds at every value of each inferred input that is a reading of the "
+        f"sentence (runs, not arguments); **fragile**: one flips it. {len(marked)} tolerances were set after their value "
+        "was seen (marked post hoc; the closing note lists them). Full rows: `results/claims/registry/<paper>.csv`.",
         "",
     ]
 
 
-def closing(df, registry, figures=None):
-    """The closing note: every verdict changed by issue 31 and why, every post-hoc tolerance, the figures viewed."""
-    rows = _rows(df)
-    out = ["## Closing note: verdicts changed, tolerances set after the fact, figures viewed", ""]
-    changed = [c for c in registry if "changed" in c]
-    out += [f"**Verdicts changed ({len(changed)}).** Each row's verdict at the commit named and now (computed by "
-            "this run), and why:", ""]
-    for c in changed:
-        ch = c["changed"]
-        now = rows[c["id"]]["verdict"] if c["id"] in rows else "not judged"
-        out.append(f"- `{c['id']}` ({c['kind']}): was **{cell(ch['was'])}** ({ch['commit']}), now **{cell(now)}**. "
-                   f"{cell(ch['why'])}")
+def changes(df, registry, baseline):
+    """[(id, was, now, why)]: every row whose kind, verdict class or robustness differs from the baseline table (the
+    verdicts at the commit the baseline names, docs/tables/claims_baseline.csv), new rows, and rows gone, with the
+    reason its registry row gives (``changed.why``; '' when it gives none: a change no one explained)."""
+    if baseline is None:
+        return []
+    by = {c["id"]: c for c in registry}
+    base = {r["id"]: r for _, r in baseline.iterrows()}
+    out = []
+    for _, r in df.iterrows():
+        now = f"{verdict_class(r['verdict'])}; {r['kind']}; {r['robustness']}"
+        b = base.get(r["id"])
+        was = "new row" if b is None else f"{verdict_class(b['verdict'])}; {b['kind']}; {b['robustness']}"
+        if was != now:
+            out.append((r["id"], was, now, by.get(r["id"], {}).get("changed", {}).get("why", "")))
+    out += [(k, f"{verdict_class(b['verdict'])}; {b['kind']}; {b['robustness']}", "removed", "")
+            for k, b in base.items() if k not in set(df["id"])]
+    return out
+
+
+def closing(df, registry, figures=None, baseline=None):
+    """The closing note: every verdict, kind or robustness changed since the baseline and why, every post-hoc
+    tolerance, which rows are judged at the paper's version and which cannot be, the figures viewed."""
+    out = ["## Closing note: what changed, tolerances set after the fact, figures viewed", ""]
+    ch = changes(df, registry, baseline)
+    since = baseline["commit"].iloc[0] if baseline is not None and "commit" in baseline else "the baseline"
+    out += [f"**Changed since {since} ({len(ch)}: verdict; kind; robustness).**", ""]
+    out += [f"- `{i}`: was {cell(w)}, now **{cell(n)}**. " + (cell(why) if why else "**unexplained**")
+            for i, w, n, why in ch]
+    paper = df[df["judged_on"].astype(str).str.startswith("the paper's version")] if "judged_on" in df else df[:0]
+    out += ["", f"**Judged at the paper's version ({len(paper)} rows)**: "
+            + ", ".join(f"`{i}`" for i in paper["id"]) + ". The other rows read runs no input of the paper changes, or "
+            "this project's own runs (deviations and checks, `judged_on: kept`).", ""]
     marked = post_hoc(registry)
-    out += ["", f"**Tolerances marked post hoc ({len(marked)}).**", ""]
+    out += [f"**Tolerances marked post hoc ({len(marked)}).**", ""]
     out += [f"- `{i}` ({commit}): seen {cell(seen)}" + (f"; {cell(note)}" if note else "") for i, commit, seen, note
             in marked]
     if figures:

@@ -207,6 +207,19 @@ use rule call as isa_fig_flow_history with:
         "logs/isa/figures/flow_history.log",
 
 
+# the paper's coarse flow as an animation: the stored states of its flow runs (the chain without its single vessel)
+use rule call as isa_flow_animation with:
+    input:
+        runs=[isa_file(r) for r in FLOW["chains"]["coarse"][1:]],
+        code=code("figures.animation"),
+    output:
+        "figures/isa_flow_animation.gif",
+    params:
+        func="figures.animation.flow_animation",
+    log:
+        "logs/isa/figures/flow_animation.log",
+
+
 use rule call as isa_table1 with:
     input:
         runs=[isa_file(r) for r in TABLE1_RUNS],
@@ -444,6 +457,8 @@ PAPER_TARGETS = [f for name in ("fig05_inputs_coarse", "fig06_single_coarse", "f
 rule paper:
     input:
         with_report_copies(PAPER_TARGETS),
+        # the paper's claims, judged from the runs its rows read (claims.smk, one job per paper)
+        "results/claims/registry/papadopoulos2016.csv",
 
 
 # the smallest target set CI runs (.tests/integration/config.yaml): the paper's coarse Figures 5, 6, 9 and 10
@@ -463,7 +478,8 @@ register(targets=PAPER_TARGETS + figure("calibration_free_surface") + figure("co
          + figure("flow_history") + figure("error_vs_runtime") + figure("error_vs_work") + figure("stability_map")
          + figure("isa_overdamped") + [f for n in _FIG10_SWEEPS for f in figure(f"fig10_{n}")]
          + ["results/isa/study/fire_ratio.csv", "results/isa/metrics.csv"])
+register(targets=["figures/isa_flow_animation.gif"])
 register(report=["results/report/10_single.md", "results/report/20_flow.md", "results/report/30_study.md"])
 # the paper's claims are judged by the shared claims rule (claims.smk) from config/claims/papadopoulos2016.yaml
-# and methods.isa.claims: results/claims/registry/papadopoulos2016.csv
+# and the quantities of methods.isa.quantities: results/claims/registry/papadopoulos2016.csv
 register(bench=["results/bench/10_isa.md"])

@@ -1,7 +1,7 @@
 # MPS with three pressure source terms (Hattori et al.'s eq. 6 against the standard and mixed ones): its
 # runs (config/methods/mps.yaml runs: single vessel, both flow tanks, stiff cases, time-step study) go
 # through the shared rule `run`; here the summary, figures, report fragment 55 and timing fragment (the claims:
-# claims.smk, measures in methods/mps/claims.py).
+# claims.smk, quantities in methods/mps/quantities.py).
 # Package: src/isaflow/methods/mps/.
 _MPS_RUNS = RUNS["mps"]  # its settings file's runs (common.smk)
 MPS_FILES = [run_file("mps", r) for r in _MPS_RUNS]
@@ -71,6 +71,19 @@ use rule call as mps_figure_flow with:
         "logs/mps/figure_flow.log",
 
 
+# the standard source term's flow at the finer spacing as an animation (its stored states)
+use rule call as mps_flow_animation with:
+    input:
+        runs=[run_file("mps", "flow_standard_dx3.45")],
+        code=code("figures.animation"),
+    output:
+        "figures/mps_flow_animation.gif",
+    params:
+        func="figures.animation.flow_animation",
+    log:
+        "logs/mps/figure_flow_animation.log",
+
+
 rule mps_bench:
     input:
         script="benchmarks/bench_mps.py",
@@ -108,7 +121,7 @@ use rule call as mps_report with:
 
 
 register(MPS_FILES + ["results/mps/summary.csv"] + figure("mps_wall_loads") + figure("mps_flow") + figure("mps_rest")
-         + figure("mps_column"),
+         + figure("mps_column") + ["figures/mps_flow_animation.gif"],
          ["results/report/55_mps.md"], timing=["results/timing/55_mps.md"])
 
 

@@ -27,14 +27,18 @@ SOLID_FIGURES = SOLID_FIGURES_41_43 + SOLID_FIGURES_44
 # runs the claims registry asks for (config/claims/marko2017.yaml): the 4.3 plate under disks of the other
 # stated radii, stepped by eq. 27 undamped (capped by eq. 26 and not), the 4.1 bar held in sustained tension
 # (the strain x step sweep of input tension_test_setup), the 4.4 vessel with water under the printed solid model
-# (the project's mirror-pressure coupling, and the paper's stop-at-the-boundary coupling: vessel_water_stop_paper)
+# (the project's mirror-pressure coupling, and the paper's stop-at-the-boundary coupling: vessel_water_stop_paper, also
+# with the other waters of input vessel_water), the printed bar with axial-only grips, the printed plate at the other
+# depths
 SOLID_CLAIM_RUN_IDS = ["hertz_R50.8mm_paper", "hertz_R127mm_paper", "hertz_R20m_paper", "hertz_R50m_paper",
                        "hertz_eq27_paper", "hertz_eq27_hooke", "hertz_eq27_uncapped_paper", "bar_tension_long_paper",
                        "bar_tension_long_e0.1_dt0.1_paper", "bar_tension_long_e0.1_dt0.25_paper",
                        "bar_tension_long_e0.1_dt0.5_paper", "bar_tension_long_e1_dt0.1_paper",
                        "bar_tension_long_e1_dt0.5_paper", "bar_tension_long_e5_dt0.1_paper",
                        "bar_tension_long_e5_dt0.25_paper", "bar_tension_long_e5_dt0.5_paper",
-                       "vessel_water_particles_paper", "vessel_water_stop_paper"]
+                       "vessel_water_particles_paper", "vessel_water_stop_paper", "vessel_water_stop_h1_paper",
+                       "vessel_water_stop_h1.5_paper", "vessel_water_stop_a0_paper", "vessel_water_stop_a0.1_paper",
+                       "bar_tension_sliding_paper", "bar_compression_sliding_paper", "hertz_loadsteps_paper"]
 
 
 # the list above is what the settings give (hertz.scale_radii_mm, the bar_long sweep): refuse the rule file otherwise
@@ -130,6 +134,7 @@ use rule call as solid_report with:
     input:
         runs=SOLID_RUNS + SOLID_NEW_RUNS + SOLID_CLAIM_RUNS,
         claims="results/claims/registry/marko2017.csv",
+        registry=sorted(glob.glob("config/claims/*.yaml")),
         code=code("methods/solid/report"),
     output:
         "results/report/65_solid.md",
@@ -138,6 +143,32 @@ use rule call as solid_report with:
         func="methods.solid.report.report",
     log:
         "logs/solid/report.log",
+
+
+# the solid's step cost against its floor (the same per-link arithmetic fused in one loop) and the coupled
+# vessel's step cost: target `benchmarks`, not the full run
+rule solid_bench:
+    input:
+        script="benchmarks/bench_solid.py",
+        cfg=SOLID_CFG,
+        code=code("methods/solid/*"),
+    output:
+        "benchmarks/results/solid_step_cost.csv",
+    message:
+        JOB
+    resources:
+        **BENCH,
+    log:
+        "logs/solid/bench.log",
+    conda:
+        "../../envs/isaflow.yaml"
+    params:
+        src=os.path.join(workflow.basedir, "src"),  # this checkout's source (no install needed)
+    shell:
+        "PYTHONPATH={params.src} python {input.script} > {log} 2>&1"
+
+
+register(bench=["benchmarks/results/solid_step_cost.csv"])
 
 
 # the solid runs the claims read (claims.smk): 'solid:<case>_<variant>'

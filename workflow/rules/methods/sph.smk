@@ -36,6 +36,22 @@ use rule call as sph_figures with:
         "logs/sph/figures.log",
 
 
+# the finest flow into the stepped second vessel as an animation (its stored states)
+SPH_ANIMATED = run_file("sph", "flow_wcsph_dx2.5")
+
+
+use rule call as sph_flow_animation with:
+    input:
+        runs=[SPH_ANIMATED],
+        code=code("figures.animation"),
+    output:
+        "figures/sph_flow_animation.gif",
+    params:
+        func="figures.animation.flow_animation",
+    log:
+        "logs/sph/flow_animation.log",
+
+
 use rule call as sph_report with:
     input:
         summary="results/sph/summary.csv",
@@ -70,6 +86,6 @@ rule sph_bench:
         "PYTHONPATH={params.src} python {input.script} > {log} 2>&1"
 
 
-register(SPH_FILES + ["results/sph/summary.csv"] + SPH_FIGURES,
+register(SPH_FILES + ["results/sph/summary.csv"] + SPH_FIGURES + ["figures/sph_flow_animation.gif"],
          ["results/report/50_sph.md"], timing=["results/timing/50_sph.md"])
 register(bench=["benchmarks/results/sph_step_cost.csv"])

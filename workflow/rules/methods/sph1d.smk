@@ -27,8 +27,8 @@ use rule call as sph1d_sweep with:
 
 
 # the sweep at other values of two registry inputs (config/methods/sph1d.yaml resolutions; sensitivity only):
-# n_window (to N = 8192) and surface_placement (the top particle on the surface)
-for _res in ("n8192", "surface_top"):
+# n_window (to N = 8192), surface_placement (the top particle on the surface) and kernel_form (the 1D Wendland functions)
+for _res in ("n8192", "surface_top", "wendland_1d"):
 
     rule:
         name:

@@ -15,8 +15,8 @@ import numpy as np
 from ...budget import gb as _gb
 from ...budget import memory_limit
 from ...inputs import InputError
-from ...plausible import extreme
-from .checks import BYTES_PER_PARTICLE, BYTES_PER_RECORD, check_grid, particle_count, particles_field  # noqa: F401
+from ...plausible import extreme, where
+from .checks import BYTES_PER_PARTICLE, BYTES_PER_RECORD, BYTES_PER_SNAPSHOT_PARTICLE, check_grid, particle_count, particles_field  # noqa: F401
 from .settings import settings
 
 BYTES_PER_PAIR = 12  # int32 neighbour entry with its doubling growth
@@ -47,7 +47,8 @@ def check_settings(scene):
 
 
 def _refuse(scene, field, need, limit, what):
-    raise InputError(f"{scene.path}: field '{field}': the run needs about {_gb(need)} of memory ({what}); "
+    """field: a settings key, or (file, field) of another file (a start file's variable)."""
+    raise InputError(f"{where(scene.path, field)}: the run needs about {_gb(need)} of memory ({what}); "
                      f"{_gb(limit)} available")
 
 
@@ -58,18 +59,19 @@ def _fixed_bytes(scene, n):
     steps = s["max_steps"]
     chunks = steps // s["chunk"] + 2
     records = steps // hist["every"] + chunks if hist.get("every") else 0
-    snaps = min(hist.get("snapshots", 0), chunks)
+    snaps = s["snapshot_megabytes"] * 1e6 + 3 * n * BYTES_PER_SNAPSHOT_PARTICLE
     samples = chunks * (len(scene.walls) * 48 + len(scene.spec.get("vessels", [])) * 24 + 64) \
         if hist.get("walls") or hist.get("vessels") else 0
     parts = [(records * BYTES_PER_RECORD, "solver.history.every", f"{records:.3g} max|F| records"),
-             (snaps * n * 32, "solver.history.snapshots", f"{snaps} snapshots of {n} particles"),
+             (snaps, "solver.snapshot_megabytes", f"{snaps / 1e6:.3g} MB of snapshots of {n} particles"),
              (samples, "solver.chunk", f"{chunks:.3g} chunk-end samples"),
              (s["chunk"] * 8, "solver.chunk", f"a chunk buffer of {s['chunk']:.3g} steps")]
     return parts
 
 
 def check_count(scene, n, field):
-    """Refuse a particle count (before the particles exist) whose run cannot fit in memory."""
+    """Refuse a particle count (before the particles exist) whose run cannot fit in memory; field: where the count
+    comes from (a settings key, or (start file, 'pos'))."""
     limit = memory_limit()
     parts = [(n * BYTES_PER_PARTICLE, field, f"{n:.3g} particles")] + _fixed_bytes(scene, n)
     need = sum(p[0] for p in parts)
@@ -98,8 +100,10 @@ def pair_bound(pos, box, rc):
     return total
 
 
-def check_memory(scene, pos):
-    """Refuse a run whose particles, pairs, grid and records cannot fit in memory (pos (N, 2) cm)."""
+def check_memory(scene, pos, field=None):
+    """Refuse a run whose particles, pairs, grid and records cannot fit in memory (pos (N, 2) cm); field: where the
+    particles come from (default the settings' particles.points or particles.lattice; (file, 'pos') of a start
+    file)."""
     s = settings(scene)
     walls = scene.walls
     lo, hi = walls.reshape(-1, 2).min(0), walls.reshape(-1, 2).max(0)
@@ -107,7 +111,7 @@ def check_memory(scene, pos):
     cells = check_grid(scene.path, walls.tolist(), rc, "walls")  # the scene's walls: its settings file's copy
     n = len(pos)
     pairs = pair_bound(pos, np.array([lo[0], lo[1], hi[0], hi[1]]), rc)
-    field = particles_field(scene.spec["particles"])
+    field = field or particles_field(scene.spec["particles"])
     parts = [(n * BYTES_PER_PARTICLE, field, f"{n} particles"),
              (pairs * BYTES_PER_PAIR, field, f"up to {pairs:.3g} neighbour pairs"),
              (cells * 4, "forces.pair.l_u", f"{cells:.3g} grid cells")] + _fixed_bytes(scene, n)

@@ -18,6 +18,7 @@ from .settings import SKIN_FRACTION
 NS_PER_PARTICLE_STEP = 20.0  # fastest measured relax step (benchmarks/), rounded down
 BYTES_PER_PARTICLE = 640  # solver + compiled loop + contacts + the run file's copy (measured order, rounded up)
 MAX_GRID_CELLS = 10**9  # cells of the neighbour grid (int32 cell starts)
+BYTES_PER_SNAPSHOT_PARTICLE = 26  # a particle in a snapshot (driver.drive): position, force, vessel, status
 BYTES_PER_RECORD = 4 * 56  # hist_fmax/lo/hi/step records held as Python lists, then arrays
 DU = "a step moves a particle by du; longer than half the pair range l_pu it can carry a particle through its " \
      "neighbour's whole repulsion (the paper: du = 0.01 cm against l_pu = 7.07 cm)"
@@ -28,14 +29,26 @@ def particles_field(part):
     return "particles.points" if part.get("points") is not None else "particles.lattice"
 
 
-def particle_count(part):
-    """Particles a lattice or points block will create, without creating them."""
+def particle_count(part, tank=None):
+    """Particles a lattice or points block will create, without creating them; a lattice of rows null fills the
+    tank's first vessel with its weight in particles of particles.weight (scene.vessel_fill)."""
     if part.get("points"):
         return len(part["points"])
+    if part.get("fill"):
+        return part["fill"]["count"]
     lat = part["lattice"]
+    if lat["rows"] is None:
+        return fill_count(tank.weight, part["weight"])
     rows, lengths = lat["rows"], lat["row_lengths"]
     full, rest = divmod(rows, len(lengths))
     return full * sum(lengths) + sum(lengths[:rest])
+
+
+def fill_count(weight, w):
+    """Particles of about w [N] that hold a liquid of weight [N]: round(weight / w), at least one (a count that
+    overflows: inf)."""
+    n = weight / w
+    return max(1, round(n)) if math.isfinite(n) else n
 
 
 def lattice_corners(lat):
@@ -65,7 +78,7 @@ def plausible(tank, s, stability=False):
     part = s.tree("particles")
     if part.get("points") is not None:
         check_points(s.path, "particles.points", part["points"], tank.walls_list())
-    else:
+    elif part["lattice"]["rows"] is not None:  # rows null: the lattice fills the vessel (scene.vessel_fill)
         check_points(s.path, "particles.lattice", lattice_corners(part["lattice"]), tank.walls_list(),
                      "lattice corner(s)")
     within(s.path, "solver.du", s["solver.du"], None, s["forces.pair.l_u"] / 2, DU, stability=stability)
@@ -84,14 +97,14 @@ def plausible(tank, s, stability=False):
 def cost(tank, s, particles=None):
     """budget.Cost of a run: the lattice or points (or a start file's `particles`), max_steps steps."""
     part = s.tree("particles")
-    n = particle_count(part) if particles is None else particles
+    n = particle_count(part, tank) if particles is None else particles
     steps = s["solver.max_steps"]
     hist = s["solver.history"] or {}
     records = steps / hist["every"] if hist.get("every") else 0
-    snaps = hist.get("snapshots", 0) * n * 32
+    snaps = s["solver.snapshot_megabytes"] * 1e6 + 3 * n * BYTES_PER_SNAPSHOT_PARTICLE
     nbytes = n * BYTES_PER_PARTICLE + records * BYTES_PER_RECORD + snaps
     big = max((n * BYTES_PER_PARTICLE, particles_field(part)), (records * BYTES_PER_RECORD, "solver.history.every"),
-              (snaps, "solver.history.snapshots"))
+              (snaps, "solver.snapshot_megabytes"))
     return [budget.Cost(n, steps, nbytes, NS_PER_PARTICLE_STEP,
                         {"particles": particles_field(part), "steps": "solver.max_steps", "bytes": big[1]},
                         f"max_steps = {steps:.3g}")]

@@ -61,9 +61,8 @@ def solve(tank, settings, variant, resolution, start=None, progress=None, thread
         pos0, weight, start_step, spacing, state = st["pos"], st["weight"], st["steps"], st["spacing"], st["state"]
         pitch, held, depth, diff = st["chain"]
         extra = dict(restart=st["restart"], start_sha256=st["sha256"], start_step=st["steps"])
-    report = (lambda step, fmax: progress(step, "max|F|", fmax, "N")) if progress else None
-    result = solver.solve(scene, pos0, weight, start_step=start_step, progress=report, state=state,
-                          rest_depth=tank.depth, threads=threads)
+    result = solver.solve(scene, pos0, weight, start_step=start_step, progress=progress.log if progress else None,
+                          state=state, rest_depth=tank.depth, threads=threads)
     result.spacing = spacing
     result.params.update(layer_pitch=pitch, held_weight=held, initial_depth=depth, tank_difference=diff, **extra)
     return result

@@ -11,6 +11,8 @@ du = w / (10 k_p)); stiffness as factors of both force laws' r_u.  Pure Python
 import math
 
 from ... import settings as S
+from ... import tank as T
+from ...inputs import InputError, not_a_file
 from .settings import RULES, VALUES, fire_dt_max
 
 VARIANTS = tuple(RULES)
@@ -52,6 +54,7 @@ def plan(study, spec):
     fire_tuning ``ft_{lattice}_du{f}_dt{g}``, stability_map
     ``sm_{variant}_k{s}_du{f}``, cases ``sc_{case}_{variant}``.
     """
+    check_names(study, spec)
     out = {}
     acc = list(study["accept"])
     lat = study["lattices"]
@@ -61,7 +64,8 @@ def plan(study, spec):
 
     def add(sid, tank, variant, resolution, sets, **meta):
         if sid in out:
-            raise ValueError(f"study run '{sid}' is planned twice")
+            raise InputError(f"field 'study.{meta['group']}': run '{sid}' is planned twice (a value given twice, or "
+                             f"two entries planning the same point)")
         out[sid] = dict(tank=tank, variant=variant, resolution=resolution, set=sets, accept=acc,
                         stability=True, meta=dict(variant=variant, **meta))
         if meta.get("lattice") not in own.get("lattices", ()) and meta.get("case") not in own.get("cases", ()):
@@ -97,15 +101,61 @@ def plan(study, spec):
                     group="stability_map", lattice=sm["lattice"], du_factor=f, k_factor=s)
     cs = study["cases"]
     for case, c in cs["list"].items():
-        extra = list(c.get("set", []))
-        cv = resolution_values(spec, c["resolution"], extra)  # stiffness after the case's own overrides
+        extra_sets = case_sets(case, c.get("set", []))
+        cv = resolution_values(spec, c["resolution"], extra_sets)  # stiffness after the case's own overrides
         base = resolution_values(spec, c["resolution"])
-        extra_sets = dict(S._parse(item, SETTINGS, f"study case '{case}'") for item in extra)
         for var in c.get("variants", VARIANTS):
             f = cs["du_factors"].get(var, 1.0)
             sets = solver_sets(var, f * base["du"], cs["max_steps"], cv["kb"], cv["kp"], study["fire_dt_factor"])
             add(f"sc_{case}_{var}", c["tank"], var, c["resolution"], {**sets, **extra_sets},
                 group="cases", case=case, note=c["note"], du_factor=f)
+    return out
+
+
+def check_names(study, spec):
+    """Refuse a study whose names point at nothing, naming the study file's field (the workflow puts the file's
+    name before it): a lattice no ``lattices`` entry defines, a resolution config/methods/isa.yaml (spec) has not, a
+    case without a tank file, an ``own_jobs`` name of nothing.  A name the plan did not find was a KeyError, or a
+    refusal naming config/methods/isa.yaml's field or a generated run's."""
+    lat, cases = study["lattices"], study["cases"]["list"]
+    resolutions = spec.get("resolutions", {})
+
+    def need(ok, field, what, choices):
+        if not ok:
+            raise InputError(f"field '{field}': {what} (choose from {', '.join(choices)})")
+
+    for name, v in lat.items():
+        need(v["resolution"] in resolutions, f"study.lattices.value.{name}.resolution",
+             f"config/methods/isa.yaml has no resolution '{v['resolution']}'", resolutions)
+    uses = [(f"study.error_runtime.value.blocks.{k}.lattices", b["lattices"])
+            for k, b in enumerate(study["error_runtime"]["blocks"])]
+    uses += [("study.fire_tuning.value.lattices", study["fire_tuning"]["lattices"]),
+             ("study.stability_map.value.lattice", [study["stability_map"]["lattice"]]),
+             ("study.own_jobs.value.lattices", study.get("own_jobs", {}).get("lattices", []))]
+    for field, names in uses:
+        for name in names:
+            need(name in lat, field, f"no lattice '{name}' in study.lattices", lat)
+    for name in study.get("own_jobs", {}).get("cases", []):
+        need(name in cases, "study.own_jobs.value.cases", f"no case '{name}' in study.cases", cases)
+    for case, c in cases.items():
+        need(c["resolution"] in resolutions, f"study.cases.value.list.{case}.resolution",
+             f"config/methods/isa.yaml has no resolution '{c['resolution']}'", resolutions)
+        kind = not_a_file(T.path_of(c["tank"]))
+        if kind:
+            raise InputError(f"field 'study.cases.value.list.{case}.tank': no tank '{c['tank']}' "
+                             f"({T.path_of(c['tank'])}: {kind})")
+
+
+def case_sets(case, items):
+    """{key: {value, source}} of a study case's ``set`` strings ('key=value'), each checked against the ISA values;
+    an error names the study file's field (``field 'study.cases.value.list.<case>.set.<k>'``; the workflow puts
+    the file's name before it)."""
+    out = {}
+    for k, item in enumerate(items):
+        where = f"field 'study.cases.value.list.{case}.set.{k}'"
+        key, leaf = S._parse(item, where, "override", source=f"study plan: case '{case}' of the study's cases")
+        S.apply(S.Settings({}, {}, where, {}), {key: leaf}, VALUES, where)
+        out[key] = leaf
     return out
 
 

@@ -1,9 +1,10 @@
-"""Continuing a run from its run file (``particles.from_run``): checks and the solver's restart state.
+"""Continuing a run from its run file (a start file: ``--start``, a declaration's ``start``; the scene's
+``particles.from_run``): checks and the solver's restart state.
 
-A start file is refused (SceneError naming the scene file and the field)
-unless it is a complete ISA run file whose particles fit this scene; its
-solver state (solver.STATE_VARS) is restored when it was made under the same
-dynamics, so the continued run repeats the uninterrupted one bit for bit.
+A start file is refused (one line: ``--start: '<file>' ...``, or ``<file>: field '<variable>'`` for a
+variable of it that is wrong, or the settings field it conflicts with) unless it is a complete ISA run
+file whose particles fit this scene; its solver state (solver.STATE_VARS) is restored when it was made
+under the same dynamics, so the continued run repeats the uninterrupted one bit for bit.
 """
 
 import numpy as np
@@ -24,34 +25,32 @@ def start_file(scene):
     numbers, chunk), so the continued run repeats the uninterrupted one bit
     for bit; otherwise, and for the newton_lm variant, None (positions only: a new problem started from a
     previous state, e.g. application 3 from application 1), and restart
-    says why.  Refused (SceneError naming 'particles.from_run' or the
-    conflicting field): missing, a directory or other non-regular file, not
-    netCDF, an incomplete write, not an ISA run, missing or malformed
-    variables, non-finite or escaped states, particles outside this scene's
+    says why.  Refused (SceneError naming the start file and its variable, or the conflicting settings
+    field): missing, a directory or other non-regular file, not netCDF, an incomplete write, not an ISA
+    run, missing or malformed variables, non-finite or escaped states, particles outside this scene's
     walls, another particle weight, or a step at or past solver.max_steps.
     """
 
-    field = "start"
     src = scene.spec["particles"]["from_run"]
-    where = f"{scene.path}: field '{field}'"
+    where = "--start"  # the file as a whole; a variable of it is named as (file, variable)
     try:
         ds = runfile.open_run(src)
     except runfile.RunFileError as err:
         raise SceneError(f"{where}: {err}") from None
     try:
         with ds:
-            pos, weight, steps, spacing, state = _read_start(scene, ds, src, where, field)
+            pos, weight, steps, spacing, state = _read_start(scene, ds, src, where)
             chain = _chain(ds, spacing, weight)
     except SceneError:
         raise
     except (OSError, RuntimeError, ValueError, TypeError, KeyError, IndexError) as err:
         raise SceneError(f"{where}: '{src}' cannot be read as a run file ({type(err).__name__})") from None
     if not np.issubdtype(steps.dtype, np.integer) or not 0 <= int(steps) < 2**62:
-        raise SceneError(f"{where}: '{src}' has no valid step count")
+        raise SceneError(f"{src}: field 'steps': the start file has no valid step count")
     steps = int(steps)
-    check_positions(scene.path, field, pos, scene.walls)
+    check_positions(src, "pos", pos, scene.walls)  # the start file's own positions
     if not (np.isfinite(weight).all() and (weight > 0).all()):
-        raise SceneError(f"{where}: '{src}' has non-finite or non-positive particle weights")
+        raise SceneError(f"{src}: field 'weight': the start file has non-finite or non-positive particle weights")
     w = float(scene.spec["particles"]["weight"])
     if not np.all(weight == w):
         raise SceneError(f"{scene.path}: field 'particles.weight': {w:g} N, but the particles of '{src}' weigh "
@@ -60,7 +59,7 @@ def start_file(scene):
     if steps >= max_steps:
         raise SceneError(f"{scene.path}: field 'solver.max_steps': {max_steps} steps, but '{src}' is already at "
                          f"step {steps} (counted from the chain's start): nothing to do")
-    budget.check_memory(scene, pos)
+    budget.check_memory(scene, pos, (src, "pos"))
     state, restart = state
     return dict(pos=pos, weight=weight, steps=steps, spacing=spacing, path=src, sha256=runfile.sha256(src),
                 state=state, restart=restart, chain=chain)
@@ -76,7 +75,7 @@ def _chain(ds, spacing, weight):
         return spacing / 2, float(np.sum(weight)), float("nan"), "continued run"
 
 
-def _read_start(scene, ds, src, where, field):
+def _read_start(scene, ds, src, where):
     """(pos, weight, steps, spacing, (state, why)) of an open start file, shapes checked before loading."""
     problem = runfile.start_problem(ds, src, "isa", unusable=())  # the method first, the outcome after the shapes
     if problem:
@@ -88,7 +87,7 @@ def _read_start(scene, ds, src, where, field):
     n = ds.sizes["particle"]
     if ds.sizes["xy"] != 2 or n == 0:
         raise SceneError(f"{where}: '{src}' holds no particles in 2D")
-    budget.check_count(scene, n, field)
+    budget.check_count(scene, n, (src, "pos"))
     problem = runfile.start_problem(ds, src, "isa")
     if problem:
         raise SceneError(f"{where}: {problem}")
@@ -99,7 +98,7 @@ def _read_start(scene, ds, src, where, field):
         spacing = float(ds.attrs.get("spacing", np.nan))
     except (TypeError, ValueError):
         spacing = np.nan
-    return pos, weight, steps, spacing, _restart_state(scene, ds, n, where)
+    return pos, weight, steps, spacing, _restart_state(scene, ds, n, src)
 
 
 DYNAMICS = ("du", "f_tol", "f_ref", "dt_max", "skin", "chunk", "wall_l_u", "wall_r_u", "pair_l_u", "pair_r_u",
@@ -108,7 +107,7 @@ OVERDAMPED_DYNAMICS = ("zeta", "lambda_max", "dt")
 LAW_DEFAULT = 1.0  # the law exponent of run files written before the law option (all linear)
 
 
-def _restart_state(scene, ds, n, where):
+def _restart_state(scene, ds, n, src):
     """(state or None, why) of an open run file: its solver state if its dynamics equal this scene's."""
     s = settings(scene)
     differ = ["variant"] if ds.attrs.get("variant") != s["variant"] else []
@@ -136,6 +135,7 @@ def _restart_state(scene, ds, n, where):
         ok = ok and (dims != ("cycle_window",) or ds[name].size <= 10**6)
         v = np.asarray(ds[name].values, float) if ok else None
         if not ok or not np.isfinite(v).all():
-            raise SceneError(f"{where}: the run file's solver state '{name}' is missing, malformed or not finite")
+            raise SceneError(f"{src}: field '{name}': the start file's solver state is missing, malformed or not "
+                             f"finite")
         state[name] = v
     return state, "solver state restored (bit-identical continuation)"

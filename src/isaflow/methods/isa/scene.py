@@ -101,6 +101,44 @@ def square_lattice(a, rows, row_lengths, center_x, bottom_y):
     return np.concatenate(pts)
 
 
+def vessel_fill(fill, lattice, walls):
+    """(N, 2) positions [cm] of a lattice filling a vessel (rows null): the rhombic (or square) lattice of the
+    settings' a, centred on the vessel (fill['center_x']), its first row fill['clearance'] above the vessel's floor
+    and in phase with a first row of row_lengths[0] particles (odd: one on the centre), every site inside the
+    vessel's polygon at least fill['clearance'] (the wall law's range l_bu) from its edges and the walls
+    (core.geometry.inside_vessel); the lowest fill['count'] sites, row by row from the floor (the last row's
+    nearest the centre), ordered as rhombic_lattice orders them.  In the paper's vessel (100 cm, a = 10 cm, l_bu =
+    5 cm, 9000 N of 50 N particles) it is the paper's lattice: 19 rows of 9 and 10, 5 cm from every wall."""
+    from ...core.geometry import inside_vessel
+
+    a, square = float(lattice["a"]), lattice.get("kind", "rhombic") == "square"
+    pitch = a if square else a / 2
+    poly = np.asarray(fill["polygon"], float)
+    cx, c, need = float(fill["center_x"]), float(fill["clearance"]), int(fill["count"])
+    bottom_y = float(fill["floor_y"]) + c
+    half = max(abs(poly[:, 0].min() - cx), abs(poly[:, 0].max() - cx))
+    m = int(np.ceil(half / a)) + 1
+    odd = lattice["row_lengths"][0] % 2 == 1
+    rows, taken, r = [], 0, 0
+    while taken < need:
+        y = bottom_y + r * pitch
+        if y > poly[:, 1].max():
+            raise InputError(f"{fill['path']}: field 'particles.lattice.rows': null fills the first vessel with "
+                             f"{need} particles (the tank's weight over particles.weight), but only {taken} sites of "
+                             f"a = {a:g} cm lie {c:g} cm inside its walls (forces.wall.l_u) below their top")
+        n = 2 * m + 1 if odd == (square or r % 2 == 0) else 2 * m + 2
+        x = cx + (np.arange(n) - (n - 1) / 2) * a
+        pts = np.column_stack([x, np.full(n, bottom_y + r * pitch)])
+        pts = pts[inside_vessel(pts, poly, walls, c)]
+        if taken + len(pts) > need:  # the last row: its sites nearest the centre, in order along the row
+            keep = np.sort(np.argsort(np.abs(pts[:, 0] - cx), kind="stable")[: need - taken])
+            pts = pts[keep]
+        rows.append(pts)
+        taken += len(pts)
+        r += 1
+    return np.concatenate(rows)
+
+
 def layer_pitch(lattice):
     """Vertical pitch [cm] of a lattice's particle layers: a / 2 (rhombic), a (square)."""
     return float(lattice["a"]) if lattice.get("kind", "rhombic") == "square" else float(lattice["a"]) / 2
@@ -148,7 +186,10 @@ def initial_positions(scene):
     if "lattice" in part:
         lat = part["lattice"]
         build = square_lattice if lat.get("kind", "rhombic") == "square" else rhombic_lattice
-        pos = build(lat["a"], lat["rows"], lat["row_lengths"], lat["center_x"], lat["bottom_y"])
+        if "fill" in part:
+            pos = vessel_fill(part["fill"], lat, scene.walls)
+        else:
+            pos = build(lat["a"], lat["rows"], lat["row_lengths"], lat["center_x"], lat["bottom_y"])
         if lat.get("jitter", 0.0) > 0:  # a named alternative (disordered packing), not the paper's
             rng = np.random.default_rng(int(lat.get("seed", 0)))
             pos = pos + rng.uniform(-1.0, 1.0, pos.shape) * float(lat["jitter"]) * float(lat["a"])
@@ -172,6 +213,15 @@ def spec_of(tank, settings, variant, start=None):
         part["points"] = t["particles"]["points"]
     else:
         part["lattice"] = t["particles"]["lattice"]
+        if part["lattice"]["rows"] is None:  # fill the first vessel with the tank's weight (vessel_fill)
+            from .checks import fill_count
+
+            _, (x0, x1) = tank.vessels[0]
+            n = fill_count(tank.weight, part["weight"])
+            part["weight"] = tank.weight / n if n else part["weight"]
+            part["fill"] = {"count": n, "polygon": [list(p) for p in tank.vessel_polygon(0)],
+                            "floor_y": tank.floor_y(0), "center_x": 0.5 * (x0 + x1),
+                            "clearance": float(t["forces"]["wall"]["l_u"]), "path": settings.path}
     solver = {k: v for k, v in t["solver"].items() if v is not None}
     spec = {"name": tank.name, "description": tank.spec.get("description", ""),
             "walls": tank.spec["walls"], "particles": part, "forces": t["forces"],

@@ -24,15 +24,14 @@ _COUNT = {"type": "integer", "minimum": 1, "maximum": 2147483647}
 _LAW = {"enum": list(LAW_EXPONENT)}
 _HISTORY = {"type": "object", "additionalProperties": False, "properties": {
     "every": {"type": "integer", "minimum": 1, "maximum": 10**15},
-    "walls": {"type": "boolean"}, "vessels": {"type": "boolean"},
-    "snapshots": {"type": "integer", "minimum": 0, "maximum": 10**6}}}
+    "walls": {"type": "boolean"}, "vessels": {"type": "boolean"}}}
 # {dotted key: JSON schema of the value} of config/methods/isa.yaml
 VALUES = {
     "particles.weight": _POS,  # N per particle
     "particles.points": {"type": ["array", "null"], "minItems": 1, "items": {
         "type": "array", "items": {"type": "number"}, "minItems": 2, "maxItems": 2}},  # cm; null: the lattice
     "particles.lattice.a": _POS,  # cm, rhomb diagonal
-    "particles.lattice.rows": _COUNT,
+    "particles.lattice.rows": {"anyOf": [_COUNT, {"type": "null"}]},  # null: fill the first vessel (scene.vessel_fill)
     "particles.lattice.row_lengths": {"type": "array", "items": _COUNT, "minItems": 1, "maxItems": 2},
     "particles.lattice.center_x": {"type": "number"},  # cm
     "particles.lattice.bottom_y": {"type": "number"},  # cm
@@ -48,9 +47,21 @@ VALUES = {
     "solver.chunk": {"type": "integer", "minimum": 100, "maximum": 10**12},
     "solver.stop_on_cycle": {"type": "boolean"},
     "solver.history": _HISTORY,
+    # the stored states (driver.Recording): steps between snapshots in a single vessel and in a tank of vessels
+    "solver.snapshot_every_single": _COUNT, "solver.snapshot_every_flow": _COUNT,
+    "solver.snapshot_megabytes": _POS,  # 10^6 bytes the kept snapshots may take before they are thinned
     # the overdamped variant (dynamics.py): damping ratio zeta of the stiffest mode lambda_max [N/cm], time step [s]
     "solver.zeta": _POS, "solver.lambda_max": _POS, "solver.dt": _OPT_POS,
 }
+
+
+def own_tank(tank, settings):
+    """The overrides ('key=value') of a run on a tank no settings file was written for (isaflow compare): the
+    paper's lattice rows fit the paper's 100 cm vessel only; with rows null the resolution's lattice fills the
+    tank's first vessel with the tank's weight (scene.vessel_fill), in the paper's vessel the paper's lattice."""
+    return ("particles.lattice.rows=null",)
+
+
 # Defaults of the optional solver fields.  f_ref and dt_max depend on the
 # stiffness: both come from the Gershgorin bound lambda_max <= 2 k_b + 12 k_p
 # (two walls, six neighbours) of the stiffness matrix.
@@ -99,7 +110,7 @@ def settings(scene):
     """{name: value} of every solver setting of an ISA scene, defaults resolved.
 
     Keys: variant, du (cm), f_tol (N), max_steps, f_ref (N), dt_max (s),
-    skin (cm), chunk, stop_on_cycle, history, the force laws
+    skin (cm), chunk, stop_on_cycle, history, snapshot_every_single / _flow (steps) and snapshot_megabytes, the force laws
     wall_l_u, wall_r_u, pair_l_u, pair_r_u (cm, N) and their exponents wall_p,
     pair_p (LAW_EXPONENT), and the overdamped variant's zeta (1), lambda_max
     (N/cm), dt (s) and damping c = 2 zeta sqrt(m lambda_max) [N s/cm] of a
@@ -119,6 +130,8 @@ def settings(scene):
         dt_max=float(s.get("dt_max", fire_dt_max(k_wall, k_pair))),
         skin=float(s.get("skin", SKIN_FRACTION * pair_l_u)), chunk=int(s["chunk"]),
         stop_on_cycle=bool(s["stop_on_cycle"]), history=dict(s["history"]),
+        snapshot_every_single=int(s["snapshot_every_single"]), snapshot_every_flow=int(s["snapshot_every_flow"]),
+        snapshot_megabytes=float(s["snapshot_megabytes"]),
         wall_l_u=wall_l_u, wall_r_u=wall_r_u, pair_l_u=pair_l_u, pair_r_u=pair_r_u,
         wall_p=LAW_EXPONENT[scene.spec["forces"]["wall"]["law"]], pair_p=LAW_EXPONENT[scene.spec["forces"]["pair"]["law"]],
         zeta=zeta, lambda_max=lam, dt=dt, damping=2 * zeta * math.sqrt(weight / G * lam),

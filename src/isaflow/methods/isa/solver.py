@@ -14,7 +14,7 @@ from contextlib import contextmanager
 import numba
 import numpy as np
 
-from ... import driver, rest as REST
+from ... import at_rest as AT, driver, rest as REST
 from ...contract import Result, wall_resultants
 from ...core.geometry import bounding_box, outside_box
 from ...core.units import G
@@ -163,16 +163,15 @@ def warm_up(threads=1):
 
 class _History:
     """Records of max|F| (every ``every`` steps), wall resultants and vessel counts
-    (every chunk) and position snapshots, under their run-file names."""
+    (every chunk), under their run-file names (the driver keeps the snapshots)."""
 
     def __init__(self, hist, n_walls, vessels):
         self.every = hist.get("every", 0)
         self.walls = hist.get("walls", False)
         self.vessels = vessels if hist.get("vessels") and vessels else None
-        self.n_snap = hist.get("snapshots", 0)
         self.n_walls = n_walls
         self.rec = {k: [] for k in ("hist_step", "hist_fmax", "hist_fmax_lo", "hist_fmax_hi", "hist_energy",
-                                    "sample_step", "sample_wall_resultant", "sample_vessel_count", "snap_step", "snap_pos")}
+                                    "sample_step", "sample_wall_resultant", "sample_vessel_count")}
 
     def steps(self, step, h, origin, ke=None):
         """Record h (max|F| before steps step, step + 1, ...) in strides counted from step origin <= step;
@@ -186,7 +185,7 @@ class _History:
             if ke is not None:
                 self.rec["hist_energy"].append(ke[k0])
 
-    def chunk(self, step, pos, s, walls, snap):
+    def chunk(self, step, pos, s, walls):
         if self.walls:
             part, wall, point, force = contacts(pos, walls, s)
             self.rec["sample_wall_resultant"].append(wall_resultants(wall, force, self.n_walls))
@@ -194,9 +193,6 @@ class _History:
             self.rec["sample_vessel_count"].append(vessel_counts(pos, self.vessels))
         if self.walls or self.vessels is not None:
             self.rec["sample_step"].append(step)
-        if snap:
-            self.rec["snap_pos"].append(pos.copy())
-            self.rec["snap_step"].append(step)
 
     def variables(self, n):
         """{name: (dims, array, units, long_name)} of the non-empty records."""
@@ -210,8 +206,6 @@ class _History:
             "sample_step": (("sample",), np.int64, "1", "algorithm step of diagnostic sample"),
             "sample_wall_resultant": (("sample", "wall", "xy"), float, "N", "resultant force of wall on liquid over the run"),
             "sample_vessel_count": (("sample", "vessel"), np.int64, "1", "particles per vessel"),
-            "snap_step": (("snapshot",), np.int64, "1", "algorithm step of snapshot"),
-            "snap_pos": (("snapshot", "particle", "xy"), float, "cm", "particle positions at snapshot"),
         }
         out = {k: (d, np.array(r[k], t), u, ln) for k, (d, t, u, ln) in spec.items() if r[k]}
         if "sample_wall_resultant" in out:
@@ -243,7 +237,8 @@ def solve(scene, pos0, weight, start_step=0, progress=None, state=None, rest_dep
     """Relax ``pos0`` (N, 2) cm with per-particle ``weight`` (N,) N under an ISA scene.
 
     start_step: steps already taken (a continued run counts from there up to
-    solver.max_steps).  progress(step, fmax) is called every driver.LOG_EVERY s of wall time.
+    solver.max_steps).  progress(text): the driver's progress lines (step, max|F|, ETA), one every
+    driver.LOG_EVERY s of wall time.
     rest_depth: depth h [cm] of the rest criterion's e = KE / (W h) (overdamped variant only).
     state: {STATE_VARS name: array} of the run this one continues (same
     scene dynamics), or None for a fresh start; with it the continued run
@@ -296,7 +291,6 @@ class _Stepper:
         self.chunk_start = np.array(state["state_chunk_start"], float) if self.resume else pos.copy()
         self.buf = np.zeros(chunk)
         self.hist = _History(s["history"], len(walls), vessels)
-        self.snap_every = max(1, round((s["max_steps"] - start_step) / max(self.hist.n_snap, 1) / chunk))
         self.memo = ChunkMemo() if not (s["stop_on_cycle"] or overdamped or newton) else None
         self.nstate = np.zeros(2)  # newton: (mu, nu) between chunks
         self.counts = np.zeros(4, np.int64)  # newton: Hessian assemblies, CG iterations, refused crossings, evaluations
@@ -404,14 +398,42 @@ class _Stepper:
         return None
 
     def record(self):
-        """Wall resultants, vessel counts and snapshots at the chunk's end (no rest samples: None)."""
+        """Wall resultants and vessel counts at the chunk's end (no rest samples: None)."""
         if not self.quiet_end:
-            hist = self.hist
-            hist.chunk(self.step, self.pos, self.s, self.walls, hist.n_snap and self.n_chunk % self.snap_every == 0)
+            self.hist.chunk(self.step, self.pos, self.s, self.walls)
         return None
 
     def spent(self):
         return self.step >= self.s["max_steps"]
+
+    def fraction_done(self):
+        return (self.step - self.start_step) / max(self.s["max_steps"] - self.start_step, 1)
+
+    def clock(self):
+        """(simulated time s of the overdamped variant, NaN for the static rules; step from the chain's start)."""
+        return (float(self.kernel[1]) if self.overdamped else float("nan")), self.step
+
+    def state(self):
+        """Copies of the positions and out-of-balance forces (NaN before the run's first evaluation: not known yet),
+        and the overdamped variant's velocities."""
+        out = {"pos": self.pos.copy(), "force": self.force.copy() if self.evals else np.full_like(self.force, np.nan)}
+        if self.overdamped:
+            out["velocity"] = self.vel.copy()
+        return out
+
+    def recording(self):
+        """The driver's Recording of this run: a snapshot every solver.snapshot_every_single steps (single vessel)
+        or _flow steps (a tank of vessels), within solver.snapshot_megabytes; the tank's walls, vessels and box
+        (isaflow.tank.Tank's); the lattice spacing as the strip width."""
+        from ...tank import Tank
+
+        s, spec = self.s, self.scene.spec
+        tank = Tank(self.scene.path, {"name": spec["name"], "walls": spec["walls"],
+                                      **({"vessels": spec["vessels"]} if spec.get("vessels") else {})}, "")
+        flow = len(spec.get("vessels", [])) > 1
+        return driver.Recording(s["snapshot_every_flow"] if flow else s["snapshot_every_single"],
+                                s["snapshot_megabytes"], self.walls, tank.vessels, tank.escape_box(),
+                                self.scene.spacing or float("nan"), timed=False)
 
     def limit_message(self, monitor=None):
         return f"max|F| = {self._fmax():.4g} N >= f_tol = {self.s['f_tol']:g} N after {self.step} steps"
@@ -439,15 +461,17 @@ class _Stepper:
                   and (overdamped or k not in dynamic)}
         params.update(cycle_period=int(self.period), stop_on_cycle=int(s["stop_on_cycle"]),
                       nonfinite_particle=int(self.bad_particle), max_step_move=self.max_step_move)
+        measures = {}
         if overdamped:
             sim_time = float(kernel[1])
             ke = 0.5 * float(np.sum(weight / G * np.sum(vel * vel, axis=1)))
             at_rest = kernel[2] >= 0 and sim_time - kernel[2] >= rest_cfg["window"] - 1e-12
             params.update(rest_energy_ratio=rest_cfg["energy_ratio"], rest_window=rest_cfg["window"],
-                          rest_depth=rest_depth,
-                          final_energy_ratio=ke / e_norm, start_time=t_start,
-                          time_to_rest=max(float(kernel[2]) - t_start, 0.0) if at_rest else float("nan"),
+                          rest_depth=rest_depth, final_energy_ratio=ke / e_norm, start_time=t_start,
                           particle_mass=float(weight[0] / G) if len(weight) else float("nan"))
+            measures["time_to_rest"] = AT.measure(  # the compiled rest test's (the driver judges no rest here)
+                "time_to_rest", max(float(kernel[2]) - t_start, 0.0) if at_rest else float("nan"),
+                None if at_rest else "not at rest when the run stopped")
             if status == "converged":
                 message += (f", at rest (e = KE / (W h) < {rest_cfg['energy_ratio']:g} since t = {kernel[2]:.4g} s); "
                             f"t = {sim_time:.4g} s")
@@ -468,12 +492,11 @@ class _Stepper:
             contact_wall=wall, contact_point=point, contact_force=cforce, status=status, message=message,
             steps=step, start_step=self.start_step, wall_time=run.wall_time, force_evals=self.evals, residual=fmax,
             residual_name="max|F|", residual_units="N", sim_time=sim_time,
-            history=hist.variables(len(pos)), fields=fields, params=params,
+            history=hist.variables(len(pos)), fields=fields, params=params, measures=measures,
         )
 
 
 def _solve(scene, pos0, weight, start_step, progress, state, rest_depth, threads):
     """Build the stepper (kernels warmed) and drive it (driver.drive) -> contract.Result; arguments as solve's."""
     stepper = _Stepper(scene, pos0, weight, start_step, state, rest_depth, threads)
-    log = (lambda line: progress(stepper.step, stepper.fmax_last)) if progress else None
-    return driver.drive(stepper, None, log)
+    return driver.drive(stepper, None, progress, recording=stepper.recording())

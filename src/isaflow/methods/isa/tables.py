@@ -62,7 +62,7 @@ def write_table1(runs, benchmarks, outputs, rows):
     return df
 
 
-# -- study tables (figures/error_vs_runtime.csv, results/study/*.csv) ----------
+# -- study tables (results/isa/study/*.csv) --------------------------------------
 
 
 def _write(df, out):
@@ -83,9 +83,9 @@ def _base_row(sid, ds):
 
 
 def error_table(runs, outputs, meta, paper):
-    """figures/error_vs_runtime.csv: one row per error_runtime run with its outcome,
+    """results/isa/study/error_vs_runtime.csv: one row per error_runtime run with its outcome,
     step count (= force evaluations), solver wall-clock time [s] and every
-    metrics.hydrostatic_errors measure.  paper: config.yaml 'paper' mapping."""
+    metrics.hydrostatic_errors measure.  paper: config/methods/isa_workflow.yaml's 'paper' mapping."""
     rows = []
     for p in runs:
         sid = _stem(p)
@@ -195,7 +195,7 @@ def stability_row(sid, ds, m):
 
 
 def map_table(runs, outputs, meta):
-    """results/study/stability_map.csv: outcome of every stability-map run."""
+    """results/isa/study/stability_map.csv: outcome of every stability-map run."""
     df = pd.DataFrame([stability_row(_stem(p), read(p), meta[_stem(p)]) for p in runs])
     df = df.sort_values(["variant", "k_factor", "du_factor"])
     _write(df, outputs[0])
@@ -203,7 +203,7 @@ def map_table(runs, outputs, meta):
 
 
 def cases_table(runs, outputs, meta):
-    """figures/stability_cases.csv: outcome of every extreme case and variant."""
+    """results/isa/study/stability_cases.csv: outcome of every extreme case and variant."""
     order = {c: i for i, c in enumerate(dict.fromkeys(meta[_stem(p)]["case"] for p in runs))}
     df = pd.DataFrame([stability_row(_stem(p), read(p), meta[_stem(p)]) for p in runs])
     df["_o"] = df["case"].map(order)

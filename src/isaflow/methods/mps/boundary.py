@@ -18,6 +18,7 @@ end, where the other vessel's liquid is seen in their place).
 import numpy as np
 from scipy.spatial import cKDTree
 
+from isaflow.core.geometry import inside_vessel
 from isaflow.core.panels import wall_panels
 
 from .operators import DUMMY, FLUID, WALL
@@ -131,15 +132,20 @@ def wall_particles(walls, l0, layers=4, pressure_layers=2, thin=None):
                 face_side=cand_side[faces], face_arc=cand_s[faces], face_ds=cand_ds[faces])
 
 
-def liquid_block(x_range, floor_y, depth, l0):
-    """(N, 2) cm square lattice filling [x0, x1] x [floor_y, floor_y + rows l0], rows = round(depth / l0)."""
+def liquid_block(x_range, floor_y, depth, l0, vessel=None, walls=()):
+    """(N, 2) cm square lattice filling [x0, x1] x [floor_y, floor_y + rows l0], rows = round(depth / l0); vessel:
+    the vessel's polygon [(x, y)] (tank.vessel_polygon): only the cells whose centres lie inside it half a cell
+    from its edges and the walls (W, 4) (core.geometry.inside_vessel: in a rectangular vessel, every cell)."""
     cols = int(round((x_range[1] - x_range[0]) / l0))
     rows = max(1, int(round(depth / l0)))
     dx = (x_range[1] - x_range[0]) / cols
     x = x_range[0] + (np.arange(cols) + 0.5) * dx
     y = floor_y + (np.arange(rows) + 0.5) * l0
     X, Y = np.meshgrid(x, y)
-    return np.column_stack([X.ravel(), Y.ravel()])
+    pos = np.column_stack([X.ravel(), Y.ravel()])
+    if vessel is not None:
+        pos = pos[inside_vessel(pos, vessel, walls, 0.5 * min(dx, l0))]
+    return pos
 
 
 def load_map(walls, bnd, panel_length):

@@ -57,11 +57,26 @@ def wall_loads(runs, outputs):
     save(fig, out)
 
 
+FLOW_COLUMNS = 5  # snapshots per flow row: a fifth of the time limit apart
+
+
+def _flow_columns(ds):
+    """(positions, times) of the FLOW_COLUMNS stored states nearest k / FLOW_COLUMNS of the run's time limit
+    after its start (k = 1 ...), the last the end state; the final state alone for a run without snapshots."""
+    if "snap_pos" not in ds:
+        return ds["pos"].values[None], [float(ds["sim_time"])]
+    t = ds["snap_time"].values
+    t0, limit = float(ds.attrs.get("start_time", t[0])), float(ds.attrs["time_limit_s"])
+    keep = [int(np.argmin(np.abs(t - (t0 + limit * k / FLOW_COLUMNS)))) for k in range(1, FLOW_COLUMNS)] + [len(t) - 1]
+    return ds["snap_pos"].values[keep], t[keep]
+
+
 def flow(runs, outputs):
-    """Rows: runs; columns: position snapshots of the flow [cm] with the walls."""
+    """Rows: runs; columns: position snapshots of the flow [cm] with the walls: the stored ones nearest a fifth,
+    two fifths ... of the run's time limit after its start (the last: its end state)."""
     out = outputs
     dss = [runfile.read(p) for p in runs]
-    ncol = max(ds.sizes.get("snapshot", 1) for ds in dss)
+    ncol = FLOW_COLUMNS
     fig, axes = plt.subplots(len(dss), ncol, figsize=(3.0 * ncol, 1.9 * len(dss) + 1.0), squeeze=False)
     for row, ds in zip(axes, dss):
         v = VARIANTS[ds.attrs["variant"]]
@@ -70,8 +85,7 @@ def flow(runs, outputs):
                         f"second vessel depth {m['depth']:.1f} cm, surface slope {m['slope_deg']:+.1f} deg, range "
                         f"{m['surface_range_cm']:.1f} cm", (0, 1.32), xycoords="axes fraction", fontsize=8,
                         color=v.colour, fontweight="bold")
-        snaps = ds["snap_pos"].values if "snap_pos" in ds else ds["pos"].values[None]
-        times = ds["snap_time"].values if "snap_time" in ds else [float(ds["sim_time"])]
+        snaps, times = _flow_columns(ds)
         for ax, pos, t in zip(row, snaps, times):
             for w in ds["wall_segment"].values:
                 ax.plot(w[[0, 2]], w[[1, 3]], "k-", lw=1)

@@ -17,7 +17,6 @@ from . import boundary, model, solver
 REFERENCES = ("Koshizuka & Oka (1996), Nucl. Sci. Eng. 123, 421; MPS-Basic (github.com/MPS-Basic/MPS-Basic); "
               "Hattori, Seta, Shibata & Koshizuka, 'A new derivation of pressure Poisson equation in MPS'; "
               "Tanaka & Masunaga (2010), J. Comput. Phys. 229, 4279")
-SNAPSHOTS = 6  # evenly spaced position snapshots of a run in a tank of vessels
 
 
 def _flow(tank):
@@ -51,7 +50,7 @@ def start_state(path):
 def on_wall_start(tank, l0, point):
     """The liquid block at rest with the particle nearest ``point`` (x, y cm) moved onto it."""
     xr, floor = tank.first_vessel
-    fluid = boundary.liquid_block(xr, floor, tank.depth, l0)
+    fluid = boundary.liquid_block(xr, floor, tank.depth, l0, tank.vessel_polygon(0), tank.walls)
     k = int(np.argmin(np.hypot(*(fluid - np.asarray(point) - [0, l0 / 2]).T)))
     fluid[k] = point
     return dict(pos=fluid, vel=np.zeros_like(fluid), steps=0, sim_time=0.0)
@@ -69,10 +68,18 @@ def warm_up(threads=None):
     for variant in ("standard", "hattori", "mixed"):
         cfg = S.resolved(variant=variant, resolution=None, overrides={"resolution.spacing": 2.0})
         solver.solve(tank, cfg, variant, 2.0, 3e-3, np.array([[10.0, 5.0]]), log=lambda msg: None, threads=threads)
-    # what the claims' derived numbers (methods.mps.derived) and measures call beside a run's kernels: the plain
-    # pair distances the step check recomputes its operators with, the one-particle source term of the dilation
-    # and the relaxation factors hat-eq4-rho-star reports
-    model.distances(np.zeros((2, 2)), np.array([0, 1, 1], np.int64), np.array([1], np.int32))
+    # what the claims' derived numbers (methods.mps.derived) and measures call beside a run's kernels (a run's step
+    # fuses the stage kernels, model.step_cg): the plain pair distances, number density, velocity Laplacian and
+    # gradient the step check recomputes its operators with, the one-particle source term of the dilation and the
+    # relaxation factors hat-eq4-rho-star reports
+    pos = np.array([[0.0, 0.0], [1.0, 0.0]])
+    kind = np.zeros(2, np.int64)
+    start, nbr = model.neighbour_list(pos, kind, np.array([-1.0, -1.0, 2.0, 1.0]), 1.5, np.full(2, -1, np.int64),
+                                      np.ones(2, np.int64), np.zeros((0, 4)))
+    dist = model.distances(pos, start, nbr)
+    model.number_density(start, nbr, dist, 1.5)
+    model.laplacian(np.zeros_like(pos), kind, start, nbr, dist, 1.5, 1.0, 1.0)
+    model.gradient(pos, np.zeros(2), kind, start, nbr, dist, 1.5, 1.0, model.GRADIENTS["variational"])
     model.source_term(1.0, 1.0, 1.0, 1.0, 1.0, model.SOURCES["hattori"], 0.5, 1.0)
     model.relaxation_factors(model.SOURCES["hattori"], model.RELAX_SCOPES["density"], 0.2)
 
@@ -87,7 +94,6 @@ def solve(tank, settings, variant, resolution, start=None, progress=None, thread
     if st is None and settings["start.on_wall_point"] is not None:
         st = on_wall_start(tank, l0, settings["start.on_wall_point"])
     log = progress.log if progress is not None else (lambda msg: None)
-    res = solver.solve(tank, settings, variant, l0, t_end, probes, start=st, snapshots=SNAPSHOTS if flow else 0,
-                       log=log, threads=threads)
+    res = solver.solve(tank, settings, variant, l0, t_end, probes, start=st, log=log, threads=threads)
     res.spacing = l0
     return res

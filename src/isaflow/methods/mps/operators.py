@@ -21,19 +21,44 @@ Units: cm, s, density N s^2 / cm^4 (2D), pressure N / cm^2.
 """
 
 import numpy as np
-from numba import prange
+from numba import prange, uint64
+from numba.core.cpu import ParallelOptions
 
 from ...core.jit import njit
 
 JIT = dict(cache=True, nogil=True)
-PAR = dict(cache=True, nogil=True, parallel=True)
+# explicit prange loops only: numba would also run every array expression (np.zeros, a copy) as a parallel loop of its
+# own, a thread hand-off each (about 0.2 us apiece, some 20 per step)
+PAR = dict(cache=True, nogil=True, parallel=ParallelOptions(dict(
+    comprehension=False, reduction=False, inplace_binop=False, setitem=False, numpy=False, stencil=False, fusion=False,
+    prange=True)))
 FLUID, WALL, DUMMY = 0, 1, 2
 DIM = 2
 # pressure gradients (settings name -> id)
 GRADIENTS = {"min": 0, "corrected": 1, "symmetric": 2, "cmps": 3, "variational": 4, "variational_dummies": 5}
+VARIATIONAL = GRADIENTS["variational"]
 # the gradients whose pair terms are antisymmetric (momentum-conserving): their wall pair forces are the momentum the
 # walls exchange with the liquid (wall_forces)
 PAIRWISE = frozenset({2, 3, 4, 5})
+# a squared radius times this is a pair's cut before its distance is taken: a pair cut so has r >= the radius whatever
+# the rounding of r, so every test on r itself decides as before
+CUT = 1.0 + 1e-9
+
+
+@njit(inline="always", **JIT)
+def pair_distance(dx, dy):
+    """|(dx, dy)| [cm] of a pair, by numba's np.hypot: 8x dearer per list entry than sqrt(dx^2 + dy^2), kept because
+    sqrt's last-bit differences move the settled columns' states: the dx5.56 standard column's pressure slope then
+    ends at 1.031 rho0 g, outside its +-3 % test, while np.hypot keeps every MPS output bit for bit as before the fused
+    passes (issue 42: the change of every verdict and table a faster distance brings is a decision of its own)."""
+    return np.hypot(dx, dy)
+
+
+@njit(inline="always", **JIT)
+def row_span(start, i):
+    """(first, end) of row i's list entries, unsigned: numba then indexes with them (and with unsigned neighbour
+    indices) without the negative-index test, 28 % of a pass's inner loop."""
+    return uint64(start[i]), uint64(start[i + 1])
 
 
 @njit(inline="always", **JIT)
@@ -100,7 +125,7 @@ def segments_cross(x0, y0, x1, y1, seg):
     return t0 * t1 <= 0.0
 
 
-@njit(inline="always", **JIT)
+@njit(**JIT)
 def visible(i, j, pos, tw, tside, near, thin, behind=False):
     """Whether particles i and j see each other across the thin walls thin (T, 4).
 
@@ -124,6 +149,22 @@ def visible(i, j, pos, tw, tside, near, thin, behind=False):
             if segments_cross(pos[i, 0], pos[i, 1], pos[j, 0], pos[j, 1], thin[t]):
                 return False
     return True
+
+
+@njit(inline="always", **JIT)
+def plain_row(i, tw, near, thin):
+    """Particle i sees every particle but thin walls' face particles (visible's first test for any j): no thin walls,
+    or i is no face particle and within reach of none."""
+    return thin.shape[0] == 0 or (tw[i] < 0 and near[i] == 0)
+
+
+@njit(inline="always", **JIT)
+def sees(i, j, pos, tw, tside, near, thin, behind, plain):
+    """visible(i, j, ...), plain = plain_row(i, ...): a plain row's non-face neighbours are seen without more tests
+    (visible itself is a call, not inlined: the passes' inner loops stay small)."""
+    if plain and (thin.shape[0] == 0 or tw[j] < 0):
+        return True
+    return visible(i, j, pos, tw, tside, near, thin, behind)
 
 
 @njit(**JIT)
@@ -229,7 +270,7 @@ def distances(pos, start, nbr):
     for i in prange(n):
         for k in range(start[i], start[i + 1]):
             j = nbr[k]
-            d[k] = np.hypot(pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1])
+            d[k] = pair_distance(pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1])
     return d
 
 
@@ -246,7 +287,7 @@ def visible_distances(pos, start, nbr, tw, tside, thin, reach, behind=False):
         for k in range(start[i], start[i + 1]):
             j = nbr[k]
             if visible(i, j, pos, tw, tside, near, thin, behind):
-                d[k] = np.hypot(pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1])
+                d[k] = pair_distance(pos[j, 0] - pos[i, 0], pos[j, 1] - pos[i, 1])
             else:
                 d[k] = np.inf
     return d
@@ -268,44 +309,54 @@ def number_density(start, nbr, dist, re):
     return out
 
 
+@njit(inline="always", **JIT)
+def divergence_term(hs, i, j, pos, vel, r, re):
+    """Pair (i, j)'s term of particle i's divergence sum at distance r: the K&O model's (u_ij . r_ij) / r^2 w(r), or
+    (hs) Khayyer & Gotoh 2009's (u_ij . r_ij) r_e / r^3 (0 from r_e on)."""
+    if hs:
+        if r >= re:
+            return 0.0
+        rr = max(r, 1e-6 * re)
+        return ((vel[j, 0] - vel[i, 0]) * (pos[j, 0] - pos[i, 0]) + (vel[j, 1] - vel[i, 1]) * (pos[j, 1] - pos[i, 1])) \
+            * re / (rr * rr * rr)
+    wt = weight(r, re)
+    if wt == 0.0:
+        return 0.0
+    return ((vel[j, 0] - vel[i, 0]) * (pos[j, 0] - pos[i, 0]) + (vel[j, 1] - vel[i, 1]) * (pos[j, 1] - pos[i, 1])) \
+        / (r * r) * wt
+
+
+@njit(inline="always", **JIT)
+def divergence_value(hs, s, n0):
+    """Particle i's divergence [1/s] from its sum of divergence_term: d / n0 times it, or (hs) 1 / n0."""
+    return s / n0 if hs else s * (DIM / n0)
+
+
 @njit(**PAR)
-def divergence(pos, vel, start, nbr, dist, re, n0):
-    """(N,) MPS divergence of vel [1/s] (all neighbours; wall particles' velocity is theirs, 0)."""
+def _divergence(pos, vel, start, nbr, dist, re, n0, hs):
     n = pos.shape[0]
     out = np.zeros(n)
     for i in prange(n):
         s = 0.0
         for k in range(start[i], start[i + 1]):
-            wt = weight(dist[k], re)
-            if wt == 0.0:
-                continue
-            j = nbr[k]
-            dx = pos[j, 0] - pos[i, 0]
-            dy = pos[j, 1] - pos[i, 1]
-            s += ((vel[j, 0] - vel[i, 0]) * dx + (vel[j, 1] - vel[i, 1]) * dy) / (dist[k] * dist[k]) * wt
-        out[i] = s * (DIM / n0)
+            if dist[k] < re:
+                s += divergence_term(hs, i, nbr[k], pos, vel, dist[k], re)
+        out[i] = divergence_value(hs, s, n0)
     return out
 
 
-@njit(**PAR)
+@njit(**JIT)
+def divergence(pos, vel, start, nbr, dist, re, n0):
+    """(N,) MPS divergence of vel [1/s] (all neighbours; wall particles' velocity is theirs, 0)."""
+    return _divergence(pos, vel, start, nbr, dist, re, n0, False)
+
+
+@njit(**JIT)
 def divergence_hs(pos, vel, start, nbr, dist, re, n0):
     """(N,) divergence as the higher-order source term of Khayyer & Gotoh 2009 (Appl. Ocean Res. 31, 111):
     -(1/n0) Dn/Dt with the analytic rate of the number density, Dn/Dt = -sum_j r_e / r^3 (r_ij . u_ij) [1/s]
     (all neighbours within re; wall particles' velocity is theirs, 0)."""
-    n = pos.shape[0]
-    out = np.zeros(n)
-    for i in prange(n):
-        s = 0.0
-        for k in range(start[i], start[i + 1]):
-            if dist[k] >= re:
-                continue
-            j = nbr[k]
-            r = max(dist[k], 1e-6 * re)
-            dx = pos[j, 0] - pos[i, 0]
-            dy = pos[j, 1] - pos[i, 1]
-            s += ((vel[j, 0] - vel[i, 0]) * dx + (vel[j, 1] - vel[i, 1]) * dy) * re / (r * r * r)
-        out[i] = s / n0
-    return out
+    return _divergence(pos, vel, start, nbr, dist, re, n0, True)
 
 
 @njit(**PAR)
@@ -391,21 +442,35 @@ def gradient(pos, p, kind, start, nbr, dist, re, n0, mode):
     for i in prange(n):
         if kind[i] != FLUID:
             continue
-        gx = gy = 0.0
-        for k in range(start[i], start[i + 1]):
-            j = nbr[k]
-            if dist[k] >= re or not in_gradient(mode, kind[j]):
-                continue
-            q = pair_coefficient(mode, p[i], p[j], pmin[i], pmin[j], dist[k], re)
-            gx += q * (pos[j, 0] - pos[i, 0])
-            gy += q * (pos[j, 1] - pos[i, 1])
-        gx *= a
-        gy *= a
-        if mode == 1:
-            gx, gy = corrected(gx, gy, corrective(i, pos, kind, start, nbr, dist, re, a))
-        out[i, 0] = gx
-        out[i, 1] = gy
+        out[i, 0], out[i, 1], _ = gradient_row(i, pos, p, pmin, kind, start, nbr, dist, re, a, mode, False, nbr, p)
     return out
+
+
+@njit(inline="always", **JIT)
+def gradient_row(i, pos, p, pmin, kind, start, nbr, dist, re, a, mode, record, wk, wq):
+    """(gx, gy, walls) of fluid particle i: its pressure gradient (gradient; a = d / n_g, pmin: p^ or p) and the number
+    of its terms that are a boundary particle's (its share of the walls' forces, wall_terms).  record (a constant):
+    the boundary terms' list entries k and pair coefficients q are stored at wk, wq[start[i]:] (recorded_wall_terms)."""
+    gx = gy = 0.0
+    walls = 0
+    first, end = row_span(start, i)
+    for k in range(first, end):
+        j = uint64(nbr[k])
+        if dist[k] >= re or not in_gradient(mode, kind[j]):
+            continue
+        q = pair_coefficient(mode, p[i], p[j], pmin[i], pmin[j], dist[k], re)
+        if kind[j] != FLUID:
+            if record:
+                wk[first + walls] = k
+                wq[first + walls] = q
+            walls += 1
+        gx += q * (pos[j, 0] - pos[i, 0])
+        gy += q * (pos[j, 1] - pos[i, 1])
+    gx *= a
+    gy *= a
+    if mode == 1:
+        gx, gy = corrected(gx, gy, corrective(i, pos, kind, start, nbr, dist, re, a))
+    return gx, gy, walls
 
 
 @njit(inline="always", **JIT)
@@ -449,27 +514,47 @@ def wall_forces(pos, p, kind, start, nbr, dist, re, n0, mode, mass_over_rho):
     (the liquid's internal terms do not cancel).  Serial (a scatter onto the boundary particles)."""
     pmin = neighbourhood_min(p, kind, start, nbr, dist, re) if mode in (0, 1, 3) else p
     out = np.zeros((pos.shape[0], 2))
-    a = DIM / n0
-    m = (1.0, 0.0, 1.0, 1.0)
     for i in range(pos.shape[0]):
-        if kind[i] != FLUID:
-            continue
-        first = True
-        for k in range(start[i], start[i + 1]):
-            j = nbr[k]
-            if kind[j] == FLUID or dist[k] >= re or not in_gradient(mode, kind[j]):
-                continue
-            q = a * pair_coefficient(mode, p[i], p[j], pmin[i], pmin[j], dist[k], re)
-            gx = q * (pos[j, 0] - pos[i, 0])
-            gy = q * (pos[j, 1] - pos[i, 1])
-            if mode == 1:
-                if first:
-                    m = corrective(i, pos, kind, start, nbr, dist, re, a)
-                    first = False
-                gx, gy = corrected(gx, gy, m)
-            out[j, 0] -= mass_over_rho * gx
-            out[j, 1] -= mass_over_rho * gy
+        if kind[i] == FLUID:
+            wall_terms(i, out, 0, pos, p, pmin, kind, start, nbr, dist, re, DIM / n0, mode, mass_over_rho)
     return out
+
+
+@njit(inline="always", **JIT)
+def wall_terms(i, out, first, pos, p, pmin, kind, start, nbr, dist, re, a, mode, mass_over_rho):
+    """Add fluid particle i's boundary-neighbour terms of its pressure gradient, times -mass_over_rho, to out[j - first]
+    of each boundary neighbour j (wall_forces; a = d / n_g, pmin: p^ or p).  Serial: a scatter."""
+    m = (1.0, 0.0, 1.0, 1.0)
+    fresh = True
+    for k in range(start[i], start[i + 1]):
+        j = nbr[k]
+        if kind[j] == FLUID or dist[k] >= re or not in_gradient(mode, kind[j]):
+            continue
+        if mode == 1 and fresh:
+            m = corrective(i, pos, kind, start, nbr, dist, re, a)
+            fresh = False
+        wall_term(i, j, a * pair_coefficient(mode, p[i], p[j], pmin[i], pmin[j], dist[k], re), pos, m, mode, out,
+                  first, mass_over_rho)
+
+
+@njit(inline="always", **JIT)
+def recorded_wall_terms(i, out, first, pos, kind, start, nbr, dist, re, a, mode, mass_over_rho, wk, wq, walls):
+    """wall_terms from the boundary terms gradient_row recorded (walls of them at wk, wq[start[i]:])."""
+    m = corrective(i, pos, kind, start, nbr, dist, re, a) if mode == 1 else (1.0, 0.0, 1.0, 1.0)
+    for t in range(start[i], start[i] + walls):
+        wall_term(i, nbr[wk[t]], a * wq[t], pos, m, mode, out, first, mass_over_rho)
+
+
+@njit(inline="always", **JIT)
+def wall_term(i, j, q, pos, m, mode, out, first, mass_over_rho):
+    """One boundary term of fluid particle i's pressure gradient, q r_ij (q: d / n_g times the pair coefficient; mode 1
+    times the inverse of the moment matrix m), times -mass_over_rho, added to out[j - first]."""
+    gx = q * (pos[j, 0] - pos[i, 0])
+    gy = q * (pos[j, 1] - pos[i, 1])
+    if mode == 1:
+        gx, gy = corrected(gx, gy, m)
+    out[j - first, 0] -= mass_over_rho * gx
+    out[j - first, 1] -= mass_over_rho * gy
 
 
 @njit(**PAR)
@@ -503,7 +588,7 @@ def probe_pressure(pos, p, kind, probes, re):
         for i in range(pos.shape[0]):
             if kind[i] != FLUID:
                 continue
-            wt = weight(np.hypot(pos[i, 0] - probes[k, 0], pos[i, 1] - probes[k, 1]), re)
+            wt = weight(pair_distance(pos[i, 0] - probes[k, 0], pos[i, 1] - probes[k, 1]), re)
             sw += wt
             sp += wt * p[i]
         if sw > 0.0:

@@ -30,9 +30,9 @@ def noise(ds):
 
 
 def time_to_rest(ds):
-    """Time [s] after the run's start at which the quiet stretch that made it at rest began (isaflow.rest);
-    NaN if it never came to rest."""
-    return float(ds.attrs.get("time_to_rest", np.nan))
+    """Time [s] after the run's start at which the quiet stretch that made it at rest began (isaflow.rest: the
+    run file's variable time_to_rest, at_rest.AT_REST); NaN if it never came to rest."""
+    return float(ds["time_to_rest"]) if "time_to_rest" in ds else np.nan
 
 
 SIDE_LOAD = 3262.5  # N, rho g h^2 / 2 of the single tank (72.5 cm, 9000 N): the side-wall load every method is judged on

@@ -11,6 +11,7 @@ Chosen by benchmarks/bench_mps.py.  The residual reported is the true
 relative residual |b - A x| / |b| of the returned solution.
 """
 
+import numba
 import numpy as np
 import scipy.sparse as sp
 import scipy.sparse.linalg as spla
@@ -19,6 +20,7 @@ from numba import prange, uint64
 from ...core.jit import njit
 
 SOLVERS = ("cg_jacobi", "scipy_cg", "amg", "direct")
+ZERO_DIAGONAL = "division by zero"  # cg_jacobi's error where a diagonal entry is 0 (numba's ZeroDivisionError)
 BLOCK = 512  # entries per partial sum of a dot product (fixed: the sum order does not depend on the threads)
 PAR = dict(cache=True, nogil=True, parallel=True)
 
@@ -169,6 +171,23 @@ def cg_jacobi(indptr, indices, data, b, x0, rtol, maxiter, parallel=False):
     return x, np.sqrt(_dot_serial(res, res)) / bnorm, its
 
 
+@njit(cache=True, nogil=True)
+def cg_solve(indptr, indices, data, rhs, x0, rtol, maxiter, threads):
+    """solve_csr's cg_jacobi, callable from compiled code: (x, relative residual, iterations, failed), the loops in
+    parallel from PAR_MIN rows when numba has more than one thread (threads: numba.get_num_threads(), which compiled
+    code that is cached cannot ask).  failed: a diagonal entry is 0 (cg_jacobi would
+    divide by it; x NaN, residual inf, 0 iterations)."""
+    n = rhs.shape[0]
+    if n == 0:
+        return np.zeros(0), 0.0, 0, False
+    for r in range(n):
+        for k in range(indptr[r], indptr[r + 1]):
+            if indices[k] == r and data[k] == 0.0:
+                return np.full(n, np.nan), np.inf, 0, True
+    x, resid, its = cg_jacobi(indptr, indices, data, rhs, x0, rtol, maxiter, threads > 1 and n >= PAR_MIN)
+    return x, resid, its, False
+
+
 def solve_csr(indptr, indices, data, rhs, method="cg_jacobi", rtol=1e-8, maxiter=2000, x0=None):
     """Solve the CSR system of model.assemble.  Returns (x, relative residual, iterations)."""
     n = len(rhs)
@@ -176,9 +195,10 @@ def solve_csr(indptr, indices, data, rhs, method="cg_jacobi", rtol=1e-8, maxiter
         return np.zeros(0), 0.0, 0
     x0 = np.zeros(n) if x0 is None else x0
     if method == "cg_jacobi":
-        import numba
-
-        return cg_jacobi(indptr, indices, data, rhs, x0, rtol, maxiter, numba.get_num_threads() > 1 and n >= PAR_MIN)
+        x, resid, its, failed = cg_solve(indptr, indices, data, rhs, x0, rtol, maxiter, numba.get_num_threads())
+        if failed:
+            raise ZeroDivisionError(ZERO_DIAGONAL)
+        return x, resid, its
     return solve(csr(indptr, indices, data), rhs, method, rtol, maxiter, x0)
 
 

@@ -1,6 +1,6 @@
 """MPS report fragment (results/report/55_mps.md), timing fragment and the single-vessel table, generated from
 results/mps/summary.csv.  The claims on MPS (Hattori et al.; the ISA paper's introduction) are judged by
-isaflow.claims from the registry (config/claims/), measures in methods/mps/claims.py."""
+isaflow.claims from the registry (config/claims/), quantities in methods/mps/quantities.py."""
 
 from pathlib import Path
 
@@ -8,6 +8,7 @@ import numpy as np
 import pandas as pd
 
 from ...core.units import G
+from ...figures.animation import report_line
 from . import settings
 
 def _fmt(x, f="{:.3g}"):
@@ -153,6 +154,8 @@ def fragment(df, cfg):
                            ["flow run", "tank", "status", "t end s", "mass left (fraction)", "second-vessel level cm",
                             "rms cm/s (window)", "time to rest s", "escapes", "guard: particles reflected",
                             "guard: steps", "graze steps", "why it stopped"])
+    lines += ["", report_line("figures/mps_flow_animation.gif", "the standard source term's flow at l0 = 3.45 cm "
+                              "(flow_standard_dx3.45), particles coloured by speed")]
     lines += ["", "Stiff and extreme cases (standard source, single vessel): " + "; ".join(
         f"{r.run.removeprefix('stiff_')}: {r.label}" for r in stiff.itertuples()) + ".", ""]
     lines += _table(stiff, [("run", None), ("status", None), ("rms_speed_cm_s", g), ("floor_err", g), ("message", None),
@@ -178,7 +181,8 @@ def fragment(df, cfg):
 # dt = 2 ms) on this project's single vessel at l0 = 1.25 cm (4,640 liquid particles), 3 s, measured by the
 # developers (../shared/peers.md, "MPS, hydrostatic column"): rms speed at 1 s and 3 s [cm/s], floor and side-wall
 # load errors averaged over 1-3 s against W and rho g h^2 / 2, ms per step on one thread.  Not at rest.
-PEER = dict(code="MPS-Basic", spacing_cm=1.25, rms_1s=8.3, rms_3s=8.7, floor_err=0.018, side_err=0.023, ms_per_step=46.0)
+PEER = dict(code="MPS-Basic", spacing_cm=1.25, rms_1s=8.3, rms_3s=8.7, floor_err=0.018, side_err=0.023, ms_per_step=46.0,
+            particles=4640)
 
 
 def peer_comparison(df):
@@ -237,10 +241,31 @@ def timing(df, cfg):
     return "\n".join(lines + [""])
 
 
+def floor(bench):
+    """Markdown table of the step-cost benchmark's floor rows (cg_jacobi, one thread): ns per particle-step of the
+    step's operators (the step without its pressure solve) against one fused pass over the same lists and matrix
+    (benchmarks/bench_mps.py floor_pass), and of the whole step per liquid particle against the peer."""
+    b = pd.read_csv(bench)
+    if "floor_ratio" not in b:
+        return ""
+    b = b[b.floor_ratio.notna()].sort_values("liquid_particles")
+    lines = [f"| liquid / all particles | operators ns/particle-step | floor | operators / floor | whole step ns per "
+             f"liquid particle-step | {PEER['code']} |", "|---|---|---|---|---|---|"]
+    for r in b.itertuples():
+        lines.append(f"| {r.liquid_particles:,} / {r.all_particles:,} | {r.ops_ns_per_particle_step:.0f} | "
+                     f"{r.floor_ns_per_particle_step:.0f} | {r.floor_ratio:.2f} | {r.ns_per_liquid_particle_step:,.0f} | "
+                     f"{r.peer_ns_per_liquid_particle_step:,.0f} |")
+    return ("Operators against their floor (thread CPU time, one numba thread, shared 2-core machine, load average "
+            f"{b.load_average.min():.1f}-{b.load_average.max():.1f}; {PEER['code']}: {PEER['ms_per_step']:g} ms per step "
+            f"at l0 = {PEER['spacing_cm']:g} cm, {PEER['particles']:,} liquid particles, ../shared/peers.md):\n\n"
+            + "\n".join(lines) + "\n")
+
+
 def bench_fragment(bench, outputs):
     """outputs = [the benchmarks page's MPS fragment] from the step-cost benchmark."""
     Path(outputs[0]).parent.mkdir(parents=True, exist_ok=True)
-    Path(outputs[0]).write_text(f"## MPS: step-cost benchmark (benchmarks/results/mps_step_cost.csv)\n\n{cost(bench)}\n")
+    Path(outputs[0]).write_text(f"## MPS: step-cost benchmark (benchmarks/results/mps_step_cost.csv)\n\n{cost(bench)}\n\n"
+                                f"{floor(bench)}")
 
 
 SINGLE_TABLE = "mps_single.csv"  # every single-vessel run, next to the report

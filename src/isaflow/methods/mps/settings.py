@@ -12,6 +12,15 @@ from ... import settings as S
 
 DEFAULT_PATH = Path(__file__).resolve().parents[4] / "config" / "methods" / "mps.yaml"
 
+
+
+def own_tank(tank, settings):
+    """The overrides ('key=value') of a run on a tank no settings file was written for (isaflow compare): the
+    pressure probes' points are in the project's tanks (x = 10-250 cm), so none is read in another (set them on a
+    run of its own)."""
+    return ("probes.single=[]", "probes.flow=[]")
+
+
 # {dotted key: JSON schema of the value} of config/methods/mps.yaml
 VALUES = {
     'model.re_density': {"type": "number", "exclusiveMinimum": 1},
@@ -43,6 +52,9 @@ VALUES = {
     'time.single_time': {"type": "number", "exclusiveMinimum": 0},
     'time.flow_time': {"type": "number", "exclusiveMinimum": 0},
     'time.average_window': {"type": "number", "exclusiveMinimum": 0},
+    'time.snapshot_single': {"type": "number", "exclusiveMinimum": 0},
+    'time.snapshot_flow': {"type": "number", "exclusiveMinimum": 0},
+    'time.snapshot_megabytes': {"type": "number", "exclusiveMinimum": 0},
     'pressure.solver': {"enum": ["cg_jacobi", "scipy_cg", "amg", "direct"]},
     'pressure.rtol': {"type": "number", "exclusiveMinimum": 0},
     'pressure.maxiter': {"type": "integer", "minimum": 1},

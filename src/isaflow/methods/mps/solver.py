@@ -3,7 +3,8 @@
 Per step (model.py, numba, every particle loop a gather run in parallel): neighbour list, explicit step,
 collision model, penetration guard (walls.reflect: a move across a wall line mirrored back), free surface and
 source term, pressure equation (pressure.py), pressure correction, particle shifting, penetration guard,
-wall-crossing check.  The step loop runs in Python around compiled stages, one step per advance of a stepper
+wall-crossing check.  A step is one compiled call with the compiled pressure solver (model.step_cg: model.predict,
+pressure.cg_solve, model.correct; any other solver from Python between the two), one step per advance of a stepper
 run by driver.drive.
 Rest: isaflow.rest (one criterion for every dynamic method).  Units: cm, N, s; pressure N/cm^2
 (2D, per cm of thickness).
@@ -18,12 +19,34 @@ import time
 # waiting is set before numba starts its threads (the first parallel loop), unless the environment says otherwise.
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")
 
+
+def _keep_freed_memory():
+    """glibc: serve every allocation below 1 GiB from the heap and never give freed heap back to the system.  A step
+    allocates arrays of the lists' size (1.5 MB each at 6,000 particles); by default glibc maps such blocks afresh
+    and unmaps them when freed, so every step paid a page fault per 4 kB touched: on the shared 2-core machine one
+    pass over the lists took 10 ms on every other call instead of 1.8 ms (1.0 ms with this).  Peak memory is
+    unchanged (what a step frees, the next reuses).  Not glibc: nothing to do."""
+    import ctypes
+    import ctypes.util
+
+    try:
+        libc = ctypes.CDLL(ctypes.util.find_library("c") or "libc.so.6")
+        libc.mallopt(-3, 1 << 30)  # M_MMAP_THRESHOLD
+        libc.mallopt(-1, 1 << 30)  # M_TRIM_THRESHOLD
+    except (OSError, AttributeError):
+        pass
+
+
+_keep_freed_memory()
+
 import numba
 import numpy as np
+import scipy.sparse as sp
 
 from isaflow import driver, rest
-from isaflow.contract import Result
+from isaflow.contract import Result, wall_resultants
 from isaflow.core import units
+from isaflow.inputs import InputError
 from isaflow.tank import vessel_counts
 
 from . import boundary, model, pressure
@@ -78,21 +101,47 @@ class State:
         self.grid_box = box + np.array([-pad, -pad, pad, pad])
         self.escape_box = box
         self.graze_depth = cfg["walls.graze_depth"] * l0  # cm: deeper crossings are escapes
-        self.grazes, self.deepest_graze = 0, 0.0  # steps with a graze, deepest graze [cm]
-        self.reflect_steps, self.reflections = 0, 0  # steps with a wall reflection, particles reflected (walls.reflect)
+        self.counts = np.zeros(4, np.int64)  # list builds, steps with a wall reflection, particles reflected, grazes
+        self.deepest = np.zeros(1)  # deepest graze [cm]
         self.panel_wall, self.panel_centre, self.panel_side, self.load_matrix, self.share = boundary.load_map(
             self.walls, self.bnd, cfg["walls.panel_length"])
+        self.share_csr, self.loads_csr = _csr(self.share), _csr(self.load_matrix)
         self.pair_state = None  # (positions, distances, list start, list) of the last pressure gradient
         self.load_sum, self.p_sum, self.sum_time = np.zeros((2 * len(self.panel_wall), 2)), np.zeros(self.nf), 0.0
         self.surface_mode = model.SURFACE[cfg["model.surface_pressure"]]
         self.lap_mode = model.LAPLACIANS[cfg["model.pressure_laplacian"]]
         self.div_mode = model.DIVERGENCES[cfg["model.divergence"]]
-        self.n_prev = None  # number density at the start of the previous step (ECS)
-        self.builds = 0
-        self.dist_memo = None  # (builds, positions, distances) of the last distances call
-        self.start = self.nbr = self.list_pos = None
+        self.n_prev = np.zeros(0)  # number density at the start of the previous step (ECS; empty: none yet)
+        self.start, self.nbr, self.list_pos = np.zeros(1, np.int64), np.zeros(0, np.int32), np.zeros((0, 2))  # none yet
         self.surf = np.zeros(n, bool)
         self.solve_error = ""
+        self.consts_cfg, self.consts = None, None
+        self.clock = np.zeros(3, np.int64)  # cycles of model.step_cg's stages, its last call
+
+    builds = property(lambda self: int(self.counts[0]), doc="neighbour-list builds")
+    reflect_steps = property(lambda self: int(self.counts[1]), doc="steps with a wall reflection (walls.reflect)")
+    reflections = property(lambda self: int(self.counts[2]), doc="particles reflected, summed over the steps")
+    grazes = property(lambda self: int(self.counts[3]), doc="steps with a graze")
+    deepest_graze = property(lambda self: float(self.deepest[0]), doc="deepest graze [cm]")
+
+    def constants(self, cfg):
+        """model.StepConstants of settings cfg (those of the state's build, as a rule) and this run's lattice."""
+        if cfg is not self.consts_cfg:
+            self.consts_cfg = cfg
+            self.solve_settings = (cfg["pressure.solver"], cfg["pressure.rtol"], cfg["pressure.maxiter"],
+                                   cfg["model.sound_speed"])
+            self.consts = model.step_constants(
+                nf=self.nf, l0=self.l0, rmax=self.rmax, skin=self.skin, nu=cfg["model.kinematic_viscosity"],
+                ecs=cfg["model.ecs"], re_n=self.re_n, re_g=self.re_g, re_l=self.re_l, re_s=self.re_s, n0_n=self.n0_n,
+                n0_g=self.n0_g, n0_s=self.n0_s, n0_l=self.n0_l, lam=self.lam, rho0=self.rho0, n_grad=self.n_grad,
+                grad_mode=self.grad_mode, div_mode=self.div_mode, lap_mode=self.lap_mode, surface_mode=self.surface_mode,
+                cdist=cfg["model.collision_distance"] * self.l0, restitution=cfg["model.restitution"],
+                reflect=cfg["walls.reflect"], behind=cfg["walls.thin_line_of_sight"], beta=cfg["model.beta"],
+                dist_thr=cfg["model.surface_distribution"] * self.l0, gamma=cfg["model.gamma_mixed"],
+                relax=cfg["model.relaxation"], scope=model.RELAX_SCOPES[cfg["model.relaxation_scope"]],
+                clip=cfg["model.clip_negative"], shifting=cfg["model.shifting"], graze=self.graze_depth,
+                mass_over_rho=self.weight / units.G / self.rho0)
+        return self.consts
 
     def neighbours(self, pos):
         """Neighbour lists at pos, radius rmax + skin (start, nbr); reused until a particle has moved more
@@ -100,47 +149,34 @@ class State:
         The rows' order depends on the positions at the build, so a continued run (which builds its own
         lists) matches the run it continues to round-off, not bit for bit.  The lists hold every pair in range
         whatever the thin walls between them (no thin wall passed): which pairs see each other is decided at
-        the positions the operators use (distances)."""
-        self.builds += 1
-        self.list_pos = pos.copy()
-        self.start, self.nbr = model.neighbour_list(pos, self.kind, self.grid_box, self.rmax + self.skin, self.tw, self.tside,
-                                                    self.thin[:0])
+        the positions the operators use (distances).  The step builds its own the same way (model.lists_at)."""
+        self.list_pos = np.zeros((0, 2))
+        self.start, self.nbr, self.list_pos = model.lists_at(pos, self.kind, self.tw, self.tside, self.grid_box,
+                                                             self.start, self.nbr, self.list_pos, self.counts,
+                                                             self.constants(self.cfg))
 
     def distances(self, pos):
         """(M,) distance of every list entry at pos, inf where the pair does not see each other across a thin
         wall at pos (the lists hold every pair in range; visibility is that of the positions the operators
-        use, so a particle that grazes a thin wall's line between list builds sees, and is seen, as it is now).
-        The last result is reused when pos equals, value for value, the positions it was computed at with the
-        same lists (the predicted positions that no collision or reflection moved): the same numbers, once."""
-        if self.dist_memo is not None and self.dist_memo[0] == self.builds and np.array_equal(self.dist_memo[1], pos):
-            return self.dist_memo[2]
-        d = model.visible_distances(pos, self.start, self.nbr, self.tw, self.tside, self.thin, self.rmax + self.skin,
-                                    self.cfg["walls.thin_line_of_sight"])
-        self.dist_memo = (self.builds, pos.copy(), d)
-        return d
+        use, so a particle that grazes a thin wall's line between list builds sees, and is seen, as it is now)."""
+        return model.visible_distances(pos, self.start, self.nbr, self.tw, self.tside, self.thin, self.rmax + self.skin,
+                                       self.cfg["walls.thin_line_of_sight"])
 
     def list_valid(self, pos):
         """The lists still hold every pair closer than rmax at pos (nobody moved more than skin / 2)."""
-        d = pos[: self.nf] - self.list_pos[: self.nf]
-        return float(np.max(d[:, 0] ** 2 + d[:, 1] ** 2, initial=0.0)) <= (0.5 * self.skin) ** 2
+        return model.list_holds(pos, self.list_pos, self.nf, self.skin)
 
-    def count_reflections(self, hit):
-        n_hit = int(np.count_nonzero(hit))
-        if n_hit:
-            self.reflect_steps += 1
-            self.reflections += n_hit
-
-    def panel_forces(self):
-        """(P, 2) force of each wall panel on the liquid [N] from the wall particles' pressures: the first row's
-        pressure times the length of wall it faces (the panel reading)."""
-        return (self.load_matrix @ self.p[self.nf:]).reshape(-1, 2)
-
-    def accumulate(self, dt):
-        """Add this step's wall loads by both readings and the liquid's pressures, times dt, to the sums since the
-        last take_means (the momentum the walls exchanged, and the pressure's time integral)."""
-        self.load_sum += dt * np.concatenate([self.pair_forces(), self.panel_forces()])
-        self.p_sum += dt * self.p[: self.nf]
-        self.sum_time += dt
+    def loads(self):
+        """(2P, 2) force of each wall panel on the liquid [N] now (model.panel_loads: by the pair-force reading, the
+        wall-liquid pair terms of the last step's pressure gradient at the positions and pressures it used, the
+        momentum the walls exchange with the liquid, model.wall_forces; then by the panel reading, the first row's
+        pressures times the length of wall each faces)."""
+        f = np.zeros((len(self.pos), 2))
+        if self.pair_state is not None:
+            pos, dist, start, nbr = self.pair_state
+            f = model.wall_forces(pos, self.p, self.kind, start, nbr, dist, self.re_g, self.n_grad, self.grad_mode,
+                                  self.weight / units.G / self.rho0)
+        return model.panel_loads(f[self.nf:], self.p, self.nf, self.share_csr, self.loads_csr)
 
     def take_means(self):
         """(pair-force loads (P, 2) N, panel loads (P, 2) N, liquid pressures (nf,) N/cm^2): the means over the steps
@@ -148,153 +184,84 @@ class State:
         if self.sum_time > 0.0:
             load, p = self.load_sum / self.sum_time, self.p_sum / self.sum_time
         else:
-            load, p = np.concatenate([self.pair_forces(), self.panel_forces()]), self.p[: self.nf].copy()
+            load, p = self.loads(), self.p[: self.nf].copy()
         self.load_sum, self.p_sum, self.sum_time = np.zeros((2 * len(self.panel_wall), 2)), np.zeros(self.nf), 0.0
         return load[: len(self.panel_wall)], load[len(self.panel_wall):], p
 
-    def pair_forces(self):
-        """(P, 2) force of each wall panel's boundary particles on the liquid [N]: the wall-liquid pair terms of
-        the last step's pressure gradient (model.wall_forces, at the positions and pressures it used; the
-        pair-force reading, the momentum the walls exchange with the liquid)."""
-        if self.pair_state is None:
-            return np.zeros((len(self.panel_wall), 2))
-        pos, dist, start, nbr = self.pair_state
-        f = model.wall_forces(pos, self.p, self.kind, start, nbr, dist, self.re_g, self.n_grad, self.grad_mode,
-                              self.weight / units.G / self.rho0)
-        return self.share @ f[self.nf:]
+
+def _csr(dense):
+    """(indptr, indices, data) of a dense matrix's nonzero entries, row by row in column order."""
+    m = sp.csr_matrix(dense)
+    m.sort_indices()
+    return m.indptr.astype(np.int64), m.indices.astype(np.int64), m.data.astype(float)
 
 
 def step(s, dt, source, cfg, timers=None):
-    """Advance State s by one step.  Returns (bad, residual, iterations); bad as model.check
-    (kind 4: the pressure solve failed outright or gave a non-finite pressure; residual inf).
-    timers: (3,) s accumulated in predict (to the assembled system), solve and correct."""
-    t0 = time.perf_counter()
-    pos_old = s.pos
-    ps, vs, b_ecs = _predict(s, dt, cfg)
-    dist, surf, normal, p_dir, row, system = _pressure_system(s, ps, vs, dt, source, cfg, b_ecs)
-    t1 = time.perf_counter()
-    unk = row >= 0
-    x0 = np.zeros(int(unk.sum()))
-    x0[row[unk]] = s.p[unk]
-    try:
-        x, resid, its = pressure.solve_csr(*system, cfg["pressure.solver"], cfg["pressure.rtol"],
-                                           cfg["pressure.maxiter"], x0)
-    except (RuntimeError, ValueError, ArithmeticError) as err:  # e.g. SuperLU "matrix is exactly singular"
-        x, resid, its = np.full(len(system[-1]), np.nan), np.inf, 0
-        s.solve_error = str(err)
-    if not np.all(np.isfinite(x)):
-        resid = np.inf
-    t2 = time.perf_counter()
-    if not np.isfinite(resid):
-        if timers is not None:
-            timers += (t1 - t0, t2 - t1, 0.0)
-        return (4, -1, -1), resid, its
-    p = p_dir.copy()
-    p[unk] = x[row[unk]]
-    if cfg["model.clip_negative"]:
-        p = np.maximum(p, 0.0)
-    bad = _correct(s, pos_old, ps, vs, p, dist, surf, normal, dt, cfg)
-    if timers is not None:
-        timers += (t1 - t0, t2 - t1, time.perf_counter() - t2)
+    """Advance State s by one step: model.predict, the pressure solve, model.correct (with the compiled solver
+    cg_jacobi all three in one compiled call, model.step_cg).  Returns (bad, residual, iterations); bad as model.check
+    (kind 4: the pressure solve failed outright or gave a non-finite pressure; residual inf).  timers: (3,) s
+    accumulated in predict (to the assembled system), solve and correct."""
+    c = s.constants(cfg)
+    solver, rtol, maxiter, sound = s.solve_settings
+    extra = s.lam * s.n0_l / (2.0 * model.DIM * sound**2 * dt**2) if sound > 0 else 0.0
+    if solver == "cg_jacobi":
+        t0 = time.perf_counter()
+        (done, bad, resid, its, failed, s.start, s.nbr, s.list_pos, s.n_prev, pos, vel, p, surf, ps, dist,
+         *lists) = model.step_cg(s.pos, s.vel, s.p, s.kind, s.tw, s.tside, s.thin, s.walls, s.grid_box, s.escape_box,
+                                 s.start, s.nbr, s.list_pos, s.n_prev, s.counts, s.deepest, s.load_sum, s.p_sum,
+                                 s.share_csr, s.loads_csr, c, dt, s.gravity[0], s.gravity[1], model.SOURCES[source],
+                                 extra, rtol, maxiter, numba.get_num_threads(), s.clock)
+        if timers is not None:  # the stages' share of the call's time, from the cycles each took
+            spent = s.clock.sum()
+            timers += (time.perf_counter() - t0) * (s.clock / spent if spent > 0 else np.array([1.0, 0.0, 0.0]))
+        if failed:
+            s.solve_error = pressure.ZERO_DIAGONAL
+    else:
+        done, bad, resid, its, pos, vel, p, surf, ps, dist, lists = _step_python(s, dt, source, cfg, timers, c, extra)
+    if not done:
+        return (4, -1, -1), np.inf, its
+    s.pair_state = (ps, dist) + tuple(lists)
+    s.pos, s.vel, s.p, s.surf = pos, vel, p, surf
+    s.sum_time += dt  # wall loads: the momentum exchanged over a sample interval, not one step's force
     return bad, resid, its
 
 
-def _predict(s, dt, cfg):
-    """The explicit part of a step (viscosity, gravity, collisions, reflection) -> (ps, vs) (P, 2) predicted
-    positions [cm] and velocities [cm/s], b_ecs (P,) the ECS source term (None without it)."""
-    pos_old = s.pos
-    if s.start is None or not s.list_valid(s.pos):
-        s.neighbours(s.pos)
-    nu = cfg["model.kinematic_viscosity"]
-    ecs = cfg["model.ecs"]
-    if nu > 0 or ecs:
-        dist = s.distances(s.pos)
-    if nu > 0:
-        lap = model.laplacian(s.vel, s.kind, s.start, s.nbr, dist, s.re_l, s.n0_l, s.lam)
-    else:
-        lap = np.zeros_like(s.vel)
-    b_ecs = None
-    if ecs:
-        n_now = model.number_density(s.start, s.nbr, dist, s.re_n)
-        b_ecs = model.ecs_term(n_now, n_now if s.n_prev is None else s.n_prev, s.n0_n, s.rho0, dt)
-        s.n_prev = n_now
-    ps, vs = model.explicit(s.pos, s.vel, s.kind, lap, dt, s.gravity[0], s.gravity[1], nu)
-    if not s.list_valid(ps):
-        s.neighbours(ps)
-    coll = cfg["model.collision_distance"] * s.l0
-    if coll > 0.0:
-        ps, vs = model.collide(ps, vs, s.kind, s.start, s.nbr, s.distances(ps), coll, cfg["model.restitution"])
-        if not s.list_valid(ps):
-            s.neighbours(ps)
-    if cfg["walls.reflect"]:  # the predicted positions stay on the side each particle started on
-        ps, vs, hit = model.reflect(pos_old, ps, vs, s.kind, s.walls, cfg["model.restitution"], 1e-6 * s.l0)
-        s.count_reflections(hit)
-        if not s.list_valid(ps):
-            s.neighbours(ps)
-    return ps, vs, b_ecs
+def _step_python(s, dt, source, cfg, timers, c, extra):
+    """step with any other pressure solver (pressure.solve_csr from Python between model.predict and model.correct).
+    Returns (done, bad, residual, iterations, pos, vel, p, surf, ps, dist, gradient's lists)."""
+    t0 = time.perf_counter()
+    (s.start, s.nbr, s.list_pos, s.n_prev, ps, vs, dist, surf, normal, p_dir, row, indptr, indices, data, rhs,
+     x0) = model.predict(s.pos, s.vel, s.p, s.kind, s.tw, s.tside, s.thin, s.walls, s.grid_box, s.start, s.nbr,
+                         s.list_pos, s.n_prev, s.counts, c, dt, s.gravity[0], s.gravity[1], model.SOURCES[source], extra)
+    t1 = time.perf_counter()
+    try:
+        x, resid, its = pressure.solve_csr(indptr, indices, data, rhs, cfg["pressure.solver"], cfg["pressure.rtol"],
+                                           cfg["pressure.maxiter"], x0)
+    except (RuntimeError, ValueError, ArithmeticError) as err:  # e.g. SuperLU "matrix is exactly singular"
+        x, resid, its = np.full(len(rhs), np.nan), np.inf, 0
+        s.solve_error = str(err)
+    t2 = time.perf_counter()
+    lists = s.start, s.nbr
+    done, pos, vel, p, bad = False, s.pos, s.vel, s.p, (4, -1, -1)
+    if np.isfinite(resid):
+        done, pos, vel, p, bad, s.start, s.nbr, s.list_pos = model.correct(
+            s.pos, ps, vs, x, row, p_dir, dist, surf, normal, s.kind, s.tw, s.tside, s.thin, s.walls, s.grid_box,
+            s.escape_box, s.start, s.nbr, s.list_pos, s.counts, s.deepest, s.load_sum, s.p_sum, s.share_csr,
+            s.loads_csr, c, dt)
+    if timers is not None:
+        timers += (t1 - t0, t2 - t1, time.perf_counter() - t2 if done else 0.0)
+    return done, bad, resid, its, pos, vel, p, surf, ps, dist, lists
 
 
-def _pressure_system(s, ps, vs, dt, source, cfg, b_ecs):
-    """The pressure Poisson system at the predicted state -> (dist, surf, normal, p_dir, row, (indptr, indices,
-    data, rhs)): pair distances [cm], free-surface flags and normals, Dirichlet pressures [N/cm2], each
-    particle's unknown (-1: none) and the CSR system (model.assemble)."""
-    dist = s.distances(ps)
-    n_star = model.number_density(s.start, s.nbr, dist, s.re_n)
-    if s.div_mode == 1:
-        div = model.divergence_hs(ps, vs, s.start, s.nbr, dist, s.re_g, s.n0_g)
-    else:
-        div = model.divergence(ps, vs, s.start, s.nbr, dist, s.re_g, s.n0_g)
-    dist_thr = cfg["model.surface_distribution"] * s.l0
-    surf, normal = model.surface(ps, s.kind, s.start, s.nbr, dist, s.re_s, s.n0_s, cfg["model.beta"], dist_thr, s.rmax)
-    b = model.source_term_all(n_star, div, s.n0_n, s.rho0, dt, model.SOURCES[source], cfg["model.gamma_mixed"],
-                              cfg["model.relaxation"], model.RELAX_SCOPES[cfg["model.relaxation_scope"]])
-    if b_ecs is not None:
-        b = b + b_ecs
-    p_dir = np.zeros(len(ps))
-    if s.surface_mode == 1:
-        p_dir[surf] = s.rho0 * units.G * 0.5 * s.l0 * np.maximum(normal[surf, 1], 0.0)
-    elif s.surface_mode == 2:
-        p_dir = model.surface_values(ps, s.p, s.kind, surf, normal, s.start, s.nbr, dist, s.re_g, s.n0_g, 0.5 * s.l0)
-    sound = cfg["model.sound_speed"]
-    extra = s.lam * s.n0_l / (2.0 * model.DIM * sound**2 * dt**2) if sound > 0 else 0.0
-    row, indptr, indices, data, rhs = model.assemble(s.kind, surf, p_dir, b, s.start, s.nbr, dist, s.re_l, s.n0_l,
-                                                     s.lam, extra, s.lap_mode)
-    return dist, surf, normal, p_dir, row, (indptr, indices, data, rhs)
-
-
-def _correct(s, pos_old, ps, vs, p, dist, surf, normal, dt, cfg):
-    """The pressure-gradient correction, shifting and reflection; stores the new state in s -> bad (model.check)."""
-    g = model.gradient(ps, p, s.kind, s.start, s.nbr, dist, s.re_g, s.n_grad, s.grad_mode)
-    s.pair_state = (ps, dist, s.start, s.nbr)
-    pos, vel = model.update(ps, vs, s.kind, g, s.rho0, dt)
-    c = cfg["model.shifting"]
-    if c > 0.0:
-        if not s.list_valid(pos):
-            s.neighbours(pos)
-        d2 = s.distances(pos)
-        pos = pos + model.shift(pos, s.kind, surf, normal, s.start, s.nbr, d2, s.re_n, s.n0_n, c, s.l0)
-    if cfg["walls.reflect"]:
-        pos, vel, hit = model.reflect(pos_old, pos, vel, s.kind, s.walls, cfg["model.restitution"], 1e-6 * s.l0)
-        s.count_reflections(hit)
-    bad, graze = model.check(pos_old, pos, vel, s.kind, s.walls, s.escape_box, s.graze_depth)
-    s.pos, s.vel, s.p = pos, vel, p
-    s.accumulate(dt)  # wall loads: the momentum exchanged over a sample interval, not one step's force
-    s.surf = surf
-    if graze > 0.0:
-        s.grazes += 1
-        s.deepest_graze = max(s.deepest_graze, graze)
-    return bad
-
-
-def solve(tank, cfg, variant, spacing, t_end, probes, start=None, snapshots=0, log=print, threads=None,
-          rest_settings=None):
+def solve(tank, cfg, variant, spacing, t_end, probes, start=None, log=print, threads=None, rest_settings=None):
     """Run MPS with source term ``variant`` on ``tank`` until the liquid is at rest (isaflow.rest) or for
     ``t_end`` s of physical time, whichever comes first.
 
     spacing l0 [cm]; probes (K, 2) cm; start None (liquid block at rest in the first vessel, depth
     tank.depth rounded to whole rows) or dict(pos, vel, steps, sim_time[, initial_depth]) of the run this
     one continues (the walls are this tank's; the chain's clock and step count go on).
-    snapshots: number of evenly spaced position snapshots kept.  threads: numba threads of the particle
+    Snapshots (driver.Recording): every time.snapshot_single s in a single vessel, time.snapshot_flow s in a tank
+    of vessels, within time.snapshot_megabytes.  threads: numba threads of the particle
     loops (None: numba's current setting; results do not depend on it).  rest_settings: dict
     (energy_ratio, window) (None: config/rest.yaml).  Wall loads (contacts) are the mean panel forces over
     the last settings 'time.average_window' s.  Returns a contract.Result.
@@ -305,7 +272,7 @@ def solve(tank, cfg, variant, spacing, t_end, probes, start=None, snapshots=0, l
     before = numba.get_num_threads()
     numba.set_num_threads(threads)
     try:
-        return _solve(tank, cfg, variant, float(spacing), t_end, probes, start, snapshots, log, threads,
+        return _solve(tank, cfg, variant, float(spacing), t_end, probes, start, log, threads,
                       rest.load() if rest_settings is None else rest_settings)
     finally:
         numba.set_num_threads(before)
@@ -315,11 +282,15 @@ class _Stepper:
     """MPS on a tank for driver.drive: one advance is one step (its time step dt0, or shorter by the velocity
     Courant condition), a diagnostic sample every time.sample_interval s of simulated time."""
 
-    def __init__(self, tank, cfg, variant, l0, t_end, probes, start, snapshots, threads):
+    def __init__(self, tank, cfg, variant, l0, t_end, probes, start, threads):
         self.tank, self.cfg, self.variant, self.l0, self.t_end, self.threads = tank, cfg, variant, l0, t_end, threads
         xr, floor = tank.first_vessel
         if start is None:
-            fpos, self.step0, self.t0 = boundary.liquid_block(xr, floor, tank.depth, l0), 0, 0.0
+            fpos = boundary.liquid_block(xr, floor, tank.depth, l0, tank.vessel_polygon(0), tank.walls)
+            if len(fpos) < 2:
+                raise InputError(f"{tank.path}: field 'liquid.depth': {len(fpos)} cell(s) of l0 = {l0:.3g} cm lie half "
+                                 f"a cell inside the first vessel below the depth; a liquid needs at least 2")
+            self.step0, self.t0 = 0, 0.0
             fvel = np.zeros_like(fpos)
             self.depth0 = rows_depth(tank, l0)
             self.origin = "lattice at rest"
@@ -335,13 +306,11 @@ class _Stepper:
         self.nsteps = nsteps = int(np.ceil(t_end / dt0 - 1e-9))  # steps at the base time step
         every = max(1, int(round(cfg["time.sample_interval"] / dt0)))
         self.sample_dt = sample_dt = every * dt0  # s between samples (every base steps, as many shorter ones as it takes)
-        self.snap_times = list(np.linspace(0.0, nsteps * dt0, snapshots)[1:]) if snapshots else []
         self.tol = 1e-6 * dt0
         self.elapsed, self.next_sample, self.dt_min, self.short_steps = 0.0, sample_dt, dt0, 0
         self.probes = np.asarray(probes, float).reshape(-1, 2)
         self.rec = {k: [] for k in ("time", "pair", "panel", "probe", "rms", "vmax", "energy", "count", "resid",
                                     "iters", "surf")}
-        self.snaps, self.snap_t = [], []
         self.fail_tol = cfg["pressure.rtol"] * cfg["pressure.fail_factor"]
         self.status, self.max_resid, self.iters = None, 0.0, []
         self.timers = np.zeros(3)
@@ -391,8 +360,30 @@ class _Stepper:
     def spent(self):
         return self.elapsed >= self.nsteps * self.dt0 - self.tol
 
+    def fraction_done(self):
+        return self.elapsed / (self.nsteps * self.dt0)
+
+    def clock(self):
+        """(chain time s, chain step) of the current state (driver.drive's snapshots)."""
+        return self.t, self.step0 + self.k
+
+    def state(self):
+        """Copies of the liquid's positions, velocities and pressures (driver.drive's snapshots)."""
+        s = self.s
+        return {"pos": s.pos[: s.nf].copy(), "velocity": s.vel[: s.nf].copy(), "pressure": s.p[: s.nf].copy()}
+
+    def recording(self):
+        """The driver's Recording of this run: snapshots every time.snapshot_single s (single vessel) or
+        time.snapshot_flow s (a tank of vessels), within time.snapshot_megabytes; the tank's walls, vessels
+        and box; the strip width l0 of the free surface."""
+        flow = len(self.tank.spec.get("vessels", [])) > 1
+        cfg = self.cfg
+        return driver.Recording(cfg["time.snapshot_flow"] if flow else cfg["time.snapshot_single"],
+                                cfg["time.snapshot_megabytes"], self.s.walls, self.tank.vessels,
+                                tuple(self.s.escape_box), self.l0)
+
     def record(self):
-        """A diagnostic sample when one is due (and at the run's last step); position snapshots.
+        """A diagnostic sample when one is due (and at the run's last step).
         Returns (t, e) of the sample for the rest monitor, or None."""
         s, rec, t, tol = self.s, self.rec, self.t, self.tol
         sample = None
@@ -416,10 +407,6 @@ class _Stepper:
             rec["resid"].append(self.resid)
             rec["iters"].append(self.its)
             rec["surf"].append(int(s.surf[: s.nf].sum()))
-        if self.snap_times and self.elapsed >= self.snap_times[0] - 0.5 * self.dt0:
-            self.snap_times.pop(0)
-            self.snaps.append(s.pos[: s.nf].copy())
-            self.snap_t.append(t)
         return sample
 
     def rest_message(self, monitor):
@@ -469,8 +456,8 @@ class _Stepper:
             params=self._params(run, pairwise))
 
     def _history(self, times, panels, window, pairwise):
-        """The run file's sample_* and snap_* variables."""
-        rec = self.rec
+        """The run file's sample_* variables (the driver adds the snapshots)."""
+        rec, s = self.rec, self.s
         hist = {
             "sample_time": (("sample",), times, "s", "time of sample"),
             "sample_panel_force": (("sample", "contact", "xy"), panels, "N",
@@ -486,6 +473,10 @@ class _Stepper:
                                           "length it faces (panel reading), mean over the steps since the previous sample"),
             "sample_probe_pressure": (("sample", "probe"), np.array(rec["probe"]).reshape(len(times), -1), "N cm-2", "pressure at fixed probe",
                                     {"missing": "no liquid particle within the probe's radius (a dry probe)"}),
+            "sample_wall_resultant": (("sample", "wall", "xy"),
+                                      np.array([wall_resultants(s.panel_wall, f, len(s.walls)) for f in panels])
+                                      .reshape(len(times), len(s.walls), 2), "N",
+                                      "force of each wall on the liquid: sample_panel_force summed over its panels"),
             "sample_rms_speed": (("sample",), np.array(rec["rms"]), "cm s-1", "rms speed of the liquid particles"),
             "sample_max_speed": (("sample",), np.array(rec["vmax"]), "cm s-1", "largest liquid particle speed"),
             "sample_energy_ratio": (("sample",), np.array(rec["energy"]), "1", "kinetic energy / (W h), isaflow.rest"),
@@ -496,16 +487,12 @@ class _Stepper:
             "probe_point": (("probe", "xy"), self.probes, "cm", "pressure probe position"),
             "in_window": (("sample",), window.astype(np.int8), "1", "1 if the sample is in the averaging window"),
         }
-        if self.snaps:
-            hist["snap_time"] = (("snapshot",), np.array(self.snap_t), "s", "time of position snapshot")
-            hist["snap_pos"] = (("snapshot", "particle", "xy"), np.array(self.snaps), "cm",
-                                "liquid particle positions at snapshot")
         return hist
 
     def _params(self, run, pairwise):
         """The run file's attributes (settings, counters, the tank difference; the driver adds the rest ones)."""
         s, cfg, tank, l0, depth0, timers = self.s, self.cfg, self.tank, self.l0, self.depth0, self.timers
-        e_mean, e_max, rms_window = self._window_energy(run.monitor)
+        e_mean, e_max, _ = self._window_energy(run.monitor)
         nb = np.bincount(s.kind, minlength=3)
         rows_note = (f"depth rounded to whole rows: {depth0:.4g} cm (tank {tank.depth:g} cm), weight held at {tank.weight:g} N"
                      if abs(depth0 - tank.depth) > 1e-9 else "none")
@@ -534,12 +521,12 @@ class _Stepper:
             "threads": self.threads, "start_state": self.origin,
             "layer_pitch": l0, "held_weight": float(s.weight * s.nf), "initial_depth": depth0, "tank_difference": rows_note,
             "rest_depth_cm": depth0, "final_rms_speed_cm_s": float(np.sqrt((s.vel[: s.nf] ** 2).sum(1).mean())),
-            "window_energy_ratio_mean": e_mean, "window_energy_ratio_max": e_max, "window_rms_speed_cm_s": rms_window,
+            "window_energy_ratio_mean": e_mean, "window_energy_ratio_max": e_max,
             "wall_load_reading": "pair forces" if pairwise else "panel pressures",
         }
 
 
-def _solve(tank, cfg, variant, l0, t_end, probes, start, snapshots, log, threads, rest_cfg):
+def _solve(tank, cfg, variant, l0, t_end, probes, start, log, threads, rest_cfg):
     """Set up the run (_Stepper) and drive it (driver.drive) -> contract.Result; arguments as solve's."""
-    stepper = _Stepper(tank, cfg, variant, l0, t_end, probes, start, snapshots, threads)
-    return driver.drive(stepper, rest_cfg, log)
+    stepper = _Stepper(tank, cfg, variant, l0, t_end, probes, start, threads)
+    return driver.drive(stepper, rest_cfg, log, recording=stepper.recording())

@@ -1,4 +1,4 @@
-"""Hooke's-law solid particles (Marko 2017, marko2017_lagrangian_solid_sph.txt, sections 3-4).
+"""Hooke's-law solid particles (Marko 2017, ../shared/papers/marko2017_lagrangian_solid_sph.txt, sections 3-4).
 
 Cubic particles linked to their lattice neighbours (the contact matrix):
 linked pairs pull and push by Hooke's law (eqs. 11-16), unlinked ones only

@@ -185,20 +185,17 @@ def run_hertz_eq27(cfg, variant, cap=True):
     rows = {k: [] for k in ("depth", "load", "pmax", "move", "dt_min", "dt_max", "status")}
     t, ke = [0.0], [0.0]
     status, msg, resid, overall = "step_limit", "", 0.0, 0.0
+
+    def sample(_):  # every eq27_record_every steps (the stepper's chunk)
+        t.append(float(st.clock[1]))
+        ke.append(float(st.clock[0]))
+
     for d in c["depths_um"]:
         set_depth(st, R, d * UM)
         st.clock[6] = 0.0
         st.clock[2], st.clock[3] = np.inf, 0.0
-        done, g = 0, np.zeros(2)
-        while done < n:
-            k = min(every, n - done)
-            status, msg, resid, g = S.relax(st, 0.0, k, min_steps=k, chunk=k, log_every=1e9, cap=cap, vfloor=vfloor,
-                                            label=f"hertz eq27 {variant} {d} um")
-            done += k
-            t.append(float(st.clock[1]))
-            ke.append(float(st.clock[0]))
-            if status in ("escaped", "nonfinite"):
-                break
+        status, msg, resid, g = S.relax(st, 0.0, n, min_steps=n, chunk=every, cap=cap, vfloor=vfloor,
+                                        label=f"hertz eq27 {variant} {d} um", sample=sample)
         overall = max(overall, float(st.clock[6])) if np.isfinite(st.clock[6]) else np.inf
         for key, val in zip(rows, (d * UM, g[1], st.pres.max() / dx, float(st.clock[6]), float(st.clock[2]),
                                    float(st.clock[3]), status)):
@@ -256,20 +253,17 @@ def run_bar_long(cfg, variant, strain, dt_frac, case="bar_tension_long"):
 
     t, rec = [0.0], [measures()]
     ke = [0.0]
-    status, msg, resid = "step_limit", "", 0.0
-    done, n, every = 0, lg["steps"], lg["record_every"]
-    while done < n:
-        k = min(every, n - done)
-        status, msg, resid, _ = S.relax(st, 0.0, k, dt=dt, min_steps=k, chunk=k, log_every=1e9,
-                                        label=f"bar long {variant}")
-        done += k
+
+    def sample(_):  # every bar_long.record_every steps (the stepper's chunk)
         t.append(float(st.clock[1]))
         rec.append(measures())
         ke.append(float(st.clock[0]))
-        if status in ("escaped", "nonfinite"):
-            break
+
+    n = lg["steps"]
+    status, msg, resid, _ = S.relax(st, 0.0, n, dt=dt, min_steps=n, chunk=lg["record_every"],
+                                    label=f"bar long {variant}", sample=sample)
     if status == "step_limit":
-        msg = f"undamped, {done} steps of {dt:.4g} s (no rest test)"
+        msg = f"undamped, {n} steps of {dt:.4g} s (no rest test)"
     rec = np.array(rec)
     hist = {
         "time": (("sample",), t, "s", "simulated time"),
@@ -319,6 +313,22 @@ def run_hertz_dt(cfg, variant, dt_ns):
                    {"dt_fixed_s": dt_ns * 1e-9, "dt_over_rule": dt_ns * 1e-9 / st.dt_max})
 
 
+def water_sweep(cfg, case):
+    """The vessel water's setting a case 'vessel_water_stop_h<h / dx>' or '_a<alpha>' changes (one of
+    vessel.water_h_sweep, vessel.water_alpha_sweep; claims input vessel_water), {} for the kept water (ValueError
+    for a value the settings do not list)."""
+    tag = case.removeprefix("vessel_water_stop").removeprefix("vessel_water_particles").lstrip("_")
+    if not tag:
+        return {}
+    key, sweep = {"h": ("water_h_over_dx", "water_h_sweep"), "a": ("water_alpha", "water_alpha_sweep")}.get(tag[0],
+                                                                                                        (None, None))
+    value = float(tag[1:]) if key and tag[1:].replace(".", "", 1).isdigit() else np.nan
+    if key is None or not any(np.isclose(value, x) for x in cfg["vessel"][sweep]):
+        raise ValueError(f"case '{case}': expected vessel_water_stop_h<h / dx> or _a<alpha> of vessel.water_h_sweep "
+                         "or vessel.water_alpha_sweep")
+    return {key: value}
+
+
 def to_pa(x):
     """N/cm^2 -> Pa."""
     return np.asarray(x, float) / PA
@@ -333,16 +343,26 @@ def run_case(cfg, case, variant, loads=None):
     'hertz_eq27_uncapped' (undamped, eq. 27 with and without eq. 26's cap), 'hertz_R<r>mm' / 'hertz_R<r>m'
     (other disk radii), 'bar_tension_long[_e<%>_dt<f>]' (sustained tension), 'vessel' (4.4; variant
     pressure_load or water_particles), 'vessel_water_particles' (4.4 with water, the solid model = the
-    variant), 'vessel_water_stop' (the same with the paper's stop-at-the-boundary coupling) or 'floor_<source>'
-    (elastic floor; loads: the rigid-floor run file of variant 'oneway')."""
-    if case in ("vessel_water_particles", "vessel_water_stop"):
+    variant), 'vessel_water_stop' (the same with the paper's stop-at-the-boundary coupling; '_h<h / dx>', '_a<alpha>':
+    another water, water_sweep), 'bar_tension_sliding' / 'bar_compression_sliding' (axial-only grips),
+    'hertz_loadsteps' (the other depths) or 'floor_<source>' (elastic floor; loads: the rigid-floor run file of
+    variant 'oneway')."""
+    if case.startswith(("vessel_water_particles", "vessel_water_stop")):
         from .water import run_water_vessel
 
-        coupling = {"coupling": "stop_at_boundary"} if case == "vessel_water_stop" else {}
-        r = run_water_vessel({**cfg, "vessel": {**cfg["vessel"], "solid_model": variant, **coupling}})
+        coupling = {"coupling": "stop_at_boundary"} if case.startswith("vessel_water_stop") else {}
+        r = run_water_vessel({**cfg, "vessel": {**cfg["vessel"], "solid_model": variant, **coupling,
+                                                **water_sweep(cfg, case)}})
         r.variant = variant
         r.params["case"] = case
         return r
+    if case in ("bar_tension_sliding", "bar_compression_sliding"):  # axial-only grips (claims input bar_grips)
+        r = run_bar({**cfg, "bar": {**cfg["bar"], "grips": "sliding"}}, variant, +1 if "tension" in case else -1)
+        r.params["case"] = case
+        return r
+    if case == "hertz_loadsteps":  # hertz.depths_alt_um (claims input hertz_increments)
+        return run_hertz({**cfg, "hertz": {**cfg["hertz"], "depths_um": cfg["hertz"]["depths_alt_um"]}}, variant,
+                         case=case)
     if case in ("hertz_eq27", "hertz_eq27_uncapped"):
         return run_hertz_eq27(cfg, variant, cap=case == "hertz_eq27")
     if case.startswith("hertz_R"):

@@ -86,10 +86,18 @@ def solids(s, path):
             f"supported, so the plate needs at least {FLOOR_COLUMNS} (a free one between the supports)")
 
 
+def _steps(*terms):
+    """(total steps, the field of the largest term) of (steps, field) terms: a case's steps are refused under the
+    setting that gives most of them."""
+    return sum(n for n, _ in terms), max(terms, key=lambda t: t[0])[1]
+
+
 def cost(tank, settings, particles=None):
-    """[budget.Cost] of every case of the settings (settings.Settings)."""
+    """[budget.Cost] of every case of the settings (settings.Settings): each steps figure names the setting it
+    mostly comes from (a case run with the 'hooke' variant's solver.max_steps and the 'paper' variant's
+    solver.max_steps_mechanism is two costs)."""
     s = settings.tree()
-    steps_hooke = s["solver"]["max_steps"]
+    steps_hooke, steps_paper = s["solver"]["max_steps"], s["solver"]["max_steps_mechanism"]
     b, sh, h, v, f = s["bar"], s["shear"], s["hertz"], s["vessel"], s["floor"]
     n_bar = math.prod(b["particles"])
     n_shear = sh["particles"][0] * (sh["particles"][1] + 2 * sh["grip_layers"]) * sh["particles"][2]
@@ -97,18 +105,31 @@ def cost(tank, settings, particles=None):
     n_vessel = math.pi * ((v["water_radius_particles"] + v["ring_particles"] + 1) ** 2)
     n_floor = (f["span_cm"] / f["dx_cm"] + 1) * f["layers"]
     history = v["history_us"] * 1e-6 / (v["dt_ns"] * NS)
+    # the pressure-load history steps whole records of record_every steps (vessel.history: ceil(history / every) x
+    # every), so a record longer than the history is a longer run, named after record_every
+    every = v["record_every"]
+    recorded = math.ceil(history / every) * every if math.isfinite(history) else history
+    history = (recorded, "vessel.record_every" if recorded > 2 * history else "vessel.history_us")
 
-    def case(n, steps, field_n, field_steps, detail):
+    def case(n, steps, field_n, detail):
+        steps, field_steps = steps if isinstance(steps, tuple) else (steps, None)
         return budget.Cost(n, steps, n * BYTES_PER_PARTICLE, NS_PER_PARTICLE_STEP,
                            {"particles": field_n, "steps": field_steps, "bytes": field_n}, detail)
 
-    return [
-        case(n_bar, 2 * steps_hooke, "bar.particles", "solver.max_steps", "two loads x max_steps"),
-        case(n_shear, steps_hooke, "shear.particles", "solver.max_steps", "max_steps"),
-        case(n_hertz, len(h["depths_um"]) * steps_hooke + len(h["paper_dt_ns"]) * h["dt_check_steps"],
-             "hertz.plate", "solver.max_steps", "depths x max_steps + the paper's dt checks"),
-        case(n_vessel, steps_hooke + history + v["steps"], "vessel.water_radius_particles",
-             "vessel.history_us", f"settling + history {v['history_us']:g} us / dt {v['dt_ns']:g} ns"),
-        case(n_bar, s["bar_long"]["steps"], "bar.particles", "bar_long.steps", "one sustained-tension run"),
-        case(n_floor, f["max_steps"], "floor.dx_cm", "floor.max_steps", "max_steps"),
+    dt_checks = (len(h["paper_dt_ns"]) * h["dt_check_steps"], "hertz.dt_check_steps")
+    out = []
+    for steps, key, variant in ((steps_hooke, "solver.max_steps", "hooke"),
+                                (steps_paper, "solver.max_steps_mechanism", "paper")):
+        out += [
+            case(n_bar, _steps((2 * steps, key)), "bar.particles", f"{variant}: two loads x {key.split('.')[1]}"),
+            case(n_shear, _steps((steps, key)), "shear.particles", f"{variant}: {key.split('.')[1]}"),
+            case(n_hertz, _steps((len(h["depths_um"]) * steps, key), dt_checks), "hertz.plate",
+                 f"{variant}: depths x {key.split('.')[1]} + the paper's dt checks"),
+        ]
+    return out + [
+        case(n_vessel, _steps((steps_hooke, "solver.max_steps"), history, (v["steps"], "vessel.steps")),
+             "vessel.water_radius_particles",
+             f"settling + history {v['history_us']:g} us / dt {v['dt_ns']:g} ns + the paper's {v['steps']} steps"),
+        case(n_bar, _steps((s["bar_long"]["steps"], "bar_long.steps")), "bar.particles", "one sustained-tension run"),
+        case(n_floor, _steps((f["max_steps"], "floor.max_steps")), "floor.dx_cm", "max_steps"),
     ]

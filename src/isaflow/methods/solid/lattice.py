@@ -1,6 +1,6 @@
 """Cubic particle blocks and their contact matrix (links between lattice neighbours)."""
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -13,7 +13,8 @@ class Block:
     indices (i, j, k), shape (nx, ny, nz), dim 2 or 3 (2: nz == 1, z = 0).
     Links (the paper's contact matrix): la, lb (L,) int32 particle pairs of
     lattice neighbours, d0 (L, 3) cm reference vectors ref_b - ref_a, axis (L,)
-    int32 lattice axis; partners (N, 6) int32 linked particles (-1 padded).
+    int32 lattice axis; partners (N, 6) int32 linked particles (-1 padded).  geometry: the links' rest
+    lengths, unit vectors and per-axis counts (kernels.link_geometry), filled by the first solve.Stepper.
     """
 
     dx: float
@@ -25,6 +26,7 @@ class Block:
     d0: np.ndarray
     axis: np.ndarray
     partners: np.ndarray
+    geometry: tuple = field(default=None, repr=False, compare=False)
 
     @property
     def dim(self):

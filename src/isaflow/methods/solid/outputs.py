@@ -16,7 +16,7 @@ from isaflow import runfile
 from isaflow.core import jit
 from isaflow.methods import label
 
-from . import cases, settings, solve
+from . import cases, settings, solve, water
 
 
 def to_dataset(r, config_path, started, finished):
@@ -71,6 +71,7 @@ def write_run(config_path, case, variant, out, loads=None):
     log = logging.getLogger("isaflow.solid")
     cfg = settings.checked_values(config_path)
     solve.warmup()
+    water.warmup()
     started, t0 = runfile.now(), time.perf_counter()
     r = cases.run_case(cfg, case, variant, loads=loads)
     log.info("%s %s: %s (%s), %d steps, %.2f s", case, variant, r.status, r.message, r.steps, time.perf_counter() - t0)

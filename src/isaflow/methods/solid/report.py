@@ -1,8 +1,8 @@
 """The solid method's report fragment 65 and timing fragment, from run files and the judged claims.
 
-The claims are marko2017's registry rows measured here (methods.solid.claims.MEASURES), judged by the
-claims rule (isaflow.claims, the one verdict function); the fragment counts them by kind and verdict
-class.  Units: cm, N, s.
+The claims are marko2017's registry rows whose checks read the solid's runs or quantities (the registry,
+isaflow.claims_registry), judged by the claims rule (isaflow.judge); the fragment counts them by kind and
+verdict class.  Units: cm, N, s.
 """
 
 from pathlib import Path
@@ -10,17 +10,18 @@ from pathlib import Path
 import pandas as pd
 
 from isaflow import claims as C
+from isaflow import claims_registry
 
-from .claims import MEASURES
 from .figures import read_runs
 
 
-
-def measured_here(claims):
-    """The rows of the registry's judged marko2017 table (results/claims/registry/marko2017.csv, the claims
-    rule's) that this package measures (methods.solid.claims.MEASURES)."""
+def measured_here(claims, registry=claims_registry.DEFAULT_DIRECTORY):
+    """The rows of the judged marko2017 table (results/claims/registry/marko2017.csv, the claims rule's) whose
+    checks read a solid run ('solid:...') or a solid quantity ('solid.*'), as the registry declares them."""
+    ids = {c["id"] for c in claims_registry.load(registry) for chk in c.get("checks", [])
+           if chk["q"].startswith("solid.") or any(r.startswith("solid:") for r in chk.get("runs", []))}
     table = pd.read_csv(claims)
-    return table[table["id"].isin(MEASURES)]
+    return table[table["id"].isin(ids)]
 
 
 def counts_text(table):
@@ -57,7 +58,10 @@ def write_report(table, run_paths, out):
               "floor contacts of the rigid-floor runs of the other methods (variant `oneway`) or by the uniform W / "
               "span (`uniform_load`). Runs the claims registry asks for: `hertz_R*` (the plate under disks of the "
               "other stated radii), `hertz_eq27*` (eqs. 26-27 stepping undamped, and eq. 27 without the cap), "
-              "`bar_tension_long*` (the bar held in sustained tension, strain x step sweep).", "",
+              "`bar_tension_long*` (the bar held in sustained tension, strain x step sweep), `vessel_water_stop_paper` "
+              "(the paper's coupling and ring: the paper's version of the vessel) and its `_h*`, `_a*` twins (other "
+              "water smoothing lengths and viscosities), `bar_*_sliding_paper` (axial-only grips), "
+              "`hertz_loadsteps_paper` (the other interior depths).", "",
               "Figures: `figures/solid_bar.png` (deformed bars and shear block), `figures/solid_hertz.png` "
               "(load and peak pressure against indentation), `figures/solid_vessel.png` (Fig. 7 analogue: ring "
               "radial displacement against time, Lame's value, the paper's 58.7 us), `figures/solid_floor.png` "
@@ -80,8 +84,9 @@ def write_timing(run_paths, out):
     Path(out).write_text("\n".join(lines + [""]))
 
 
-def report(runs, claims, outputs):
+def report(runs, claims, outputs, registry=()):
     """Report fragment and timing fragment, outputs[0:2] (workflow entry point); claims: the judged
-    marko2017 table of the claims rule."""
-    write_report(measured_here(claims), runs, outputs[0])
+    marko2017 table of the claims rule; registry: the registry files (their folder is read)."""
+    folder = str(Path(registry[0]).parent) if registry else claims_registry.DEFAULT_DIRECTORY
+    write_report(measured_here(claims, folder), runs, outputs[0])
     write_timing(runs, outputs[1])

@@ -1,14 +1,15 @@
-"""Drive the compiled solid step loop in chunks: one quasi-static load increment at a time.
+"""The solid's stepper (isaflow.driver.drive runs the compiled step loop in chunks): one quasi-static load
+increment, or one fixed-length time history, at a time.
 
 Units: cm, N, s; E in N/cm^2, rho in N s^2/cm^4 (isaflow.core.units).
 """
 
 import logging
-import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from isaflow import driver
 from isaflow.contract import Result
 
 from . import kernels as K
@@ -16,7 +17,7 @@ from . import kernels as K
 log = logging.getLogger("isaflow.solid")
 
 VARIANT_FLAGS = {"paper": (0, 0), "hooke": (1, 1), "objective": (1, 2)}  # (Poisson coupling, shear springs)
-STATUS = {K.RUNNING: "step_limit", K.CONVERGED: "converged", K.UNSTABLE: "escaped", K.NONFINITE: "nonfinite"}
+OUTCOME = {K.CONVERGED: "converged", K.UNSTABLE: "escaped", K.NONFINITE: "nonfinite"}  # kernel codes
 
 
 @dataclass
@@ -82,41 +83,103 @@ class State:
         return int(self.clock[5])
 
 
-def relax(st, tol, max_steps, dt=0.0, min_steps=10, chunk=20000, log_every=10.0, label="", cap=True, vfloor=0.0):
-    """Step until the residual max|F_free| / max|f_link| < tol, instability, or max_steps.
+class Stepper:
+    """One relaxation (or fixed-length stepping) of a State for isaflow.driver.drive: one advance is one
+    compiled chunk of up to ``chunk`` steps (kernels.relax), stopped by the kernel's outcomes (converged:
+    residual below tol once min_steps are done; escaped; nonfinite) or by the budget of max_steps (the
+    driver's ``step_limit``).  sample(stepper): called after every advance (record); the solid is judged by
+    its own residual, not by isaflow.rest, so record returns no rest sample.
 
-    dt = 0: the paper's rule (eqs. 26-27; cap=False: eq. 27 alone, V_max floored at vfloor [cm/s] > 0);
-    dt > 0: that fixed step [s].  Returns (status, message, residual, disk force (2,) N).
-    """
-    if not cap and not vfloor > 0.0 and dt <= 0.0:
-        raise ValueError("relax: eq. 27 without the eq. 26 cap needs a speed floor vfloor > 0 (dt = 0.1 dx / V_max)")
-    poisson, shear = VARIANT_FLAGS[st.variant]
-    b, m = st.block, st.mat
-    done, last = 0, time.perf_counter()
-    t0 = last
-    while True:
-        n = min(chunk, max_steps - done)
-        steps, code, resid, gx, gy = K.relax(
-            st.pos, st.vel, b.ref, st.target, st.free, st.mass, st.size, b.la, b.lb, b.d0, b.axis, b.partners,
-            st.disk, m.E, m.nu, m.G, m.rho, b.dim, poisson, shear, st.push, float(dt), float(tol), min_steps, n,
-            st.sig, st.strain, st.frc, st.pres, st.clock, st.fext, st.damp, int(bool(cap)), float(vfloor))
-        done += steps
-        min_steps = max(0, min_steps - steps)
-        now = time.perf_counter()
-        if now - last > log_every:
-            log.info("%s step %d residual %.3g", label, st.steps, resid)
-            last = now
-        if code != K.RUNNING or done >= max_steps:
-            break
-    st.wall_time += time.perf_counter() - t0
-    status = STATUS[code]
-    msg = {
-        "converged": f"max|F_free| / max|f_link| = {resid:.2e} < {tol:g} at step {st.steps}",
-        "step_limit": f"{max_steps} steps without reaching residual {tol:g} (residual {resid:.2e}) at step {st.steps}",
-        "escaped": f"unstable: a particle moved a full particle width at step {st.steps} (dt {st.clock[3]:.3g} s)",
-        "nonfinite": f"NaN or infinite force or position at step {st.steps}",
-    }[status]
-    return status, msg, float(resid), np.array([gx, gy])
+    A 2D block whose z is inert (z of positions, targets, velocities and loads all 0) steps in the 2D layout
+    (kernels: (N, 2) arrays, 3-component virial), copied from the State at the start and back after every
+    advance; otherwise (or with flat=False) the State's own (N, 3) arrays step in the 3D layout.  dt = 0: the
+    paper's rule (eqs. 26-27; cap=False: eq. 27 alone, V_max floored at vfloor [cm/s] > 0); dt > 0: that fixed
+    step [s]."""
+
+    t0 = 0.0  # the solid's runs have no chain clock (rest_message is never asked: no rest monitor)
+
+    def __init__(self, st, tol, max_steps, dt=0.0, min_steps=10, chunk=20000, label="", cap=True, vfloor=0.0,
+                 sample=None, flat=None):
+        if not cap and not vfloor > 0.0 and dt <= 0.0:
+            raise ValueError("relax: eq. 27 without the eq. 26 cap needs a speed floor vfloor > 0 (dt = 0.1 dx / V_max)")
+        self.st, self.tol, self.max_steps, self.dt, self.min_steps, self.chunk = st, tol, max_steps, dt, min_steps, chunk
+        self.label, self.cap, self.vfloor, self.sample = label, int(bool(cap)), float(vfloor), sample
+        self.poisson, self.shear = VARIANT_FLAGS[st.variant]
+        b = st.block
+        if b.geometry is None:
+            b.geometry = K.link_geometry(b.d0, b.la, b.lb, b.axis, b.n)
+        inert = b.dim == 2 and not any(np.any(x[:, 2]) for x in (b.ref, st.pos, st.target, st.vel, st.fext))
+        self.flat = inert if flat is None else bool(flat) and inert
+        if self.flat:  # the 2D layout: contiguous copies of the x, y columns
+            self.pos, self.vel, self.frc = (np.ascontiguousarray(x[:, :2]) for x in (st.pos, st.vel, st.frc))
+            self.ref, self.target, self.free, self.fext = (np.ascontiguousarray(x[:, :2]) for x in
+                                                             (b.ref, st.target, st.free, st.fext))
+            self.sig, self.strain = np.ascontiguousarray(st.sig[:, :4]), np.ascontiguousarray(st.strain[:, :2])
+            self.vir, self.rot, self.grad = np.zeros((b.n, 3)), np.zeros((b.n, 1)), np.zeros((b.n, 2))
+        else:
+            self.pos, self.vel, self.frc, self.ref, self.target = st.pos, st.vel, st.frc, b.ref, st.target
+            self.free, self.fext, self.sig, self.strain = st.free, st.fext, st.sig, st.strain
+            self.vir, self.rot, self.grad = np.zeros((b.n, 6)), np.zeros((b.n, 9)), np.zeros((b.n, 9))
+        self.anchor, self.box = np.zeros_like(self.pos), np.zeros(4)
+        self.pi, self.pj = np.zeros(1, np.int32), np.zeros(1, np.int32)  # the unlinked pairs (push)
+        self.done, self.code, self.resid, self.g = 0, K.RUNNING, np.inf, np.zeros(2)
+
+    def advance(self):
+        st, b, m = self.st, self.st.block, self.st.mat
+        L0, e, cnt = b.geometry
+        n = min(self.chunk, self.max_steps - self.done)
+        steps, self.code, self.resid, gx, gy, self.pi, self.pj = K.relax(
+            self.pos, self.vel, self.ref, self.target, self.free, st.mass, st.size, b.la, b.lb, L0, e, b.axis, cnt,
+            b.partners, st.disk, m.E, m.nu, m.G, m.rho, b.dim, self.poisson, self.shear, st.push, float(self.dt),
+            float(self.tol), self.min_steps, n, self.sig, self.strain, self.frc, st.pres, st.clock, self.fext,
+            st.damp, self.cap, self.vfloor, self.vir, self.rot, self.grad, self.anchor, self.pi, self.pj, self.box)
+        self.g[:] = gx, gy
+        self.done += steps
+        self.min_steps = max(0, self.min_steps - steps)
+        if self.flat:
+            st.pos[:, :2], st.vel[:, :2], st.frc[:, :2] = self.pos, self.vel, self.frc
+            st.sig[:, :4], st.strain[:, :2] = self.sig, self.strain
+        if self.code == K.RUNNING:
+            return None
+        return OUTCOME[self.code], self.message(OUTCOME[self.code])
+
+    def message(self, status):
+        st, r = self.st, self.resid
+        return {"converged": f"max|F_free| / max|f_link| = {r:.2e} < {self.tol:g} at step {st.steps}",
+                "escaped": f"unstable: a particle moved a full particle width at step {st.steps} (dt {st.clock[3]:.3g} s)",
+                "nonfinite": f"NaN or infinite force or position at step {st.steps}",
+                "step_limit": f"{self.max_steps} steps without reaching residual {self.tol:g} (residual {r:.2e}) at "
+                              f"step {st.steps}"}[status]
+
+    def record(self):
+        if self.sample is not None:
+            self.sample(self)
+
+    def spent(self):
+        return self.done >= self.max_steps
+
+    def fraction_done(self):
+        return self.done / self.max_steps if self.max_steps else 1.0
+
+    def limit_message(self, monitor):
+        return self.message("step_limit")
+
+    def rest_message(self, monitor):
+        return self.message("converged")
+
+    def progress(self, monitor):
+        return f"{self.label} step {self.st.steps} residual {self.resid:.3g}"
+
+    def result(self, run):
+        """(status, message, residual, disk force (2,) N); the loop's time is added to the State's."""
+        self.st.wall_time += run.wall_time
+        return run.status, run.message, float(self.resid), self.g.copy()
+
+
+def relax(st, tol, max_steps, dt=0.0, min_steps=10, chunk=20000, label="", cap=True, vfloor=0.0, sample=None):
+    """Step until the residual max|F_free| / max|f_link| < tol, instability, or max_steps (a Stepper run by
+    isaflow.driver.drive).  Returns (status, message, residual, disk force (2,) N)."""
+    return driver.drive(Stepper(st, tol, max_steps, dt, min_steps, chunk, label, cap, vfloor, sample), log=log.info)
 
 
 def prescribe(st, mask, disp):
@@ -128,12 +191,14 @@ def prescribe(st, mask, disp):
 
 
 def warmup():
-    """Load (or compile) the kernels on a 2-particle chain, so solver times exclude compilation."""
+    """Load (or compile) the relaxation kernels, so solver times exclude compilation: a 2-particle chain in the 2D
+    and the 3D layout (the vessel with water has its own, water.warmup; outputs.write_run calls both)."""
     from .lattice import block
 
-    b = block(2, 1, 1, 1.0)
-    st = State(b, Material(1.0, 0.3, 1.0), "hooke", np.ones((2, 3)), push=1)
-    relax(st, 1e-3, 2)
+    for shape in ((2, 1, 1), (2, 1, 2)):
+        b = block(*shape, 1.0)
+        st = State(b, Material(1.0, 0.3, 1.0), "hooke", np.ones((b.n, 3)), push=1)
+        relax(st, 1e-3, 2)
 
 
 def result(st, case, status, msg, resid, history, params, start=None):

@@ -98,21 +98,23 @@ def history(cfg, dt, snapshot=None):
     if dt > st.dt_max:
         raise ValueError(f"vessel history: dt {dt:.3g} s above the step rule dx / (4 c) = {st.dt_max:.3g} s (eq. 26)")
     every = v["record_every"]
-    n_rec = int(np.ceil(v["history_us"] * US / dt / every))
+    n = every * int(np.ceil(v["history_us"] * US / dt / every))
     t, ui, uo = [0.0], [0.0], [0.0]
     ring_all = np.ones(st.block.n, bool)
-    u_min, u_paper = [0.0], None
-    for _ in range(n_rec):
-        S.relax(st, 0.0, every, dt=dt, min_steps=every, chunk=every, log_every=1e9)
+    u_min, u_paper = [0.0], []
+
+    def sample(_):  # every record_every steps (the stepper's chunk)
         t.append(st.clock[1])
         ur = radial(st, ring_all)
         ui.append(ur[inner].mean())
         uo.append(ur[outer].mean())
         u_min.append(ur.min())
-        if u_paper is None and st.steps >= v["steps"]:
-            u_paper = ur
+        if not u_paper and st.steps >= v["steps"]:
+            u_paper.append(ur)
+
+    S.relax(st, 0.0, n, dt=dt, min_steps=n, chunk=every, label="vessel history", sample=sample)
     if snapshot is not None:
-        snapshot.update(u_paper=u_paper if u_paper is not None else np.full(st.block.n, np.nan), u_min=np.array(u_min))
+        snapshot.update(u_paper=u_paper[0] if u_paper else np.full(st.block.n, np.nan), u_min=np.array(u_min))
     return np.array(t), np.array(ui), np.array(uo), st
 
 

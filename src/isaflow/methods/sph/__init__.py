@@ -4,9 +4,12 @@ Modules: ``kernels`` (numba pair passes and the compiled leapfrog loop),
 ``eos`` (equations of state), ``repulsion`` (Lennard-Jones wall safety net),
 ``particles`` (liquid lattice, wall particles, wall contacts), ``pairs`` (pair
 list, thin-wall visibility, the colouring of the parallel passes), ``settings``
-(config/methods/sph.yaml and its schema), ``solver`` (chunks, rest test,
-outcome -> contract.Result), ``analysis`` (measures, summary, claims, report),
-``figures``, ``workflow`` (what the Snakemake rules call).
+(the values of config/methods/sph.yaml), ``checks`` (plausibility and cost, pure
+Python), ``method`` (the entry isaflow.run calls), ``solver`` (set-up and the
+stepper driver.drive runs -> contract.Result), ``block`` (the periodic block of
+the tensile-instability test), ``quantities`` (what the claims read from SPH run files),
+``outputs`` (the summary table), ``figures``, ``report`` (report and timing
+fragments).
 """
 
 from .. import Method, Variant

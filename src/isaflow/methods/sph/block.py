@@ -226,6 +226,9 @@ class _BlockStepper:
     def spent(self):
         return self.done >= self.n_total
 
+    def fraction_done(self):
+        return self.done / self.n_total
+
     def limit_message(self, monitor):
         return (f"periodic block, {self.done} steps of {self.dt:.4g} s to t = {self.done * self.dt:.4g} s "
                 "(no rest test)")

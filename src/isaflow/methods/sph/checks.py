@@ -37,7 +37,7 @@ FRACTION = (0.0, 1.0, "a fraction of the cell spacing or of h")
 BLOCK_CELLS = 3  # cells of 2h across a periodic block (sph.block: the minimum image)
 BYTES_PER_CELL = 8  # int64 cell start of a cell list
 BYTES_PER_PANEL = 16  # a panel's force (x, y) in the rest window's records (bounded here by one per chunk)
-BYTES_PER_SNAPSHOT_PARTICLE = 16  # a liquid particle's position (x, y) in a position snapshot
+BYTES_PER_SNAPSHOT_PARTICLE = 30  # a liquid particle in a snapshot (driver.drive): position, velocity, pressure, vessel, status
 
 
 def sound_speed(s):
@@ -56,7 +56,8 @@ def lattice(tank, s):
     width, depth = _first_vessel(tank), tank.depth
     n, spacing = s["resolution.particles"], s["resolution.spacing"]
     if spacing is None:
-        spacing = math.sqrt(width * depth / n) if n else float("nan")
+        area = tank.liquid_area or width * depth  # a liquid too thin for its polygon's area: the rectangle's
+        spacing = math.sqrt(area / n) if n else float("nan")
     if not (math.isfinite(spacing) and spacing > 0):
         return 0, 0, float("nan"), float("nan")
     nx, ny = width / spacing, depth / spacing
@@ -160,7 +161,8 @@ def cost(tank, s, particles=None):
     parts = [(n * (BYTES_PER_PARTICLE + BYTES_PER_PAIR * neighbours), by_liquid), (chunks * 200, by_chunks),
              (grid * BYTES_PER_CELL, tank_field(tank, "walls")),
              (panels * BYTES_PER_PANEL * (chunks + 4), "settings.panel_length" if panels > chunks else by_chunks),
-             (len(s["settings.snapshot_times"]) * liquid * BYTES_PER_SNAPSHOT_PARTICLE, "settings.snapshot_times")]
+             (s["settings.snapshot_megabytes"] * 1e6 + 3 * liquid * BYTES_PER_SNAPSHOT_PARTICLE,
+              "settings.snapshot_megabytes")]
     fields = {"particles": by_liquid, "steps": _steps_field(s, n, by_liquid), "bytes": max(parts, key=lambda p: p[0])[1]}
     return [budget.Cost(n, steps, sum(p[0] for p in parts), NS_PER_PARTICLE_STEP, fields,
                         f"t = {s[t_key]:g} s / dt = {dt:.3g} s")]

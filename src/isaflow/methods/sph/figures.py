@@ -77,17 +77,22 @@ def flow(paths, out):
     save(fig, out)
 
 
-def snapshots(path, out):
-    """Snapshots of one flow run at the recorded times."""
+SNAPSHOT_TIMES = (0.0, 0.25, 0.5, 1.0, 2.0, 4.0)  # s after the opening: the drain (about 2 s) and after
+
+
+def snapshots(path, out, times=SNAPSHOT_TIMES):
+    """Snapshots of one flow run: the recorded ones nearest ``times`` (s after the opening), titled with their own."""
     ds = runfile.read(path)
-    t = ds["snap_time"].values - float(ds.attrs.get("start_time", 0.0))  # time since the opening
+    t_all = ds["snap_time"].values - float(ds.attrs.get("start_time", 0.0))  # time since the opening
+    keep = sorted({int(np.argmin(np.abs(t_all - t))) for t in times})
+    t, pos = t_all[keep], ds["snap_pos"].values[keep]
     n = len(t)
     fig, axes = plt.subplots((n + 1) // 2, 2, figsize=(12, 3.3 * ((n + 1) // 2) + 0.8), squeeze=False)
     for k, ax in enumerate(axes.ravel()):
         if k >= n:
             ax.axis("off")
             continue
-        ax.scatter(*ds["snap_pos"].values[k].T, s=max(0.5, 1000 / ds.sizes["particle"]), color="tab:blue")
+        ax.scatter(*pos[k].T, s=max(0.5, 1000 / ds.sizes["particle"]), color="tab:blue")
         _walls(ax, ds)
         ax.set(aspect="equal", ylabel="y (cm)", title=f"{t[k]:.2f} s after the opening",
                xlabel="x (cm)" if k >= n - 2 else "")  # the bottom panel of each column: no label under a title

@@ -1,9 +1,11 @@
 """Initial liquid lattice and wall (boundary) particles of a tank (NumPy, setup only).
 
 Units cm.  The liquid fills the first vessel to the tank's depth on a
-rectangular lattice of nx x ny cells (dx, dy) = (B / nx, depth / ny), one
-particle per cell centre, so the cells tile the liquid exactly and every
-particle weighs W / (nx ny).  Wall particles continue that lattice behind
+lattice of nx x ny cells (dx, dy) = (B / nx, depth / ny) over the vessel's
+width B, one particle per cell centre inside the vessel's polygon half a cell
+from its walls (core.geometry.inside_vessel: in a rectangular vessel every
+cell, so the cells tile the liquid exactly), and every particle weighs W / N.
+Wall particles continue that lattice behind
 each wall (Adami et al. 2012: layers of fixed particles covering the kernel
 support), anchored to the liquid lattice's origin so that a straight wall
 sees the same lattice on both sides.
@@ -11,22 +13,29 @@ sees the same lattice on both sides.
 
 import numpy as np
 
+from ...core.geometry import inside_vessel
 from ...core.neighbours import build_pairs
 
 
-def lattice_shape(width, depth, particles=None, spacing=None):
+def lattice_shape(width, depth, particles=None, spacing=None, area=None):
     """(nx, ny): cells across the width and the depth [cm] for a target particle
-    count or a target spacing [cm] (cells as close to square as the counts allow)."""
+    count or a target spacing [cm] (cells as close to square as the counts allow);
+    area [cm^2]: the liquid's (a polygonal vessel's), width x depth if not given."""
     if spacing is None:
-        spacing = np.sqrt(width * depth / particles)
+        spacing = np.sqrt((width * depth if area is None else area) / particles)
     return max(1, int(round(width / spacing))), max(1, int(round(depth / spacing)))
 
 
-def liquid_lattice(x0, floor_y, width, depth, nx, ny):
-    """(nx ny, 2) cell centres [cm], row by row from the floor; and (dx, dy) [cm]."""
+def liquid_lattice(x0, floor_y, width, depth, nx, ny, vessel=None, walls=()):
+    """(N, 2) cell centres [cm], row by row from the floor; and (dx, dy) [cm].  vessel: the vessel's polygon
+    [(x, y)] (tank.vessel_polygon): only the centres inside it half a cell from its edges and the walls (W, 4)
+    (core.geometry.inside_vessel); None: all nx ny."""
     dx, dy = width / nx, depth / ny
     gx, gy = np.meshgrid(x0 + (np.arange(nx) + 0.5) * dx, floor_y + (np.arange(ny) + 0.5) * dy)
-    return np.column_stack([gx.ravel(), gy.ravel()]), (dx, dy)
+    pos = np.column_stack([gx.ravel(), gy.ravel()])
+    if vessel is not None:
+        pos = pos[inside_vessel(pos, vessel, walls, 0.5 * min(dx, dy))]
+    return pos, (dx, dy)
 
 
 def hydrostatic_heights(y, floor_y, depth, rho_ratio):

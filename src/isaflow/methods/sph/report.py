@@ -6,6 +6,8 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+from ...figures.animation import report_line
+
 def _fmt(x, f=".3g"):
     return "n/a" if x is None or (isinstance(x, float) and not np.isfinite(x)) else format(x, f)
 
@@ -53,7 +55,9 @@ def fragment(df):
         out.append(f"| {r.stability_case}: {r.stability_label} | {r.particles} | {r.status} | {r.sim_time_s:.2f} | "
                    f"{r.rms_speed_cm_s:.3g} |")
     out += ["", "Figures: `figures/sph_single.png` (particles coloured by pressure, per-panel loads against "
-            "hydrostatics), `figures/sph_flow.png` (final flow states and surfaces), `figures/sph_flow_snapshots.png`.", ""]
+            "hydrostatics), `figures/sph_flow.png` (final flow states and surfaces), `figures/sph_flow_snapshots.png`.", "",
+            report_line("figures/sph_flow_animation.gif", "the finest WCSPH flow (flow_wcsph_dx2.5), particles coloured "
+                        "by speed"), ""]
     return "\n".join(out)
 
 

@@ -15,6 +15,20 @@ DEFAULT_PATH = Path(__file__).resolve().parents[4] / "config" / "methods" / "sph
 
 _POS = {"type": "number", "exclusiveMinimum": 0}
 _NONNEG = {"type": "number", "minimum": 0}
+
+
+def own_tank(tank, settings):
+    """The overrides ('key=value') of a run on a tank no settings file was written for (isaflow compare), given the
+    run's resolved settings: settings.max_drop, the largest free fall in the project's tanks (72.5 cm of liquid over
+    a 50 cm step), at least the tank's own (the liquid's top above its lowest wall point: the sound speed keeps the
+    Mach number at 0.1) and at most what the tank allows (the checks' bound, its escape box's height); a longer
+    assumed fall only raises the sound speed, and with it the artificial viscosity's damping."""
+    low = min(min(w["from"][1], w["to"][1]) for w in tank.spec["walls"])
+    box = tank.escape_box()
+    drop = max(tank.floor_y(0) + tank.depth - low, min(settings["settings.max_drop"], box[3] - box[1]))
+    return () if drop == settings["settings.max_drop"] else (f"settings.max_drop={drop!r}",)
+
+
 SETTINGS = {
     "kernel": {"enum": ["cubic_spline", "wendland_c2"]},
     "h_factor": _POS,            # h / spacing
@@ -34,7 +48,9 @@ SETTINGS = {
     "t_max_flow": _POS,          # s
     "chunk_time": _POS,          # s
     "panel_length": _POS,        # cm
-    "snapshot_times": {"type": "array", "items": _NONNEG},
+    "snapshot_every_single": _POS,  # s between snapshots (driver.Recording), single vessel
+    "snapshot_every_flow": _POS,    # s between snapshots, a tank of vessels
+    "snapshot_megabytes": _POS,     # 10^6 bytes the kept snapshots may take before they are thinned
     "domain": {"enum": ["tank", "periodic_block"]},  # the tank's walls, or its liquid lattice made periodic (block)
     "stretch": {"type": "number", "exclusiveMinimum": -0.5, "maximum": 1.0},  # block: uniform linear strain
     "perturbation": _NONNEG,     # block: random initial displacement / spacing

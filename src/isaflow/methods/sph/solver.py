@@ -25,6 +25,7 @@ from ...core import smoothing
 from ...core.geometry import bounding_box
 from ...core.panels import wall_panels
 from ...core.units import DENSITY_2D, G, VELOCITY
+from ...inputs import InputError
 from ...tank import vessel_counts
 from . import kernels as K
 from . import particles as P
@@ -88,8 +89,12 @@ def setup(tank, s, resolution, start=None, on_wall=False):
         acc = start["acceleration"].values.copy() if "acceleration" in start else None
         depth0 = float(start.attrs.get("initial_depth", tank.depth))
     else:
-        nx, ny = P.lattice_shape(x1 - x0, tank.depth, resolution.get("particles"), resolution.get("spacing"))
-        pos, (dx, dy) = P.liquid_lattice(x0, floor_y, x1 - x0, tank.depth, nx, ny)
+        nx, ny = P.lattice_shape(x1 - x0, tank.depth, resolution.get("particles"), resolution.get("spacing"),
+                                 tank.liquid_area)
+        pos, (dx, dy) = P.liquid_lattice(x0, floor_y, x1 - x0, tank.depth, nx, ny, tank.vessel_polygon(0), tank.walls)
+        if len(pos) < 2:
+            raise InputError(f"{tank.path}: field 'liquid.depth': {len(pos)} cell(s) of {dx:.3g} x {dy:.3g} cm lie half "
+                             f"a cell inside the first vessel below the depth; a liquid needs at least 2")
         vel = np.zeros_like(pos)
         mass = tank.weight / len(pos) / G
     h = s["h_factor"] * math.sqrt(dx * dy)
@@ -241,7 +246,6 @@ class _Stepper:
         self.window, self.lj_window = collections.deque(maxlen=n_window), collections.deque(maxlen=n_window)
         self.vessels = tank.vessels
         self.rec = collections.defaultdict(list)
-        self.snaps = sorted(s["snapshot_times"])
         self.t0, self.step0 = st["t0"], st["step0"]
         self.done_total, self.builds = 0, 0
         self.ke = 0.5 * st["mass"] * float(np.sum(self.v * self.v))
@@ -254,11 +258,6 @@ class _Stepper:
     def advance(self):
         """One chunk; (status, message) if the kernel stopped on a particle, else None."""
         x, nf, dt = self.x, self.nf, self.dt
-        t = self.t0 + self.done_total * dt
-        while self.snaps and self.snaps[0] <= self.done_total * dt + 0.5 * dt:
-            self.rec["snap_time"].append(t)
-            self.rec["snap_pos"].append(x[:nf].copy())
-            self.snaps.pop(0)
         n = min(self.n_chunk, self.n_total - self.done_total)
         self.force_sum[:] = 0.0
         self.panel_sum[:] = 0.0
@@ -296,6 +295,26 @@ class _Stepper:
 
     def spent(self):
         return self.done_total >= self.n_total
+
+    def fraction_done(self):
+        return self.done_total / self.n_total
+
+    def clock(self):
+        """(chain time s, chain step) of the current state (driver.drive's snapshots)."""
+        return self.t, self.step0 + self.done_total
+
+    def state(self):
+        """Copies of the liquid's positions, velocities and pressures (driver.drive's snapshots)."""
+        return {"pos": self.x[:self.nf].copy(), "velocity": self.v[:self.nf].copy(), "pressure": self.p[:self.nf].copy()}
+
+    def recording(self):
+        """The driver's Recording of this run: snapshots every settings.snapshot_every_single s (single vessel) or
+        _flow s (a tank of vessels), within snapshot_megabytes; the tank's walls, vessels and box; the strip
+        width sqrt(dx dy) of the free surface."""
+        s = self.s
+        return driver.Recording(s["snapshot_every_flow"] if self.flow else s["snapshot_every_single"],
+                                s["snapshot_megabytes"], self.walls, self.vessels, tuple(self.box),
+                                math.sqrt(self.st["dx"] * self.st["dy"]))
 
     def rest_message(self, monitor):
         return (f"at rest: e = KE / (W h) < {self.rest_cfg['energy_ratio']:g} for {self.rest_cfg['window']:g} s from "
@@ -337,9 +356,6 @@ class _Stepper:
                                       "force of each wall on the liquid, mean over the chunk"),
             "sample_vessel_count": (("sample", "vessel"), np.array(rec["sample_vessel_count"], np.int64), "1",
                                     "liquid particles in each vessel"),
-            "snap_time": (("snapshot",), np.array(rec["snap_time"]), "s", "chain time of the position snapshot"),
-            "snap_pos": (("snapshot", "particle", "xy"), np.array(rec["snap_pos"]).reshape(-1, nf, 2), "cm",
-                         "liquid particle positions"),
             "contact_side": (("contact",), side.astype(np.int8), "1",
                              "wall face of the panel: 0 its front (left, liquid side), 1 its back (thin dividing wall)"),
         }
@@ -368,7 +384,7 @@ class _Stepper:
             t_max=t_max, panel_length=s["panel_length"], load_window=len(window) * n_chunk * dt,
             resolution=str(resolution) if start is None else "continued", on_wall=str(bool(on_wall)),
             threads=int(self.threads), layer_pitch=st["dy"], held_weight=held, initial_depth=initial_depth,
-            tank_difference="; ".join(diff), final_rms_speed=math.sqrt(2 * ke / (st["mass"] * nf)),
+            tank_difference="; ".join(diff),
             particles_left=left, list_builds=self.builds)
         return Result(
             method="sph", variant="custom", pos0=st["pos"], pos=x[:nf].copy(), weight=np.full(nf, st["mass"] * G),
@@ -381,4 +397,5 @@ class _Stepper:
 def _run(tank, s, resolution, start, on_wall, t_max, log, threads=1):
     """Set up the run (setup) and drive it (driver.drive) -> contract.Result; arguments as solve's."""
     rest_cfg = R.load()
-    return driver.drive(_Stepper(tank, s, resolution, start, on_wall, t_max, threads, rest_cfg), rest_cfg, log)
+    stepper = _Stepper(tank, s, resolution, start, on_wall, t_max, threads, rest_cfg)
+    return driver.drive(stepper, rest_cfg, log, recording=stepper.recording())

@@ -3,10 +3,12 @@
 Merino-Alonso, Macia & Souto-Iglesias (2020), abstract only: a liquid column
 at rest, the SPH momentum balance grad p = -rho g at every particle, the kernel
 truncated at the free surface; A p = b is solved directly (no time stepping).
-Modules: ``system`` (assembly, banded), ``column`` (one solve), ``closed_form``
-(one neighbour per side), ``sweep`` (N x h/dx x kernel, the classification), ``figures``,
-``report``, ``claims`` (the measures of the abstract's claims in
-config/claims/merino_alonso2020.yaml).  A 1D static study: it writes its own tables, not the 2D contract.
+Modules: ``system`` (assembly, banded), ``column`` (one solve), ``condition`` (its
+condition number, deterministically), ``closed_form`` (one neighbour per side), ``sweep``
+(N x h/dx x kernel, the classification), ``settings`` and ``checks`` (the values of
+config/methods/sph1d.yaml, plausibility and cost), ``pipeline`` (what the rules call),
+``figures``, ``report``, ``quantities`` (what the rows of config/claims/merino_alonso2020.yaml read from
+the sweep).  A 1D static study: it writes its own tables, not the 2D contract.
 """
 
 from isaflow.methods import Method, Variant

@@ -8,11 +8,12 @@ from pathlib import Path
 import pandas as pd
 import xarray as xr
 
-from isaflow import runfile
+from isaflow import claims_registry, runfile
 from isaflow.core import jit
+from isaflow.inputs import InputError, load as load_yaml
 from isaflow.methods import registry
 
-from . import claims, figures, report, settings, sweep
+from . import figures, report, settings, sweep
 
 log = logging.getLogger("isaflow.methods.sph1d")
 
@@ -23,6 +24,19 @@ def _logging():
     log.addHandler(handler)
     log.setLevel(logging.INFO)
     return handler
+
+
+def rule_of_file(path):
+    """(settle_band, round_off) of the classification rule of a claims registry file (config/claims/
+    merino_alonso2020.yaml: its rows' tolerance.parameters), the same in every row that states it (InputError naming
+    the file otherwise): the method's tables and figures classify with it, so they agree with the claims."""
+    _, spec = load_yaml(path, claims_registry.SCHEMA, "claims registry file")
+    found = {(float(p["settle_band"]), float(p["round_off"])) for c in spec["claims"]
+             for p in [c.get("tolerance", {}).get("parameters", {})] if "settle_band" in p}
+    if len(found) != 1:
+        raise InputError(f"{path}: the rows state {len(found)} different classification rules "
+                         "(tolerance.parameters settle_band, round_off); exactly one is needed")
+    return found.pop()
 
 
 def run_sweep(settings_path, outputs, resolution=None):
@@ -45,9 +59,9 @@ def run_sweep(settings_path, outputs, resolution=None):
 
 def make_cases(sweep_nc, registry, outputs):
     """outputs: the case table and the summary table, classified by the rule of the claims registry file
-    ``registry`` (claims.rule_of_file), over the sweep's window."""
+    ``registry`` (rule_of_file), over the sweep's window."""
     cases_csv, summary_csv = outputs
-    band, round_off = claims.rule_of_file(registry)
+    band, round_off = rule_of_file(registry)
     with xr.open_dataset(sweep_nc) as ds:
         cases = sweep.classify(ds.load(), int(ds.attrs["classify_window"]), band, round_off)
     cases.to_csv(cases_csv, index=False, float_format="%.6g")
@@ -76,7 +90,7 @@ def make_figures(settings_path, sweep_nc, cases_csv, outputs, surface_nc=None, r
         labels = {v: lc for v, lc in _labels().items() if v in s["variants"]}
         surface = None
         if surface_nc:
-            band, round_off = claims.rule_of_file(registry)
+            band, round_off = rule_of_file(registry)
             with xr.open_dataset(surface_nc) as ds:
                 surface = sweep.classify(ds.load(), int(ds.attrs["classify_window"]), band, round_off)
             surface = surface[surface.variant == default]
@@ -95,7 +109,7 @@ def make_report(settings_path, sweep_nc, cases_csv, summary_csv, registry, outpu
         s = settings.checked_values(settings_path)
         cases, summary = pd.read_csv(cases_csv), pd.read_csv(summary_csv)
         variants = list(s["variants"])
-        band, round_off = claims.rule_of_file(registry)
+        band, round_off = rule_of_file(registry)
         with xr.open_dataset(sweep_nc) as ds:
             nmax, secs = int(ds.n[-1]), float(ds.attrs["solve_seconds"])
             ns = [int(n) for n in ds.n.values[-int(ds.attrs["classify_window"]):]]

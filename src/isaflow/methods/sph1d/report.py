@@ -1,7 +1,7 @@
 """Report fragment and timing of the 1D study, generated from the case table (sweep.classify).
 
 The abstract's claims are judged by isaflow.claims from the registry (config/claims/merino_alonso2020.yaml,
-measures in methods/sph1d/claims.py); this fragment describes the sweep and states the classification rule
+quantities in methods/sph1d/quantities.py); this fragment describes the sweep and states the classification rule
 with the registry's numbers.  Units: errors relative to ||p_exact||_2 (1), h/dx (1).
 """
 

@@ -7,7 +7,8 @@ isaflow.inputs.InputError with one line naming the file and the field.
 from isaflow import preflight
 from isaflow import settings as S
 
-KERNELS = ("cubic_spline", "wendland_c2", "wendland_c4", "wendland_c6")  # core.smoothing.NAMES (tested equal)
+KERNELS = ("cubic_spline", "wendland_c2", "wendland_c4", "wendland_c6", "wendland_c2_1d", "wendland_c4_1d",
+           "wendland_c6_1d")  # core.smoothing.NAMES (tested equal): the Wendland functions in their 3D and 1D forms
 GRADIENT_FORMS = ("symmetric", "plain")  # system.GRADIENT_FORMS (tested equal)
 FLOORS = ("mirror_hydrostatic", "mirror_equal", "truncated")  # system.FLOORS (tested equal)
 

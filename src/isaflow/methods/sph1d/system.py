@@ -80,13 +80,12 @@ def assemble_banded(n, height, ratio, kind, norm, c_self, beta, rho_g, kl, top_g
     ab = np.zeros((3 * kl + 1, n))
     b = np.full(n, -rho_g)
     for i in range(n):
-        zi = (i + 0.5) * dx
         lo = max(0, i - kl)
         hi = min(n, i + kl + 1)
         for j in range(lo, hi):
             if j == i:
                 continue
-            s = zi - (j + 0.5) * dx
+            s = (i - j) * dx  # an integer multiple of dx: no round-off of the two positions
             if abs(s) >= reach:
                 continue
             g = vol * _phi(kind, norm, h, s)
@@ -94,7 +93,7 @@ def assemble_banded(n, height, ratio, kind, norm, c_self, beta, rho_g, kl, top_g
             ab[2 * kl, i] += c_self * g
         for k in range(0, hi if beta >= 0.0 else 0):  # ghosts: distance z_i + z_k = (i + k + 1) dx
             zk = (k + 0.5) * dx
-            s = zi + zk
+            s = (i + k + 1) * dx  # z_i + z_k, as above
             if s >= reach:
                 break
             g = vol * _phi(kind, norm, h, s)

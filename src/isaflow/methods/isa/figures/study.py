@@ -1,6 +1,6 @@
 """Study figures: error against run time, stability map.  Drawn from the study tables
-(figures/error_vs_runtime.csv, results/study/stability_map.csv, figures/stability_cases.csv),
-which isaflow.tables builds from the run files."""
+(results/isa/study/error_vs_runtime.csv, stability_map.csv, stability_cases.csv), which
+methods.isa.tables builds from the run files."""
 
 import textwrap
 

@@ -1,6 +1,6 @@
 """The headline findings about the paper's method (results/report/findings.md, the report's summary), from the
 metrics and calibration tables.  Every claim's verdict is computed by isaflow.claims from the registry
-(config/claims/papadopoulos2016.yaml) and methods.isa.claims; this file states findings, no verdict."""
+(config/claims/papadopoulos2016.yaml) and methods.isa.quantities; this file states findings, no verdict."""
 
 import numpy as np
 import pandas as pd

@@ -4,6 +4,7 @@ import pandas as pd
 from ....report import md_table, write
 from ....inputs import read_yaml
 from ....settings import plain
+from ....figures.animation import report_line
 
 RUN_IDS = ("run ids: `flow_incomplete` (application 3: from `single_coarse`'s state to step 100,000), "
            "`flow_complete` (application 4: continues it), `_capped` the named variant that reaches f_tol, "
@@ -31,5 +32,8 @@ def flow_section(metrics, config, outputs):
             "Vessel 2 columns describe the receiving vessel: level = mean top particle per strip above its floor; "
             "slope and range of that profile (a liquid at rest: about 0); K = sigma_xx / sigma_yy of its interior "
             "(a fluid: 1; above 1 the inflow's lateral stress is locked in). Table 1 with our step counts and "
-            "times: [`figures/table1.md`](../figures/table1.md) (times in [`docs/timing.md`](timing.md)).", ""]
+            "times: `results/isa/table1.md`, made by the workflow and not tracked (its times change from run to "
+            "run; they are in [`docs/timing.md`](timing.md)).", "",
+            report_line("figures/isa_flow_animation.gif", "the paper's coarse flow (applications 3-4), particles "
+                        "coloured by |F|"), ""]
     write(text, outputs[0])

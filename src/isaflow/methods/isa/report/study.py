@@ -1,4 +1,4 @@
-"""Report section: error against run time, FIRE, stability map and extreme cases (config/study.yaml)."""
+"""Report section: error against run time, FIRE, stability map and extreme cases (config/methods/isa_study.yaml)."""
 
 from pathlib import Path
 
@@ -57,8 +57,8 @@ def report_section(errors, fire_ratio, fire_grid, stability_map, cases, study_co
          f"({', '.join(f'a = {a:g} cm' for a in sorted(err['a_cm'].unique(), reverse=True))}), du from "
          f"{err['du_factor'].min():g}x to {err['du_factor'].max():g}x the paper's rule du = w / (10 k_p), and the "
          "three update rules (`paper`; the variants `capped` and `fire`, not in the paper). Full table with "
-         "wall-clock times (a timing file): [`figures/error_vs_runtime.csv`](../figures/error_vs_runtime.csv); "
-         "figure `figures/error_vs_runtime.png`.", "",
+         "wall-clock times (a timing file, made by the workflow and not tracked): "
+         "`results/isa/study/error_vs_runtime.csv`; figure `figures/error_vs_runtime.png` (not tracked either).", "",
          "**What resolution buys** (capped equilibrium at the paper's du; range over all converged runs of the "
          "lattice):", "", md_table(res), "",
          "**Which configuration to pick**: for each target, the converged run with the least work (particle-steps) "
