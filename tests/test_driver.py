@@ -170,3 +170,15 @@ def test_at_rest_numbers_of_a_run():
     moved = driver.drive(Moving([1.0, 1e-4], budget=40, fall=5), REST, recording=recording(1.0))
     assert moved.status == "converged" and moved.measures["surface_drift"][1][0] == -3.0
     assert math.isclose(float(m["residual_speed_ratio"][1]), math.sqrt(2e-4))
+
+
+def test_snapshot_field_beyond_single_precision_is_written_in_double():
+    """A run that blows up (SPH's stab_on_wall: a velocity of 7.5e49 cm/s at its escape) keeps its snapshot
+    values as they were, in double precision, instead of inf (a run file never holds inf); ordinary values stay
+    single, and a non-finite one becomes NaN (explained by the variable's attrs['missing'])."""
+    from isaflow.driver import _single
+
+    big = _single([[[7.5e49, 1.0]]])
+    assert big.dtype == np.float64 and big[0, 0, 0] == 7.5e49
+    small = _single([[[1.5, np.inf]]])
+    assert small.dtype == np.float32 and small[0, 0, 0] == np.float32(1.5) and np.isnan(small[0, 0, 1])

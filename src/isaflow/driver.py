@@ -32,7 +32,8 @@ nearest each multiple of ``Recording.every`` on this run's clock (s since t0 for
 steps since the run's first step for a static one), and the state at the stop; with each its time and step,
 every particle's vessel (rest.vessel_of) and status (rest.STATUS, past a wall or not); positions
 in double precision, velocities, pressures and forces in single (7 digits: states to look at; every measure
-is computed from the double-precision state).  When the kept snapshots would take more than
+is computed from the double-precision state), in double only where a value exceeds single precision's range
+(a run that blew up).  When the kept snapshots would take more than
 ``Recording.megabytes`` (at least two are kept), every other one is dropped and the interval doubles, so a
 run file's snapshots stay within that size, evenly spaced (and the stop), whatever the run's length.
 
@@ -119,10 +120,11 @@ class _Snapshots:
     def take(self, stepper, clock, index):
         """Keep the current state as snapshot ``index`` of the grid; returns it (double precision)."""
         raw = stepper.state()
-        state = {k: np.asarray(v, float if k == "pos" else np.float32) for k, v in raw.items()}
+        state = {k: np.array(v, float) for k, v in raw.items()}  # single precision is chosen in history()
         out = AT.outside_tank(state["pos"], self.rec.walls, self.rec.box)
-        if self.limit is None:  # the bytes of one snapshot: its arrays, the vessel and status (one byte each)
-            size = sum(a.nbytes for a in state.values()) + 2 * len(state["pos"])
+        if self.limit is None:  # the bytes of one snapshot as written: positions in double, the other arrays
+            # in single precision, the vessel and status (one byte each)
+            size = state["pos"].nbytes + sum(4 * a.size for k, a in state.items() if k != "pos") + 2 * len(state["pos"])
             self.limit = max(2, int(self.rec.megabytes * 1e6 // size))
         self.past = out if self.past is None else self.past | out
         self.taken.append((index, clock, state, out))
@@ -165,7 +167,7 @@ class _Snapshots:
             arrays["snap_time"] = np.array([c[0] for c in clocks], float)
         for key in ("velocity", "pressure", "force"):
             if key in states[0]:
-                arrays[f"snap_{key}"] = np.array([s[key] for s in states], np.float32)
+                arrays[f"snap_{key}"] = _single([s[key] for s in states])
         what = {"snap_time": "chain time of the snapshot", "snap_step": "step of the snapshot (from the chain's start)",
                 "snap_pos": "particle positions at the snapshot", "snap_velocity": "particle velocities at the snapshot",
                 "snap_pressure": "particle pressures at the snapshot",
@@ -181,6 +183,17 @@ class _Snapshots:
         return {k: (SHARED_HISTORY[k][0], a, SHARED_HISTORY[k][1], what[k],
                     {"cadence": cadence, **(missing if a.dtype.kind == "f" and np.isnan(a).any() else {})})
                 for k, a in arrays.items()}
+
+
+def _single(states):
+    """The snapshots' arrays of one field in single precision (7 digits: states to look at), or in double where
+    a value lies beyond single precision's range (a run blowing up: its escape is then written as it was, not as
+    inf); a non-finite value becomes NaN, which the variable's attrs['missing'] explains."""
+    a = np.array(states, float)
+    finite = np.isfinite(a)
+    a[~finite] = np.nan
+    big = np.abs(a[finite]).max(initial=0.0) > np.finfo(np.float32).max
+    return a if big else a.astype(np.float32)
 
 
 class _Window:
