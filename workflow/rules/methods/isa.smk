@@ -119,8 +119,8 @@ use rule call as isa_fig_calibration with:
 
 use rule call as isa_fig_convergence with:
     input:
-        inputs=[isa_file(r) for r in ["single_coarse", "single_coarse_capped", "single_coarse_nocycle", "single_refined",
-                                      "single_refined_capped", "single_refined_nocycle"]],
+        inputs=[isa_file(r) for r in ["single_coarse", "single_coarse_capped", "single_coarse_paper", "single_refined",
+                                      "single_refined_capped", "single_refined_paper"]],
         code=code("methods.isa.figures.single"),
     output:
         figure("convergence_single"),

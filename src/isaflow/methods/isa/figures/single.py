@@ -260,20 +260,22 @@ def calibration_figure(inputs, outputs, paper_levels=None, adopted=None):
 
 
 def convergence_figure(inputs, outputs):
-    """max|F| against the step: the paper's update and the capped variant; a run of the paper's update with the cycle
-    stop off (the paper's own stop rule, on which the claims are judged) is drawn as its last max|F| band at the
-    right edge, with the step it reached."""
+    """max|F| against the step: the paper's update and the capped variant (the project's kept inputs, k_p = 500 N/cm,
+    with its cycle stop); the paper's version (k_p = k_b / 2 and the paper's own stop rule, no cycle stop: the run
+    the claims are judged on) is drawn as its last max|F| band at the right edge, with the step it reached."""
     runs = [read(p) for p in inputs]
-    scenes = list(dict.fromkeys(case_name(ds) for ds in runs))
+    lattice = lambda ds: (ds.attrs["tank"], len(ds["pos"]))  # noqa: E731  (the paper's version: its own resolution)
+    scenes = list(dict.fromkeys(lattice(ds) for ds in runs))
     fig, axes = plt.subplots(1, len(scenes), figsize=(6 * len(scenes), 4.2), squeeze=False)
     for ax, sc in zip(axes[0], scenes):
-        here = [d for d in runs if case_name(d) == sc]
+        here = [d for d in runs if lattice(d) == sc]
         xmax = max(int(d["steps"]) for d in here if int(d.attrs.get("stop_on_cycle", 1)))
         for ds in (d for d in here if not int(d.attrs.get("stop_on_cycle", 1))):
             lo, hi = float(ds["hist_fmax_lo"].values[-10:].min()), float(ds["hist_fmax_hi"].values[-10:].max())
             ax.errorbar([xmax * 1.03], [np.sqrt(lo * hi)], yerr=[[np.sqrt(lo * hi) - lo], [hi - np.sqrt(lo * hi)]],
                         color="tab:purple", capsize=4, lw=2,
-                        label=f"paper, cycle stop off (its own rule; claims judged on it):\n-> {ds.attrs['status']} "
+                        label=f"the paper's version (k_p = k_b / 2, its own stop rule; claims judged on it):\n"
+                              f"-> {ds.attrs['status']} "
                               f"at step {int(ds['steps']):,}, last band {lo:.3g}-{hi:.3g} N (right edge)")
         for ds in (d for d in here if int(d.attrs.get("stop_on_cycle", 1))):
             a = ds.attrs
@@ -290,7 +292,7 @@ def convergence_figure(inputs, outputs):
         ax.set_yscale("log")
         ax.set_xlabel("algorithm step")
         ax.set_ylabel("max|F| (N)")
-        ax.set_title(sc)
+        ax.set_title(case_name(here[0]))
         legend_below(ax, ncol=1, handlelength=2.5)
     fig.suptitle("Convergence of the single-vessel runs (band: min-max of max|F| over each record stride)")
     save(fig, outputs)
