@@ -289,6 +289,8 @@ def closing(df, registry, figures=None, baseline=None):
         viewed = [(n, f) for n, f in figures.items() if f.get("viewed")]
         out += ["", f"**Figures viewed ({len(viewed)} of the {len(figures)} with a caption).** Each was opened as a "
                 "picture; what it shows:", ""]
-        out += [f"- `figures/{n}.png` (viewed {f['viewed']['date']}): {cell(f['viewed']['shows'])}" for n, f in viewed]
+        ext = lambda n: "gif" if n.endswith("_animation") else "png"  # noqa: E731  (figures.animation writes GIFs)
+        out += [f"- `figures/{n}.{ext(n)}` (viewed {f['viewed']['date']}): {cell(f['viewed']['shows'])}"
+                for n, f in viewed]
     out.append("")
     return out
