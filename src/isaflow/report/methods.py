@@ -91,7 +91,8 @@ def methods_section(table, outputs, tanks=()):
             "(kinetic energy / (W h) below the ratio of `config/rest.yaml` for its window) or their time limit; "
             "'at rest' is written only when met, and a dynamic run still moving at its time limit has no end state to compare (its row says so, its cells are empty). Every difference of a run's liquid from the tank is in the last "
             "column. All columns: [`docs/tables/methods_compare.csv`](tables/methods_compare.csv); solver times "
-            "against errors: `figures/methods_error_vs_runtime.png` (a timing figure), `figures/methods_tanks.png`.",
+            "against errors: `figures/methods_error_vs_runtime.png` (a timing figure, made by the run and not tracked); "
+            "the same errors, tracked: [`figures/methods_tanks.png`](../figures/methods_tanks.png).",
             ""]
     for tank, g in df.groupby("tank", sort=False):
         t, theory, recv = tank_table(g)

@@ -58,7 +58,9 @@ def report_section(errors, fire_ratio, fire_grid, stability_map, cases, study_co
          f"{err['du_factor'].min():g}x to {err['du_factor'].max():g}x the paper's rule du = w / (10 k_p), and the "
          "three update rules (`paper`; the variants `capped` and `fire`, not in the paper). Full table with "
          "wall-clock times (a timing file, made by the workflow and not tracked): "
-         "`results/isa/study/error_vs_runtime.csv`; figure `figures/error_vs_runtime.png` (not tracked either).", "",
+         "`results/isa/study/error_vs_runtime.csv`; figure `figures/error_vs_runtime.png` (not tracked either); "
+         "the same errors against the work (particle-steps, the same in every run), tracked: "
+         "[`figures/error_vs_work.png`](../figures/error_vs_work.png).", "",
          "**What resolution buys** (capped equilibrium at the paper's du; range over all converged runs of the "
          "lattice):", "", md_table(res), "",
          "**Which configuration to pick**: for each target, the converged run with the least work (particle-steps) "
