@@ -19,11 +19,12 @@ SRC = ROOT / "src" / "isaflow"
 NAMES = ({m for m in methods.PACKAGES} | {v for m in methods.registry().values() for v in m.variants}) - {"paper"}
 LAYERS = [  # a module may import its own layer and the ones above it in this list, never one below
     ("core",),
-    # what reads and checks inputs, the registry ('methods'), the contract and the driver: pure Python but the driver
+    # what reads and checks inputs, the registry ('methods': methods/__init__.py only), the contract, the driver
+    # and its at-rest numbers, the tank's theory, and helpers importing no other module here (deps, html, timing)
     ("inputs", "settings", "tank", "contract", "rest", "at_rest", "deps", "theory", "methods", "plausible", "budget", "preflight",
      "claims_registry", "driver", "html", "timing"),
-    # what writes, reads and judges run files, and the paths into a run: the run, the command line, tables,
-    # figures, claims, derived numbers and the report
+    # what writes, reads and judges run files: the run file, the run, the command line, measures, tables, figures,
+    # the report, the claims (judge, quantities, derived numbers), the ParaView export and the comparison on any tank
     ("metrics", "runfile", "tables", "run", "cli", "figures", "report", "claims", "judge", "quantities", "derived", "export", "compare"),
     ("methods.",),  # a method package
 ]

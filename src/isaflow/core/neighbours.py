@@ -1,9 +1,10 @@
 """The shared neighbour lists (numba): a cell-list builder, serial or in parallel blocks.
 
 Used by ISA's loops (relax, newton, replay, theory), the solid, the measures of isaflow.metrics and SPH's
-setup and claims.  Not every method's: SPH's pair list (methods/sph/pairs.py) takes :func:`cell_grid` and
-builds its own column-ordered list with wall visibility; SPH's periodic block (methods/sph/block.py) and MPS
-(methods/mps/operators.py) sort particles into cells of their own.
+setup (its wall particles, methods/sph/particles.py).  Not every method's: SPH's pair list
+(methods/sph/pairs.py) takes :func:`cell_grid` and builds its own column-ordered list with wall visibility;
+SPH's periodic block (methods/sph/block.py) keeps a periodic linked cell list of its own (``cells``), and MPS
+(methods/mps/operators.py) counting-sorts particles into cells of its own (``cell_sort``, ``neighbour_list``).
 
 ``cell_rows`` finds all pairs closer than a cutoff, each once (a half list),
 stored by rows of a cell-sorted particle order (counting sort into the cells of

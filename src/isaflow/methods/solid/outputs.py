@@ -59,7 +59,7 @@ def run_case(cfg, outputs, case, variant, loads=None):
 def run_cases(cfg, outputs, cases, loads=None, kernels=None):
     """Workflow entry point of a block of cases in one process: write_run of each [case, variant] in cases to
     the output at the same place; loads: the rigid-floor run file of each (elastic-floor cases), or None;
-    kernels: an input that only orders the job (its file is not read).  Returns the contract.Results."""
+    kernels: an input that only orders the job (its file is not read).  Returns the contract.Result of each."""
     logging.basicConfig(stream=sys.stderr, level=logging.INFO, format="%(asctime)s %(message)s")
     return [write_run(cfg, case, variant, out, loads=loads[k] if loads else None)
             for k, ((case, variant), out) in enumerate(zip(cases, outputs))]
