@@ -10,13 +10,38 @@ from isaflow.core import jit
 from isaflow.preflight import UNSTABLE
 from isaflow.methods.isa import scene, solver
 
-# this session's kernels in a generation of their own, sealed at exit: workflow jobs the tests start
-# (default, per-method generations) never meet a test session that writes theirs
-jit.use("tests")
 
 ROOT = Path(__file__).resolve().parents[1]
 TANKS = ROOT / "config" / "tanks"
 ISA_SETTINGS = ROOT / "config" / "methods" / "isa.yaml"
+
+
+def pytest_configure(config):
+    """Kernels, before any test: with pytest-xdist the controller (which runs no test) first compiles and seals
+    every tank method's generation, its processes in parallel, exactly as a run does (run.compile_method), so
+    the workers, and the runs and workflow jobs the tests start, load them instead of each compiling them
+    again.  A process that runs tests binds a generation of its own (``tests``, or ``tests-<worker>``: its
+    core, solid and 1D kernels, sealed at exit), so workflow jobs the tests start never meet a test session
+    that writes theirs, and reads the tank methods' sealed generations beside it (core.jit.read_also)."""
+    import os
+    import subprocess
+    import sys
+
+    from isaflow import methods
+
+    names = list(methods.tank_methods())
+    worker = os.environ.get("PYTEST_XDIST_WORKER")
+    if worker is None and (getattr(config.option, "numprocesses", 0) or 0) > 0:
+        procs = [subprocess.Popen([sys.executable, "-c", f"from isaflow import run; run.compile_method({m!r})"],
+                                  cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+                 for m in names]
+        for m, p in zip(names, procs):
+            _, err = p.communicate()
+            if p.returncode:  # the tests then compile these kernels themselves
+                print(f"conftest: compiling {m}'s kernels failed:\n{err[-2000:]}", file=sys.stderr)
+        return
+    jit.use("tests" if worker is None else f"tests-{worker}")
+    jit.read_also(*names)
 
 # the coarse lattice's force laws (config/methods/isa.yaml, resolution coarse): cm, N
 L_B, R_B = 5.0, 10000.0  # wall: l_bu, R_bu (k_b = 2000 N/cm)
