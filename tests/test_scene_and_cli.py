@@ -111,6 +111,14 @@ def test_a_method_that_runs_on_no_tank_is_refused(tmp_path, capsys):
     assert code == 2 and "does not run on tanks" in capsys.readouterr().err
 
 
+def test_a_declared_run_of_a_method_that_runs_on_no_tank_is_refused_naming_the_option(tmp_path, capsys):
+    """The solid's settings file declares no runs: the line names --method, not an empty list of its runs."""
+    out = tmp_path / "r.nc"
+    assert cli.main(["run", "--method", "solid", "--run", "x", "-o", str(out)]) == 2 and not out.exists()
+    err = capsys.readouterr().err
+    assert err.startswith("error: --method: method 'solid' does not run on tanks (choose from isa, sph, mps)"), err
+
+
 def test_tiny_scene_end_to_end_through_the_command_line(tmp_path):
     out = tmp_path / "run.nc"
     tp, sp = write_spec(tmp_path, TINY)

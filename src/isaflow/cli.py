@@ -48,7 +48,13 @@ def declared(method, run_id, settings_path=None):
     from . import settings as S
     from . import tank as T
 
-    m = methods.get(method)
+    try:
+        m = methods.get(method)
+    except KeyError as err:
+        raise inputs.InputError(f"--method: {err.args[0]}") from None
+    if not m.tank:  # the same line isaflow.run gives a non-tank method's run on a tank
+        raise inputs.InputError(f"--method: method '{method}' does not run on tanks (choose from "
+                                f"{', '.join(methods.tank_methods())})")
     spec = S.read(settings_path or m.settings, m.values_schema(), f"{method} settings")
     decl = spec.get("runs", {}).get(run_id)
     if decl is None:
@@ -91,10 +97,11 @@ def export(args):
 
 
 def main(argv=None):
-    ap = _Parser(prog="isaflow", description=__doc__.splitlines()[0])
+    ap = _Parser(prog="isaflow", description="Run a method on a tank, export a run for ParaView, or compare every "
+                                             "tank method on one tank (exit codes: the module docstring of isaflow.cli).")
     sub = ap.add_subparsers(dest="cmd", required=True)
     r = sub.add_parser("run", help="run one method on one tank and write its netCDF run file")
-    r.add_argument("--method", required=True, help=f"one of {', '.join(methods.PACKAGES)} (tank methods only)")
+    r.add_argument("--method", required=True, help=f"a tank method: one of {', '.join(methods.tank_methods())}")
     r.add_argument("--run", help="a run declared in the method's settings file (runs: section)")
     r.add_argument("--tank", help="tank file, e.g. config/tanks/single.yaml")
     r.add_argument("--variant")
