@@ -96,7 +96,8 @@ def export(args):
     return 0
 
 
-def main(argv=None):
+def parser():
+    """The command line's parser (isaflow run / export / compare)."""
     ap = _Parser(prog="isaflow", description="Run a method on a tank, export a run for ParaView, or compare every "
                                              "tank method on one tank (exit codes: the module docstring of isaflow.cli).")
     sub = ap.add_subparsers(dest="cmd", required=True)
@@ -123,7 +124,11 @@ def main(argv=None):
     e.add_argument("--vtk", required=True, metavar="DIR",
                    help="directory for <run>.pvd, its .vtu particle files and the walls' .vtp (created if missing)")
     compare_parser(sub)
-    args = ap.parse_args(argv)
+    return ap
+
+
+def main(argv=None):
+    args = parser().parse_args(argv)
     if args.cmd == "export":
         return export(args)
     if args.cmd == "compare":
