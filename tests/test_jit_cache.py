@@ -158,3 +158,15 @@ def test_a_process_reads_another_methods_sealed_generation_and_writes_nothing_th
     assert alone["read"] == [] and alone["compiled"] > 0
     missing = reader("nowhere")  # a generation that does not exist is skipped
     assert missing["read"] == []
+
+
+def test_a_writer_without_a_fill_that_compiled_nothing_leaves_its_generation_unsealed(env, tmp_path):
+    """A test session that ran no kernel sealed an empty generation at exit, so every later session compiled
+    all its kernels in memory; now the next process finds it unsealed, fills it and seals it."""
+    empty = subprocess.run([sys.executable, "-c", "from isaflow.core import jit; print(jit.use('default'))"],
+                           env=env, text=True, capture_output=True, check=True)
+    assert empty.stdout.strip() == "write" and not (tmp_path / "cache" / "default" / "MANIFEST.json").exists()
+    first, _ = result(start(env, generation="default", sleep=-1))
+    assert first["mode"] == "write" and first["compiled"] >= 2
+    second, _ = result(start(env, generation="default", sleep=-1))
+    assert second["mode"] == "read" and second["compiled"] == 0 and second["value"] == 12.0

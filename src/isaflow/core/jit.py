@@ -18,8 +18,9 @@ only**, then sealed:
   the first process to get the folder's exclusive lock wipes it and fills it
   (``write``): :func:`use` with a ``fill`` function (a method's warm-up,
   compiling every kernel signature its runs use) fills and seals it at once;
-  a ``default`` writer seals at exit, so a process without ``fill`` never
-  waits for a writer (which may live as long as a test session).  A process
+  a ``default`` writer seals at exit (if it compiled anything), so a process
+  without ``fill`` never waits for a writer (which may live as long as a test
+  session).  A process
   that can neither read a sealed generation nor write it (another is writing,
   or the seal is damaged while others read it) compiles in memory only
   (``private``).  Readers hold
@@ -188,7 +189,9 @@ def use(name, fill=None):
             shutil.rmtree(p) if p.is_dir() else p.unlink()
     _STATE["mode"] = "write"
     if fill is None:
-        atexit.register(lambda: _STATE["mode"] == "write" and _seal())
+        # sealed only if it saved something: an empty seal (a test session that ran no kernel) would make every
+        # later process compile all its kernels in memory, where an unsealed folder is filled by the next one
+        atexit.register(lambda: _STATE["mode"] == "write" and _COUNTERS["compiled"] and _seal())
     else:
         fill()
         _seal()
