@@ -11,7 +11,7 @@ By default four processes: three ISA update rules on one generation (one fills i
 on 1 and 2 threads) and the 1D sweep, whose generation is sealed at exit (the other path of core.jit.use).
 ISAFLOW_RACE_FULL=1 runs the full form, eleven processes using every kernel overload of every method (the
 five ISA update rules, two SPH and two MPS variants through ``isaflow run``, a solid case and a 1D sweep;
-about 150 s of two cores): run it before any change to how kernels are compiled, cached or bound
+about 90 s of two cores): run it before any change to how kernels are compiled, cached or bound
 (src/isaflow/core/jit.py, run.compile_method, a method's warm_up).
 
 ISAFLOW_RACE_SRC: the source tree to test (default this checkout's src/), to run the same test on

@@ -48,13 +48,7 @@ def declared(method, run_id, settings_path=None):
     from . import settings as S
     from . import tank as T
 
-    try:
-        m = methods.get(method)
-    except KeyError as err:
-        raise inputs.InputError(f"--method: {err.args[0]}") from None
-    if not m.tank:  # the same line isaflow.run gives a non-tank method's run on a tank
-        raise inputs.InputError(f"--method: method '{method}' does not run on tanks (choose from "
-                                f"{', '.join(methods.tank_methods())})")
+    m = runs.tank_method(method)
     spec = S.read(settings_path or m.settings, m.values_schema(), f"{method} settings")
     decl = spec.get("runs", {}).get(run_id)
     if decl is None:

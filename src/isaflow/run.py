@@ -55,6 +55,18 @@ def _start_particles(start):
         return int(ds["pos"].shape[0]) if "pos" in ds.variables else None
 
 
+def tank_method(method):
+    """The registry's Method of a method that runs on tanks, or InputError naming --method."""
+    try:
+        m = methods.get(method)
+    except KeyError as err:
+        raise InputError(f"--method: {err.args[0]}") from None
+    if not m.tank:
+        raise InputError(f"--method: method '{method}' does not run on tanks (choose from "
+                         f"{', '.join(methods.tank_methods())})")
+    return m
+
+
 def prepare(method, tank, variant, resolution, out, settings_path=None, overrides=(), start=None,
             accept=("converged",), threads=None, run_id=None, label="", stability=False, max_hours=None):
     """Check a run before any work; returns Prepared or raises InputError / runfile.RunFileError.
@@ -64,13 +76,7 @@ def prepare(method, tank, variant, resolution, out, settings_path=None, override
     stability case (literature ranges not enforced, unstable outcomes may be accepted); max_hours: this
     run's own CPU-hour budget (config/limits.yaml's otherwise).
     """
-    try:
-        m = methods.get(method)
-    except KeyError as err:
-        raise InputError(f"--method: {err.args[0]}") from None
-    if not m.tank:
-        raise InputError(f"--method: method '{method}' does not run on tanks (choose from "
-                         f"{', '.join(methods.tank_methods())})")
+    m = tank_method(method)
     if threads is not None:
         budget.check_threads("argument --threads", threads,
                              min(budget.machine_cores(), settings.RUN_SCHEMA["properties"]["threads"]["maximum"]))
