@@ -40,6 +40,7 @@ def _concrete(line):
     return line.replace("...", "").strip()
 
 
+PARSER = cli.parser()
 CASES = sorted({(path.relative_to(ROOT).as_posix(), cmd) for path in DOCS for cmd in _commands(path.read_text())})
 
 
@@ -49,7 +50,7 @@ def test_the_docs_show_command_lines_of_every_subcommand():
 
 def _options(sub):
     """The option strings of subcommand sub."""
-    action = next(a for a in cli.parser()._actions if a.dest == "cmd")
+    action = next(a for a in PARSER._actions if a.dest == "cmd")
     return {o for a in action.choices[sub]._actions for o in a.option_strings}
 
 
@@ -61,7 +62,7 @@ def test_a_documented_command_line_parses(doc, command, capsys):
     if not {"-o", "--out", "--vtk", "--help", "-h"} & set(named):  # a fragment in prose: its options exist
         return
     try:
-        args = cli.parser().parse_args(argv)
+        args = PARSER.parse_args(argv)
     except SystemExit as exc:
         if argv[-1] in ("--help", "-h") and exc.code == 0:
             return
