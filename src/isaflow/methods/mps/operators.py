@@ -199,6 +199,8 @@ def near_thin(pos, thin, reach):
     """(N,) int64: bit t set when the particle is closer than reach [cm] to thin wall t (4,)."""
     n = pos.shape[0]
     out = np.zeros(n, np.int64)
+    if thin.shape[0] == 0:  # no thin walls: no parallel loop to start
+        return out
     for i in prange(n):
         m = 0
         for t in range(thin.shape[0]):
