@@ -1,5 +1,6 @@
 """Workflow: the real config builds a complete DAG; one figure needs only its own run."""
 
+import functools
 import re
 import subprocess
 import sys
@@ -10,8 +11,10 @@ from conftest import ROOT
 SNAKEMAKE = [sys.executable, "-m", "snakemake"]
 
 
+@functools.lru_cache(maxsize=None)
 def dry_run(*targets):
-    """Dry run listing every job (full job blocks: without the default profile)."""
+    """Dry run listing every job (full job blocks: without the default profile); one per target set and test
+    session (the full one is read by three tests, 6-8 s each)."""
     proc = subprocess.run([*SNAKEMAKE, "-n", "-c1", "--forceall", "--workflow-profile", "none", *targets], cwd=ROOT,
                           capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stdout + proc.stderr
@@ -78,8 +81,9 @@ def _chain_starts():
     return out
 
 
+@functools.lru_cache(maxsize=None)
 def summary(*targets):
-    """{output file: rule} of every job the targets need (snakemake --summary)."""
+    """{output file: rule} of every job the targets need (snakemake --summary), once per target set (read only)."""
     proc = subprocess.run([*SNAKEMAKE, "--summary", "-c1", "--forceall", "--workflow-profile", "none", *targets],
                           cwd=ROOT, capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr[-3000:]
