@@ -826,15 +826,7 @@ def test_column_comes_to_rest(rest_runs, case):
     assert a["window_energy_ratio_mean"] <= a["window_energy_ratio_max"] < a["rest_energy_ratio"]
 
 
-# the standard column at l0 = 5.56 cm settles at a pressure slope 1.0221 rho0 g with np.hypot's distances and at
-# 1.0313 with sqrt(dx^2 + dy^2) (issue 42): last-bit differences of the distances move it across the +-3 % bound
-SLOPE_CASES = [pytest.param(c, marks=pytest.mark.xfail(strict=True, reason=(
-    "pressure slope 1.0221 rho0 g with np.hypot distances, 1.0313 with sqrt(dx^2 + dy^2) (issue 42): a last-bit "
-    "perturbation of the distances moves it across the +-3 % bound, so at this spacing the tolerance is not met "
-    "robustly"))) if c == ("standard", "dx5.56") else c for c in REST_CASES]
-
-
-@pytest.mark.parametrize("case", SLOPE_CASES, ids=lambda c: "-".join(c))
+@pytest.mark.parametrize("case", REST_CASES, ids=lambda c: "-".join(c))
 def test_pressure_of_the_column_at_rest_is_linear_in_depth(rest_runs, case):
     """Below 2.5 l0 from the top (the surface rows, P = 0, left out) the liquid's pressures (mean over the averaging
     window: the pressure alternates from step to step) lie on a line of slope rho0 g within +-3 % with an rms
