@@ -103,17 +103,7 @@ def test_the_v_theory_is_the_closed_form(vee_run):
             assert r[f"theory_fy_{wall}_N"] == pytest.approx(-1.25 * H**2 / 2, rel=1e-12)
 
 
-# MPS (standard, l0 = 5.56 cm) in the V came to rest at 6.37 s (at rest from 5.16 s) with np.hypot's distances; with
-# sqrt(dx^2 + dy^2) (issue 42) it is not at rest at the 8 s limit (kinetic energy / (W h) over the last 1.2 s: mean
-# 2.74e-5, max 1.68e-4 against 1e-5): a last-bit perturbation of the distances decides whether it settles in time
-HOLD_CASES = [pytest.param(m, marks=pytest.mark.xfail(strict=True, reason=(
-    "MPS in the V: at rest at 6.37 s with np.hypot distances, not at rest at the 8 s limit with sqrt(dx^2 + dy^2) "
-    "(issue 42; last 1.2 s: mean 2.74e-5, max 1.68e-4 against 1e-5): a last-bit perturbation of the distances "
-    "moves it across the rest bound, so the tolerance is not met robustly"))) if m == "mps" else m
-    for m in methods.tank_methods()]
-
-
-@pytest.mark.parametrize("method", HOLD_CASES)
+@pytest.mark.parametrize("method", methods.tank_methods())
 def test_every_method_holds_the_weight_and_loads_the_walls_as_the_theory(vee_run, method):
     out, df, _ = vee_run
     closed = W / math.sqrt(2.0)
