@@ -381,6 +381,14 @@ def test_loader_refuses_a_file_named_after_another_paper(registry_copy):
         reg.load(registry_copy)
 
 
+def test_loader_refuses_a_paper_no_method_names(registry_copy):
+    """The schema names no paper: a registry file is one of the method registry's papers (methods.papers())."""
+    text = (registry_copy / "hattori.yaml").read_text().replace("paper: hattori\n", "paper: nobody\n", 1)
+    (registry_copy / "nobody.yaml").write_text(text)
+    with pytest.raises(InputError, match="'nobody' is no registered method's paper"):
+        reg.load(registry_copy)
+
+
 def test_loader_refuses_a_missing_paper(registry_copy):
     (registry_copy / "hattori.yaml").unlink()
     with pytest.raises(InputError, match="no registry file for hattori"):

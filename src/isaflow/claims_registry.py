@@ -5,7 +5,8 @@ quantity, measure, tolerance with its derivation and source, runs, inferred inpu
 row of the old claims table) and the inputs its verdicts rest on (with the range a sensitivity
 sweep covers).  Each file is read through :func:`isaflow.inputs.load` (no aliases, tags,
 duplicate keys, NaN) against ``claims.schema.json``; :func:`load` then checks what a schema
-cannot: file name = paper, ids unique across files, every reference (inferred inputs,
+cannot: the paper is a registered method's (isaflow.methods.papers(): a new method's paper needs no edit of the
+schema), file name = paper, ids unique across files, every reference (inferred inputs,
 ``depends_on``, ``calibrated_against``) resolves, id prefix = paper, testable entries carry a
 tolerance that can fail, untestable ones say why, every run names a registered method.  A run id
 holding ``{tank_method}`` is one entry per tank method of the registry (e.g. the solid floor under each
@@ -64,6 +65,9 @@ def load_files(directory=DEFAULT_DIRECTORY):
     out = {}
     for path in files:
         _, spec = load_yaml(path, SCHEMA, "claims registry file")
+        if spec["paper"] not in PAPERS:  # the schema names no paper: the method registry's are the ones
+            raise InputError(f"{path}: field 'paper': '{spec['paper']}' is no registered method's paper "
+                             f"(choose from {', '.join(PAPERS)})")
         if spec["paper"] != path.stem:
             raise InputError(f"{path}: field 'paper': '{spec['paper']}' does not match the file name "
                              f"'{path.stem}' (one file per paper, named after it)")
