@@ -1,4 +1,4 @@
-"""The claims registry: every testable statement of the four papers, one YAML file per paper.
+"""The claims registry: every testable statement of the registered methods' papers, one YAML file per paper.
 
 ``config/claims/<paper>.yaml`` lists the paper's statements (id, section, verbatim quote, kind,
 quantity, measure, tolerance with its derivation and source, runs, inferred inputs, the replaced
