@@ -36,9 +36,15 @@ isaflow.run (prepare, solve, write: the command line's path).  The capped
 runs of study_fine / study_finer (6 s / 136 s) are not rerun: their counts are
 deterministic (the same bits on every run) and are taken from REFERENCE_CAPPED.
 
+Design floor (:func:`floor_relax`, isaflow's kernels only): the same steps as one serial compiled loop over
+SoA arrays, the project's own lists; at every N, ``reps`` calls of the project's step (1 thread) and of the floor
+interleaved from the same state, each timed by the thread's CPU time, medians; the floor's positions, forces and
+max|F| history compared with the project's (max differences written: 0 is the same bits).
+
 Outputs (benchmarks/results/, or results/quick/ with --quick): step_cost[_TAG].csv
-(1 thread), step_threads.csv, newton_evals.csv, compile[_TAG].csv, memory[_TAG].csv,
-summary[_TAG].txt, machine.txt, step_cost.png.
+(1 thread), step_threads.csv, step_floor.csv (project and floor ns per particle-step, ratio, differences,
+load average), newton_evals.csv, compile[_TAG].csv, memory[_TAG].csv, summary[_TAG].txt, machine.txt,
+step_cost.png.
 ``--kernels FILE --tag before`` times another single-file copy of the kernels (e.g. the
 version before optimisation, ``git show 09b8875:src/isaflow/kernels.py``; 1 thread only).
 """
@@ -56,6 +62,11 @@ import time
 from pathlib import Path
 
 import numpy as np
+
+from isaflow.core.geometry import crossed_wall
+from isaflow.core.jit import njit
+from isaflow.methods.isa import relax as R
+from isaflow.methods.isa.forces import wall_push
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
@@ -128,6 +139,169 @@ def run_relax(K, pos, walls, box, n_steps, threads=1):
     steps, status, _ = K.relax(*args, threads) if getattr(K, "threaded", False) else K.relax(*args)
     assert status == K.RUNNING and steps == n_steps, (steps, status)
     return f, hist
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
+def floor_relax(pos, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pair_r_u, du, n_steps, skin, force, fmax_hist):
+    """The design floor of n_steps steps of the paper's update (linear laws, one thread), in place on pos (N, 2) cm;
+    force (N, 2) [N] and fmax_hist (n_steps,) [N] as relax.relax.  Returns the status (relax's codes).
+
+    Includes, per step: the crossing test of the near-wall rows (the whole vessel when the rows may not
+    suffice, as relax), the move x += du F / max|F|, the weights, the wall rows' forces in their own pass, then
+    one sweep over the half pair list in cell order (relax's rows: every partner after its row), each pair's
+    linear-law force within l_u added to its row and subtracted from its partner, max|F| taken as each row
+    completes, and one finite check of the step (a sum of x - x terms; coincident particles, which relax
+    pushes apart along x, fail it).  State: SoA x, y, fx, fy in cell order.
+    The list builds are relax's own (relax._start, relax._cell_lists at the same steps: moved > skin / 2), with
+    the build's write-back to the caller's order and a gather into x, y; so floor and project pay the same builds,
+    and the ratio is the step's own overhead.  Sums in relax's order: the same bits."""
+    n = pos.shape[0]
+    rc = pair_l_u + skin
+    reach = wall_l_u + skin
+    lu2 = pair_l_u * pair_l_u
+    inv = 1.0 / pair_l_u
+    vel = np.zeros_like(pos)
+    pos_build = np.empty_like(pos)
+    (order, rank, row_start, near_start, pos_c, _, vel_c, _, _, w, halo, nbr, cstart, owner, gx, gy, near_part,
+     near_wall) = R._start(pos, vel, weight, pos_build, False, box, rc, walls, reach, 1)
+    x = np.empty(n)
+    y = np.empty(n)
+    fx = np.empty(n)
+    fy = np.empty(n)
+    for q in range(n):
+        x[q] = pos_c[q, 0]
+        y[q] = pos_c[q, 1]
+    moved = 0.0
+    scale = 0.0
+    move = False
+    status = R.RUNNING
+    step = -1
+    while True:
+        if move:
+            for q in range(n):
+                x[q] += scale * fx[q]
+                y[q] += scale * fy[q]
+        for q in range(n):
+            fx[q] = 0.0
+            fy[q] = -w[q]
+        for c in range(near_part.shape[0]):
+            q = near_part[c]
+            k = near_wall[c]
+            ax, ay = wall_push(x[q], y[q], walls[k, 0], walls[k, 1], walls[k, 2], walls[k, 3], wall_l_u, wall_r_u)
+            fx[q] += ax
+            fy[q] += ay
+        fmax = 0.0
+        chk = 0.0
+        for q in range(n):
+            xi = x[q]
+            yi = y[q]
+            sx = fx[q]
+            sy = fy[q]
+            for k in range(row_start[q], row_start[q + 1]):
+                j = nbr[k]
+                dx = xi - x[j]
+                dy = yi - y[j]
+                d2 = dx * dx + dy * dy
+                if d2 < lu2:
+                    s = pair_r_u * (1.0 / np.sqrt(d2) - inv)
+                    ax = s * dx
+                    ay = s * dy
+                    sx += ax
+                    sy += ay
+                    fx[j] -= ax
+                    fy[j] -= ay
+            fx[q] = sx
+            fy[q] = sy
+            fmax = max(fmax, abs(sx), abs(sy))
+            chk += (xi - xi) + (yi - yi) + (sx - sx) + (sy - sy)  # 0 unless something is not finite
+        step += 1
+        if chk != 0.0:
+            fmax = np.nan
+        if step < n_steps:
+            fmax_hist[step] = fmax
+        if chk != 0.0:
+            status = R.NONFINITE
+            break
+        if step == n_steps:
+            break
+        scale = du / fmax
+        max_move = np.sqrt(2.0) * (scale * fmax)
+        if moved + max_move < reach:
+            for c in range(near_part.shape[0]):
+                q = near_part[c]
+                k = near_wall[c]
+                if crossed_wall(x[q], y[q], x[q] + scale * fx[q], y[q] + scale * fy[q], walls[k:k + 1]) >= 0:
+                    status = R.CROSSED
+        else:
+            for q in range(n):
+                if crossed_wall(x[q], y[q], x[q] + scale * fx[q], y[q] + scale * fy[q], walls) >= 0:
+                    status = R.CROSSED
+        if status == R.CROSSED:
+            break
+        moved += max_move
+        move = True
+        if moved > 0.5 * skin:
+            for q in range(n):
+                i = order[q]
+                pos[i, 0] = x[q] + scale * fx[q]
+                pos[i, 1] = y[q] + scale * fy[q]
+            pos_build[:, :] = pos
+            nbr, cstart, owner, gx, gy, near_part, near_wall = R._cell_lists(
+                pos, vel, weight, box, rc, walls, reach, 1, 1.25 * row_start[n] / max(n, 1) + 2.0, order, cstart,
+                row_start, nbr, rank, pos_c, vel_c, w, owner, gx, gy, halo, near_start)
+            for q in range(n):
+                x[q] = pos_c[q, 0]
+                y[q] = pos_c[q, 1]
+            moved = 0.0
+            move = False
+    for q in range(n):
+        i = order[q]
+        pos[i, 0] = x[q]
+        pos[i, 1] = y[q]
+        force[i, 0] = fx[q]
+        force[i, 1] = fy[q]
+    return status
+
+
+def run_floor(pos, walls, box, n_steps):
+    """floor_relax on the benchmark's laws, in place on pos; returns (forces, fmax_hist)."""
+    f = np.zeros_like(pos)
+    hist = np.zeros(max(n_steps, 1))
+    status = floor_relax(pos, np.full(len(pos), WEIGHT), walls, box, WL_U, WR_U, PL_U, PR_U, DU, n_steps, SKIN, f,
+                         hist)
+    assert status == R.RUNNING, status
+    return f, hist
+
+
+def floor_cost(K, pos, walls, box, target, reps):
+    """Project step (kernels K, 1 thread) against :func:`floor_relax` on the state pos: ``reps`` interleaved
+    (project, floor) calls of the same steps from the same state, each timed by the thread's CPU time; the
+    floor's positions, forces and max|F| history compared with the project's on every call.  Returns dict: steps
+    per call, median ns per particle-step of each, ratio, max differences (0: the same bits)."""
+    import numba
+    n = len(pos)
+    n_steps = max(100, int(np.ceil(target / n)))
+    numba.set_num_threads(1)
+    run_floor(pos.copy(), walls, box, 2)
+    tp, tf, dpos, dforce = [], [], 0.0, 0.0
+    try:
+        for _ in range(reps):
+            p = pos.copy()
+            t0 = time.thread_time()
+            f, hist = run_relax(K, p, walls, box, n_steps, 1)
+            tp.append(time.thread_time() - t0)
+            pf = pos.copy()
+            t0 = time.thread_time()
+            ff, hf = run_floor(pf, walls, box, n_steps)
+            tf.append(time.thread_time() - t0)
+            dpos = max(dpos, float(np.abs(pf - p).max()))
+            dforce = max(dforce, float(np.abs(ff - f).max()), float(np.abs(hf - hist).max()))
+    finally:
+        numba.set_num_threads(numba.config.NUMBA_NUM_THREADS)
+    project = float(np.median(tp)) / (n_steps * n) * 1e9
+    floor = float(np.median(tf)) / (n_steps * n) * 1e9
+    return dict(N=n, steps_per_call=n_steps, reps=reps, ns_per_particle_step=project, floor_ns_per_particle_step=floor,
+                ratio=project / floor, max_pos_diff_cm=dpos, max_force_diff_N=dforce)
 
 
 def relaxed_state(K, n_target, base_cache, relax_steps, heal_steps, threads):
@@ -536,7 +710,7 @@ def main():
     relax_steps = 5000 if args.quick else RELAX_STEPS
     heal_steps = 500 if args.quick else HEAL_STEPS
     base = {}
-    rows, trows = [], []
+    rows, trows, frows = [], [], []
     big_state = None
     for n_target in n_list:
         t0 = time.perf_counter()
@@ -569,6 +743,13 @@ def main():
             trow["efficiency_best"] = trow["speedup_best"] / t2
             msg += f"  speed-up {trow['speedup']:.2f}, efficiency {trow['efficiency']:.0%}"
         trows.append(trow)
+        if kpath is None:
+            load0 = os.getloadavg()[0]
+            frow = floor_cost(K, pos, walls, box, target, reps)
+            frow["load_average"] = 0.5 * (load0 + os.getloadavg()[0])
+            frows.append(frow)
+            msg += (f" | floor {frow['floor_ns_per_particle_step']:.2f} ns vs {frow['ns_per_particle_step']:.2f} "
+                    f"(x{frow['ratio']:.2f}, max diff {frow['max_pos_diff_cm']:.3g} cm)")
         if ref is not None:
             nps, nbest, nmed, nwall, nbuild = time_numpy(ref, pos, walls, box, np_target, 3)
             rows.append(dict(impl="numpy", threads=1, N=n, steps_per_call=nps, reps=3, ns_per_particle_step=nbest,
@@ -590,6 +771,8 @@ def main():
                    total_bytes_per_particle=(mem["kernel_bytes"] + mem["caller_bytes"]) / n_big)
     write_csv(out / f"memory{sfx}.csv", [mem_row])
 
+    if frows:
+        write_csv(out / f"step_floor{sfx}.csv", frows)
     keys = ["impl", "threads", "N", "steps_per_call", "reps", "ns_per_particle_step", "ns_median", "ns_wall_best",
             "s_per_step", "speedup_vs_numpy", "contacts_per_particle", "list_pairs_per_particle", "fmax_start",
             "prep_s", "numpy_build_ns_per_particle"]
