@@ -35,12 +35,11 @@ import pandas as pd
 os.environ.setdefault("NUMBA_NUM_THREADS", "2")
 os.environ.setdefault("OMP_WAIT_POLICY", "PASSIVE")  # as solver.set_threads; the parent sets it per child
 
-from isaflow.core.geometry import bounding_box, crossed_wall  # noqa: E402
+from isaflow.core.geometry import bounding_box  # noqa: E402
 from isaflow.core.jit import njit  # noqa: E402
 from isaflow.methods.sph import kernels as K  # noqa: E402
 from isaflow.methods.sph import settings as S  # noqa: E402
 from isaflow.methods.sph import solver  # noqa: E402
-from isaflow.methods.sph.kernels import kernel_wf, liquid_range, pair_momentum, wall_range  # noqa: E402
 from isaflow.methods.sph.pairs import build  # noqa: E402
 from isaflow.methods.sph.repulsion import wall_repulsion  # noqa: E402
 from isaflow.tank import load as load_tank  # noqa: E402
@@ -53,74 +52,30 @@ STATE = ("x", "v", "rho", "p", "acc", "wall_force", "force_sum", "panel_sum")  #
 @njit(cache=True, nogil=True)
 def floor_advance(x, v, rho, p, nf, walls, box, grid_box, par, n_steps, xref, lst, wk, fk, acc, wall_force,
                   force_sum, panel_sum, panel0, npanel):
-    """n_steps of kernels.advance (continuity density, one thread) as one compiled loop with every pass inline
-    but the per-particle ones it reuses; arrays and returns as advance (no diagnostics).
+    """n_steps of kernels.advance (continuity density, one thread) as one compiled loop calling each of its
+    range kernels once a pass over the whole data; arrays and returns as advance (no diagnostics).
 
-    Per step: the kicks and the drift with the wall-crossing test of the particles that could reach a wall (the
-    |v|^2 sum, the box and finite checks); the list rebuilt by pairs.build at the same steps (a particle moved
-    skin / 2); one pass over the pairs (even columns, then odd, each in list order: advance's order) for
-    W, (dW/dr)/r and the continuity rate (density diffusion if delta > 0), W stored for the wall pairs only;
-    kernels.liquid_range (density update, Tait pressure, P / rho^2, gravity) and kernels.wall_range (Adami wall
-    pressures); a second pass over the pairs for eq. 9 with the same viscosity (kernels.pair_momentum); the
-    Lennard-Jones net (repulsion.wall_repulsion); force_sum += wall_force.  Sums in advance's order: the same
-    bits."""
-    dt = par[K.DT]
-    half = 0.5 * dt
+    Per step: kernels._move_range over all liquid particles (the kicks, the drift, the crossing test of the
+    particles that could reach a wall, the |v|^2 sum, the box and finite checks); pairs.build at the same steps
+    (a particle moved skin / 2); kernels.kernel_range over each cell column (even columns, then odd: advance's
+    order) for W, (dW/dr)/r and the continuity rate; kernels.liquid_range (density update, Tait pressure,
+    P / rho^2, gravity) and kernels.wall_range (Adami wall pressures); kernels.force_range over each column
+    (eq. 9, the same viscosity); repulsion.wall_repulsion; force_sum += wall_force.  What it leaves out is
+    advance's dispatch: the chunks of the per-particle passes, the colour passes' calls, the thread tests.
+    The same sums in the same order: the same bits."""
     lim2 = (0.5 * par[K.SKIN]) ** 2
     rc = 2.0 * par[K.H] + par[K.SKIN]
-    slack = 0.5 * par[K.SKIN]
-    mass, h, c0, rho0, g, delta, alpha = par[K.MASS], par[K.H], par[K.C0], par[K.RHO0], par[K.GRAV], par[K.DELTA], \
-        par[K.ALPHA]
-    alpha_wall = alpha if par[K.WALL_VISC] > 0 else 0.0
-    kind = int(par[K.KERNEL])
-    c = par[K.NORM] / (h * h)
-    ih = 1.0 / h
+    half = 0.5 * par[K.DT]
     n = x.shape[0]
     rate = np.zeros(nf)
     p_rho2 = np.empty(n)
     for step in range(n_steps + 1):
-        finish = step > 0
-        v2 = 0.0
         if step == n_steps:  # the last step's second kick
-            for a in range(nf):
-                v[a, 0] += half * acc[a, 0]
-                v[a, 1] += half * acc[a, 1]
-                v2 += v[a, 0] * v[a, 0] + v[a, 1] * v[a, 1]
-            return (K.OK if np.isfinite(v2) else K.NONFINITE), n_steps, lst, wk, fk
-        dwall = lst[7]
-        moved2 = 0.0
-        cross = -1
-        bad = -1
-        for a in range(nf):
-            if finish:
-                v[a, 0] += half * acc[a, 0]
-                v[a, 1] += half * acc[a, 1]
-                v2 += v[a, 0] * v[a, 0] + v[a, 1] * v[a, 1]
-            v[a, 0] += half * acc[a, 0]
-            v[a, 1] += half * acc[a, 1]
-            x0 = x[a, 0]
-            y0 = x[a, 1]
-            x1 = x0 + dt * v[a, 0]
-            y1 = y0 + dt * v[a, 1]
-            step2 = (x1 - x0) * (x1 - x0) + (y1 - y0) * (y1 - y0)
-            reach = dwall[a] - slack
-            if not (step2 < reach * reach and reach > 0.0) and crossed_wall(x0, y0, x1, y1, walls) >= 0:
-                cross = a if cross < 0 else cross
-                continue
-            if bad < 0 and not (np.isfinite(x1) and np.isfinite(y1) and box[0] <= x1 <= box[2]
-                                and box[1] <= y1 <= box[3]):
-                bad = a
-            x[a, 0] = x1
-            x[a, 1] = y1
-            ddx = x1 - xref[a, 0]
-            ddy = y1 - xref[a, 1]
-            moved2 = max(moved2, ddx * ddx + ddy * ddy)
-        if not np.isfinite(v2):
-            return K.NONFINITE, step, lst, wk, fk
-        if cross >= 0:
-            return K.CROSSED, step, lst, wk, fk
-        if bad >= 0:
-            return K.LEFT_BOX, step + 1, lst, wk, fk
+            return (K.OK if np.isfinite(K._kick_range(0, nf, v, acc, half)) else K.NONFINITE), n_steps, lst, wk, fk
+        v2, moved2, cross, bad = K._move_range(0, nf, x, v, acc, xref, half, par[K.DT], box, walls, lst[7],
+                                               0.5 * par[K.SKIN], step > 0)
+        if not np.isfinite(v2) or cross >= 0 or bad >= 0:
+            return K.NONFINITE if not np.isfinite(v2) else K.CROSSED if cross >= 0 else K.LEFT_BOX, step, lst, wk, fk
         if moved2 > lim2:
             lst = build(x, nf, grid_box, rc, walls, lst[0], lst[1], K.reach_of(par))
             if wk.shape[0] < lst[2]:
@@ -128,80 +83,17 @@ def floor_advance(x, v, rho, p, nf, walls, box, grid_box, par, n_steps, xref, ls
                 fk = np.empty(lst[0].shape[0])
             xref[:nf] = x[:nf]
         pi, pj, m, col, wrow, wpair, close, dwall = lst
-        ncol = col.shape[0] - 1
         rate[:] = 0.0
         for colour in range(2):
-            for cc in range(colour, ncol, 2):
-                run = -1
-                sa = xa = ya = vxa = vya = ra = ira = 0.0
-                for k in range(col[cc], col[cc + 1]):
-                    a = np.uint32(pi[k])
-                    b = np.uint32(pj[k])
-                    if a != run:
-                        if run >= 0:
-                            rate[run] = sa
-                        run = a
-                        sa = rate[a]
-                        xa, ya, vxa, vya, ra = x[a, 0], x[a, 1], v[a, 0], v[a, 1], rho[a]
-                        ira = 1.0 / ra
-                    dx = xa - x[b, 0]
-                    dy = ya - x[b, 1]
-                    w, f = kernel_wf(dx * dx + dy * dy, ih, kind, c)
-                    fk[k] = f
-                    if b >= nf:
-                        wk[k] = w
-                        sa += mass * f * (vxa * dx + vya * dy)
-                        continue
-                    dd = mass * f * ((vxa - v[b, 0]) * dx + (vya - v[b, 1]) * dy)
-                    if delta > 0.0:
-                        rb = rho[b]
-                        t = -2.0 * delta * h * c0 * mass * f * ((rb - ra) - rho0 * g * dy / (c0 * c0))
-                        sa += dd + t / rb
-                        rate[b] += dd - t * ira
-                    else:
-                        sa += dd
-                        rate[b] += dd
-                if run >= 0:
-                    rate[run] = sa
-        liquid_range(0, nf, rho, rate, p, p_rho2, acc, par, True)
-        wall_range(0, n - nf, x, rho, p, p_rho2, nf, pi, wrow, wpair, wk, par, wall_force)
+            for c in range(colour, col.shape[0] - 1, 2):
+                K.kernel_range(col[c], col[c + 1], x, v, rho, nf, pi, pj, par, wk, fk, rate)
+        K.liquid_range(0, nf, rho, rate, p, p_rho2, acc, par, True)
+        K.wall_range(0, n - nf, x, rho, p, p_rho2, nf, pi, wrow, wpair, wk, par, wall_force)
         for colour in range(2):
-            for cc in range(colour, ncol, 2):
-                run = -1
-                sx = sy = xa = ya = vxa = vya = ra = pa = 0.0
-                for k in range(col[cc], col[cc + 1]):
-                    a = np.uint32(pi[k])
-                    b = np.uint32(pj[k])
-                    if a != run:
-                        if run >= 0:
-                            acc[run, 0] = sx
-                            acc[run, 1] = sy
-                        run = a
-                        sx, sy = acc[a, 0], acc[a, 1]
-                        xa, ya, vxa, vya, ra, pa = x[a, 0], x[a, 1], v[a, 0], v[a, 1], rho[a], p_rho2[a]
-                    dx = xa - x[b, 0]
-                    dy = ya - x[b, 1]
-                    if b >= nf:
-                        s = mass * fk[k] * pair_momentum(pa, p_rho2[b], vxa * dx + vya * dy, dx * dx + dy * dy, h,
-                                                         alpha_wall, c0, 0.5 * (ra + rho[b]))
-                        sx -= s * dx
-                        sy -= s * dy
-                        wall_force[b - nf, 0] += mass * (-s * dx)
-                        wall_force[b - nf, 1] += mass * (-s * dy)
-                    else:
-                        s = mass * fk[k] * pair_momentum(pa, p_rho2[b], (vxa - v[b, 0]) * dx + (vya - v[b, 1]) * dy,
-                                                         dx * dx + dy * dy, h, alpha, c0, 0.5 * (ra + rho[b]))
-                        sx -= s * dx
-                        sy -= s * dy
-                        acc[b, 0] += s * dx
-                        acc[b, 1] += s * dy
-                if run >= 0:
-                    acc[run, 0] = sx
-                    acc[run, 1] = sy
-        wall_repulsion(x, close, walls, panel0, npanel, par[K.LJ_D], par[K.LJ_R0], mass, acc, panel_sum)
-        for q in range(force_sum.shape[0]):
-            force_sum[q, 0] += wall_force[q, 0]
-            force_sum[q, 1] += wall_force[q, 1]
+            for c in range(colour, col.shape[0] - 1, 2):
+                K.force_range(col[c], col[c + 1], x, v, rho, p_rho2, nf, pi, pj, par, fk, acc, wall_force)
+        wall_repulsion(x, close, walls, panel0, npanel, par[K.LJ_D], par[K.LJ_R0], par[K.MASS], acc, panel_sum)
+        force_sum += wall_force
     return K.OK, n_steps, lst, wk, fk
 
 
