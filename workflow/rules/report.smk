@@ -64,6 +64,30 @@ use rule call as bench_report with:
         "logs/report/benchmarks.log",
 
 
+# every method's step cost against its floor and its peers, from the benchmarks' CSVs (benchmarks/floors.py)
+rule bench_floors:
+    input:
+        script="benchmarks/floors.py",
+        csv=["benchmarks/results/step_floor.csv", "benchmarks/results/sph_step_cost.csv",
+             "benchmarks/results/mps_step_cost.csv", "benchmarks/results/solid_step_cost.csv"],
+    output:
+        "results/bench/05_floors.md",
+    message:
+        JOB
+    localrule: True
+    resources:
+        **SMALL,
+    log:
+        "logs/report/bench_floors.log",
+    conda:
+        "../envs/isaflow.yaml"
+    shell:
+        "python {input.script} {output} benchmarks/results > {log} 2>&1"
+
+
+register(bench=["results/bench/05_floors.md"])
+
+
 rule benchmarks:
     input:
         lambda wc: TARGETS["bench"] + ["docs/benchmarks.md"],

@@ -392,6 +392,7 @@ rule isa_bench_step:
         "benchmarks/results/step_cost.png",
         "benchmarks/results/step_threads.csv",
         "benchmarks/results/newton_evals.csv",
+        "benchmarks/results/step_floor.csv",
     threads: 2  # the benchmark takes the whole 2-core machine so other jobs do not perturb it
     message:
         JOB
