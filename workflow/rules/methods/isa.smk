@@ -382,6 +382,7 @@ rule isa_bench_step:
     input:
         script="benchmarks/bench_step.py",
         reference="benchmarks/numpy_reference.py",
+        floor="benchmarks/isa_floor.py",
         code=code("methods.isa.method"),
     output:
         "benchmarks/results/step_cost.csv",
