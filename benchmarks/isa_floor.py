@@ -22,7 +22,8 @@ def floor_relax(pos, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pair_r_u,
     pushes apart along x, fail it).  State: SoA x, y, fx, fy in cell order.
     The list builds are relax's own (relax._start, relax._cell_lists at the same steps: moved > skin / 2), with
     the build's write-back to the caller's order and a gather into x, y; so floor and project pay the same builds,
-    and the ratio is the step's own overhead.  Sums in relax's order: the same bits."""
+    and the ratio is the step's own overhead.  Sums in relax's order: the same bits.  Unlike relax, the pair law
+    is evaluated row by row in the sweep (scalar, a branch at l_u), not branch-free over a block's pairs."""
     n = pos.shape[0]
     rc = pair_l_u + skin
     reach = wall_l_u + skin
