@@ -552,3 +552,29 @@ def test_bad_method_settings_are_refused_naming_the_file(tmp_path, method, mutat
     with pytest.raises(ValueError, match=f"^{bad}: ") as err:
         settings.read(bad, m.values_schema())
     assert "\n" not in str(err.value)
+
+
+def test_libyaml_and_the_pure_python_reader_read_every_tracked_yaml_file_alike():
+    """The fast reader (libyaml) is used only where it reads what the reference reader reads: every YAML file of
+    config/, workflow/ and tests/data (the hostile ones included) that libyaml reads gives the same value, key
+    order included, from the reference; none that the reference refuses is read by libyaml."""
+    from isaflow import inputs
+
+    if inputs._FastLoader is None:
+        pytest.skip("PyYAML without libyaml: only the reference reader runs")
+    import yaml
+
+    def read(path, loader):
+        try:
+            return yaml.load(path.read_bytes().decode("utf-8"), Loader=loader)
+        except (yaml.YAMLError, UnicodeError, inputs.InputError) as err:
+            return err
+
+    files = sorted(p for d in ("config", "workflow", "tests/data") for p in (ROOT / d).rglob("*.yaml"))
+    read_alike = 0
+    for path in files:
+        ref, fast = read(path, inputs._StrictLoader), read(path, inputs._FastLoader)
+        if not isinstance(fast, Exception):
+            assert not isinstance(ref, Exception) and ref == fast and repr(ref) == repr(fast), path
+            read_alike += 1
+    assert read_alike > 40
