@@ -708,7 +708,8 @@ def predict(pos, vel, p_prev, kind, tw, tside, thin, walls, grid_box, start, nbr
     the lists (lists_at: at pos, then wherever the predicted positions move), the explicit half (explicit_pass),
     collisions (collide, cdist > 0, if a fluid particle may collide: may_collide), the guard (reflect), then at the
     predicted state the distances, free surface and source (pressure_terms), the surface pressures (surface_mode) and
-    the system (assemble; extra its compressibility term).  n_prev: the number density at the previous step's start (ECS; empty: none yet).
+    the system (assemble; extra its compressibility term).  n_prev: the number density at the previous step's start
+    (ECS; empty: none yet).
     counts (4,) int64 [list builds, reflect steps, reflected particles, grazes] are added to.
     Returns (start, nbr, list_pos, n_now, ps, vs, dist, surf, normal, p_dir, row, indptr, indices, data, rhs, x0):
     the lists, the number density at pos (ECS, else n_prev), the predicted state and its pressure system with its
