@@ -52,7 +52,7 @@ def run_relax(pos0, walls, box, rule, du, n_steps, threads, split=None):
     for lo, hi, resume in ((0, split or n_steps, False), (split or n_steps, n_steps, True)):
         if hi > lo:
             rets.append(R.relax_resume(pos, vel, weight, *args, hi - lo, 0.3 * L_P, force, hist[lo:], pos_build,
-                                       state, resume, threads, 1.0, 1.0))  # linear laws (exponents 1)
+                                       state, resume, threads, 1.0, 1.0, R.NO_TRAIL))  # linear laws (exponents 1)
     return dict(ret=np.array(rets), pos=pos, vel=vel, force=force, hist=hist, pos_build=pos_build, state=state)
 
 

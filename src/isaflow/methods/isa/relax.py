@@ -36,6 +36,7 @@ from ...core.neighbours import cell_rows_par
 from .forces import pair_push, track_max, wall_push
 
 JIT = dict(cache=True, nogil=True)
+NO_TRAIL = np.empty((0, 0, 2))  # relax_resume's trail when no step's positions are kept
 PJIT = dict(cache=True, nogil=True, parallel=True)
 # no division-by-zero check (numpy's error model): lets LLVM vectorise the pair forces; every division in
 # these functions either has a non-zero divisor or its result is discarded
@@ -583,13 +584,13 @@ def relax(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pair_r_u, 
     return relax_resume(pos, vel, weight, walls, box, float(wall_l_u), float(wall_r_u), float(pair_l_u),
                         float(pair_r_u), int(rule), float(du), float(f_ref), float(dt_max), float(f_tol), int(n_steps),
                         float(skin), force, fmax_hist, np.empty_like(pos), np.zeros(4), False, int(threads),
-                        float(wall_p), float(pair_p))
+                        float(wall_p), float(pair_p), NO_TRAIL)
 
 
 @njit(**JIT)
 def relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pair_r_u, rule, du, f_ref,
                  dt_max, f_tol, n_steps, skin, force, fmax_hist, pos_build, state, resume, threads, wall_p,
-                 pair_p):
+                 pair_p, trail):
     """Run up to n_steps relaxation steps in place; the whole loop is compiled.
 
     pos (N, 2) cm, vel (N, 2) (FIRE velocities), weight (N,) N, walls (W, 4) cm,
@@ -610,7 +611,9 @@ def relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pai
     resume=True rebuilds the list from pos_build and continues with the
     given state, so a run split anywhere repeats the unsplit run bit for bit.
     threads: how many blocks the passes may run in (:func:`blocks`; the
-    results do not depend on it).
+    results do not depend on it).  trail (K, N, 2) cm: trail[k] receives the
+    positions after k steps of this call, for k < K (K = 0: none; the replay,
+    replay.py, reads every step of a chunk from it).
 
     Implementation (results identical, to the last bit, to the plain loop
     "move; rebuild with build_pairs if due; forces.forces", for any number of
@@ -666,6 +669,8 @@ def relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pai
         step += 1
         if step < n_steps:
             fmax_hist[step] = fmax
+        if step < trail.shape[0]:
+            _to_caller_order(order, pos_c, trail[step])
         if bad >= 0:
             status = NONFINITE
             crossing = order[bad]

@@ -2,12 +2,12 @@
 
 The solver runs in compiled chunks and keeps only records; a claim about every step (the du rule of
 section 6.1: no step changes a pair reaction by more than w/5) needs each step's state.  The replay
-starts from the run's initial positions with the run's own settings (its file's attributes) and steps
-the same compiled kernel (relax.relax_resume) one step per call, starting a fresh neighbour list where
-the solver started a chunk and resuming it elsewhere: the split-anywhere guarantee of relax_resume makes
-the replay repeat the run bit for bit, which :func:`pair_increments` checks on the final positions.  The
-step loop and its measures are one compiled call (:func:`_replay`: 800,000 steps of the refined paper run took
-199 s as a Python loop over compiled steps).
+starts from the run's initial positions with the run's own settings (its file's attributes) and runs
+the same compiled kernel (relax.relax_resume) in the run's own chunks, each from a fresh neighbour list as
+the solver ran it, keeping every step's positions in the kernel's trail: the replay repeats the run bit for
+bit, which :func:`pair_increments` checks on the final positions.  The measures of a chunk are one compiled
+call (:func:`_measure`; 800,000 steps of the refined paper run took 199 s as a Python loop over
+single compiled steps).
 
 Units: cm, N.
 """
@@ -50,51 +50,41 @@ def _largest_shift(a, b):
 
 
 @njit(**JIT)
-def _replay(pos, vel, weight, walls, box, pbox, wall_l_u, wall_r_u, pair_l_u, pair_r_u, rule, du, f_ref, dt_max,
-            f_tol, skin, chunk, steps, wall_p, pair_p):
-    """Steps ``steps`` of the run one at a time in place (relax_resume, a fresh list where the solver started a
-    chunk); returns (largest change of a pair reaction [N], its step, largest displacement component [cm], steps
-    done).  The pair reactions are read on candidate pairs closer than pair_l_u + the list's reach at a build,
-    rebuilt once a particle may have come within pair_l_u of one that is no candidate (2 x its shift since the
-    build > that reach),
-    so every pair closer than pair_l_u before or after a step is a candidate and the change over the union of the
-    two steps' pair sets is the largest change over the candidates."""
-    force = np.zeros_like(pos)
-    h = np.zeros(1)
-    pos_build = pos.copy()
-    state = np.zeros(5)
-    reach = 0.5 * pair_l_u
+def _candidates(pos, pbox, pair_l_u, reach, p, r_u, v):
+    """(pi, pj, R): the candidate pairs closer than pair_l_u + reach [cm] at pos and their reactions at pos (or at
+    v, (N, 2) cm, where v is not pos: the state a step started from)."""
     pi, pj, m = build_pairs(pos, pbox, pair_l_u + reach)
-    pi, pj = pi[:m], pj[:m]
-    ref = pos.copy()
-    v0 = np.empty(m)
-    _reactions(pos, pi, pj, pair_l_u, pair_r_u, pair_p, v0)
-    v1 = np.empty(m)
-    before = np.empty_like(pos)
-    worst, at, move, done = 0.0, -1, 0.0, 0
-    for s in range(steps):
-        before[:] = pos
-        n_done, status, _ = R.relax_resume(pos, vel, weight, walls, box, wall_l_u, wall_r_u, pair_l_u, pair_r_u,
-                                           rule, du, f_ref, dt_max, f_tol, 1, skin, force, h, pos_build, state,
-                                           s % chunk != 0, 1, wall_p, pair_p)
-        if n_done != 1:
-            break
-        done += 1
-        move = max(move, np.abs(pos - before).max())
-        if 2.0 * _largest_shift(pos, ref) > reach:  # rebuild at pos, far enough to hold the pairs before the step
-            pi, pj, m = build_pairs(pos, pbox, pair_l_u + reach + 2.0 * _largest_shift(pos, before))
-            pi, pj = pi[:m], pj[:m]
-            ref[:] = pos
-            v0, v1 = np.empty(m), np.empty(m)
-            _reactions(before, pi, pj, pair_l_u, pair_r_u, pair_p, v0)
-        _reactions(pos, pi, pj, pair_l_u, pair_r_u, pair_p, v1)
+    out = np.empty(m)
+    _reactions(v, pi[:m], pj[:m], pair_l_u, r_u, p, out)
+    return pi[:m], pj[:m], out
+
+
+@njit(**JIT)
+def _measure(trail, n_done, step0, pbox, pair_l_u, pair_r_u, p, reach, pi, pj, v0, ref, worst, at, move):
+    """Steps 1..n_done of a chunk's trail (N, 2 per step, cm): the largest change of a pair reaction [N] over a
+    step and its step (from step0), the largest displacement component [cm].  The reactions are read on the
+    candidate pairs (pi, pj; v0 their reactions before the chunk's first step) closer than pair_l_u + reach at
+    ref, the positions of their build, rebuilt once a particle may have come within pair_l_u of one that is no
+    candidate (2 x its shift since the build > reach), so every pair closer than pair_l_u before or after a step
+    is a candidate and the change over the union of the two steps' pair sets is the largest change over the
+    candidates.  Returns (pi, pj, v0, worst, at, move) for the next chunk (ref updated in place)."""
+    v1 = np.empty(v0.shape[0])
+    for k in range(1, n_done + 1):
+        before, now = trail[k - 1], trail[k]
+        move = max(move, np.abs(now - before).max())
+        if 2.0 * _largest_shift(now, ref) > reach:  # rebuild at now, far enough to hold the pairs before the step
+            pi, pj, v0 = _candidates(now, pbox, pair_l_u, reach + 2.0 * _largest_shift(now, before), p, pair_r_u,
+                                     before)
+            v1 = np.empty(v0.shape[0])
+            ref[:] = now
+        _reactions(now, pi, pj, pair_l_u, pair_r_u, p, v1)
         inc = 0.0
-        for k in range(m):
-            inc = max(inc, abs(v1[k] - v0[k]))
+        for q in range(v0.shape[0]):
+            inc = max(inc, abs(v1[q] - v0[q]))
         if inc > worst:
-            worst, at = inc, s
+            worst, at = inc, step0 + k - 1
         v0, v1 = v1, v0
-    return worst, at, move, done
+    return pi, pj, v0, worst, at, move
 
 
 def pair_increments(ds):
@@ -103,6 +93,8 @@ def pair_increments(ds):
     Returns dict: max_pair_increment_N, the largest change of any pair reaction in one step; its step;
     max_component_move_cm, the largest displacement component of any particle in one step (from the
     positions); steps replayed; identical: the replay's final positions equal the file's bit for bit.
+    The run's chunks are run as the solver ran them (relax_resume from a fresh list at each chunk's start,
+    called with the solver's argument types: its one compiled specialisation), every step read off the trail.
     """
     a = ds.attrs
     if int(ds["start_step"]) != 0:
@@ -111,16 +103,28 @@ def pair_increments(ds):
     box = bounding_box(walls)
     pos = np.array(ds["pos0"].values, float)
     weight = np.array(ds["weight"].values, float)
-    vel = np.zeros_like(pos)
-    rule = RULES[a["variant"]]
+    vel, force = np.zeros_like(pos), np.zeros_like(pos)
     wp, pp = float(a.get("wall_p", 1.0)), float(a.get("pair_p", 1.0))
-    args = (float(a["wall_l_u"]), float(a["wall_r_u"]), float(a["pair_l_u"]), float(a["pair_r_u"]), rule,
-            float(a["du"]), float(a["f_ref"]), float(a["dt_max"]), float(a["f_tol"]), float(a["skin"]))
-    chunk = int(a["chunk"])
-    steps = int(ds["steps"])
+    l_u, r_u = float(a["pair_l_u"]), float(a["pair_r_u"])
+    args = (float(a["wall_l_u"]), float(a["wall_r_u"]), l_u, r_u, int(RULES[a["variant"]]), float(a["du"]),
+            float(a["f_ref"]), float(a["dt_max"]), float(a["f_tol"]))
+    chunk, steps = int(a["chunk"]), int(ds["steps"])
     lo, hi = pos.min(0) - 100.0, pos.max(0) + 100.0
     pbox = np.array([min(lo[0], box[0]), min(lo[1], box[1]), max(hi[0], box[2]), max(hi[1], box[3])])
-    worst, at, move, _ = _replay(pos, vel, weight, walls, box, pbox, *args, chunk, steps, wp, pp)
+    reach = 0.5 * l_u
+    trail = np.empty((chunk + 1, len(pos), 2))
+    pi, pj, v0 = _candidates(pos, pbox, l_u, reach, pp, r_u, pos)
+    ref = pos.copy()
+    worst, at, move, done = 0.0, -1, 0.0, 0
+    while done < steps:
+        k_max = min(chunk, steps - done)
+        n_done, _, _ = R.relax_resume(pos, vel, weight, walls, box, *args, k_max, float(a["skin"]), force,
+                                      np.zeros(k_max), np.empty_like(pos), np.zeros(5), False, 1, wp, pp, trail)
+        pi, pj, v0, worst, at, move = _measure(trail, n_done, done, pbox, l_u, r_u, pp, reach, pi, pj, v0, ref,
+                                               worst, at, move)
+        done += n_done
+        if n_done < k_max:
+            break
     return dict(max_pair_increment_N=worst, at_step=at, max_component_move_cm=move, steps=steps,
                 identical=bool(np.array_equal(pos, ds["pos"].values)))
 

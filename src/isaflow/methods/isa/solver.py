@@ -151,7 +151,7 @@ def warm_up(threads=1):
             for resume in (False, True):
                 R.relax_resume(pos.copy(), np.zeros_like(pos), np.ones(2), walls, box, 0.5, 1.0, 0.7, 1.0, rule,
                                1e-3, 1.0, 0.1, 0.1, 2, 0.1, np.zeros_like(pos), np.zeros(2), pos.copy(), np.zeros(5),
-                               resume, threads, p, p)
+                               resume, threads, p, p, R.NO_TRAIL)
     for p in (1.0, 2.0):
         D.overdamped_resume(pos.copy(), np.zeros_like(pos), np.ones(2), walls, box, 0.5, 1.0, 0.7, 1.0, 1e-3, 1.0,
                             1.0, G, 0.1, 1e-5, 1.0, 1.0, 2, 0.1, np.zeros_like(pos), np.zeros(2), np.zeros(2),
@@ -357,7 +357,7 @@ class _Stepper:
             out = R.relax_resume(
                 pos, vel, self.weight, self.walls, self.box, s["wall_l_u"], s["wall_r_u"], s["pair_l_u"],
                 s["pair_r_u"], RULES[s["variant"]], s["du"], s["f_ref"], s["dt_max"], s["f_tol"], n, s["skin"],
-                force, buf, self.pos_build, kernel, resume, self.threads, s["wall_p"], s["pair_p"],
+                force, buf, self.pos_build, kernel, resume, self.threads, s["wall_p"], s["pair_p"], R.NO_TRAIL,
             )
             if key is not None:
                 memo.put(key, state_arrays, buf, out)
