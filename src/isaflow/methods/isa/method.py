@@ -30,8 +30,11 @@ def check(tank, settings, start=None):
 
 
 def warm_up(threads=None):
-    """Compile (or load from numba's cache) every kernel a run times."""
+    """Compile (or load from numba's cache) every kernel a run times, and the replay's (a derived job's)."""
+    from . import replay  # imports xarray: only where a run warms up
+
     solver.warm_up(solver.thread_count(threads))
+    replay.warm_up()
 
 
 def tank_difference(tank, pos0, weight, pitch, floor_y):
