@@ -520,7 +520,7 @@ class _Stepper:
             "reflect_steps": s.reflect_steps, "reflected_particles": s.reflections, "escapes": int(run.status == "escaped"),
             "threads": self.threads, "start_state": self.origin,
             "layer_pitch": l0, "held_weight": float(s.weight * s.nf), "initial_depth": depth0, "tank_difference": rows_note,
-            "rest_depth_cm": depth0, "final_rms_speed_cm_s": float(np.sqrt((s.vel[: s.nf] ** 2).sum(1).mean())),
+            "final_rms_speed_cm_s": float(np.sqrt((s.vel[: s.nf] ** 2).sum(1).mean())),
             "window_energy_ratio_mean": e_mean, "window_energy_ratio_max": e_max,
             "wall_load_reading": "pair forces" if pairwise else "panel pressures",
         }

@@ -377,7 +377,7 @@ class _Stepper:
         if abs(held - tank.weight) > 1e-9 * tank.weight:
             diff.append(f"weight held {held:g} N (tank {tank.weight:g} N)")
         params.update(
-            liquid_depth=tank.depth, first_vessel_width=float(x1 - x0), cell_dx=st["dx"], cell_dy=st["dy"],
+            first_vessel_width=float(x1 - x0), cell_dx=st["dx"], cell_dy=st["dy"],
             smoothing_length=st["h"], sound_speed=st["c0"], dt=dt, particle_mass=st["mass"], rho_ref=st["rho_ref"],
             wall_particles=nw, two_faced_walls=", ".join(n for n, f in zip(tank.wall_names, P.wet_back(walls, vessels))
                                                          if f and flow) or "none",

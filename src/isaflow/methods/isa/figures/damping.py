@@ -78,7 +78,7 @@ def overdamped_figure(inputs, outputs, isa_chain=("flow_incomplete", "flow_compl
     # (c) the single vessel's overdamped history
     so = runs[singles[0]]
     tt = (so["hist_step"].values - int(so["start_step"])) * float(so.attrs["dt"])
-    e = so["hist_energy"].values / (float(so["weight"].values.sum()) * float(so.attrs["rest_depth"]))
+    e = so["hist_energy"].values / (float(so["weight"].values.sum()) * float(so.attrs["tank_depth"]))
     ax_e.semilogy(tt, np.maximum(e, 1e-16), color=OD_COLOURS[0], label="kinetic energy e = KE / (W h)")
     ax_e.semilogy(tt, so["hist_fmax"].values, color="k", lw=0.8, label="max|F| (N)")
     ax_e.axhline(float(so.attrs["rest_energy_ratio"]), color=OD_COLOURS[0], ls=":", lw=1,
