@@ -28,6 +28,7 @@ from .operators import (CUT, DIM, DUMMY, FLUID, GRADIENTS, JIT, PAIRWISE, PAR, V
                         gradient_norm, gradient_row, lattice_constants, laplacian, near_thin, neighbour_list,
                         neighbourhood_min, number_density, offsets, pair_distance, plain_row, probe_pressure,
                         recorded_wall_terms, row_span, sees, visible_distances, wall_forces, wall_terms, weight)
+from .clusters import anchor_clusters
 from .pressure import cg_solve
 
 # source terms of the pressure equation (settings name -> id)
@@ -707,7 +708,8 @@ def predict(pos, vel, p_prev, kind, tw, tside, thin, walls, grid_box, start, nbr
     """Everything of a step before the pressure solve, from the state (pos, vel; p_prev the last step's pressures):
     the lists (lists_at: at pos, then wherever the predicted positions move), the explicit half (explicit_pass),
     collisions (collide, cdist > 0, if a fluid particle may collide: may_collide), the guard (reflect), then at the
-    predicted state the distances, free surface and source (pressure_terms), the surface pressures (surface_mode) and
+    predicted state the distances, free surface and source (pressure_terms; clusters.anchor_clusters: the surface of a
+    droplet the particle-distribution test cleared), the surface pressures (surface_mode) and
     the system (assemble; extra its compressibility term).  n_prev: the number density at the previous step's start
     (ECS; empty: none yet).
     counts (4,) int64 [list builds, reflect steps, reflected particles, grazes] are added to.
@@ -733,6 +735,7 @@ def predict(pos, vel, p_prev, kind, tw, tside, thin, walls, grid_box, start, nbr
         start, nbr, list_pos = lists_at(ps, kind, tw, tside, grid_box, start, nbr, list_pos, counts, c)
     dist, surf, normal, b = pressure_terms(ps, vs, kind, start, nbr, tw, tside, near_thin(ps, thin, reach), thin, c,
                                            n_now, n_prev, dt, source)
+    anchor_clusters(kind, surf, start, nbr, dist, c.re_l, c.re_s, c.n0_s, c.beta)
     if c.surface_mode == 2:
         p_dir = surface_values(ps, p_prev, kind, surf, normal, start, nbr, dist, c.re_g, c.n0_g, 0.5 * c.l0)
     else:
