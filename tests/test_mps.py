@@ -464,7 +464,9 @@ def test_a_droplet_in_the_air_has_a_free_surface():
     surf, _ = model.surface(s.pos, s.kind, s.start, s.nbr, d, s.re_s, s.n0_s, c.beta, c.dist_thr, s.rmax)
     assert not surf[s.nf - 2] and not surf[s.nf - 1]  # the distribution test clears the pair
     before = surf.copy()
-    assert clusters.anchor_clusters(s.kind, surf, s.start, s.nbr, d, s.re_l, s.re_s, s.n0_s, c.beta) == 2
+    low = model.number_density(s.start, s.nbr, d, s.re_s) < c.beta * s.n0_s
+    assert low[s.nf - 2] and low[s.nf - 1]  # the number-density test finds them
+    assert clusters.anchor_clusters(s.kind, surf, low, s.start, s.nbr, d, s.re_l) == 2
     assert surf[s.nf - 2] and surf[s.nf - 1] and np.array_equal(surf[: s.nf - 2], before[: s.nf - 2])
     bad, _, _ = solver.step(s, dt, "mixed", cfg)
     assert bad[0] == 0 and s.surf[s.nf - 2] and s.surf[s.nf - 1]
@@ -958,7 +960,8 @@ def test_the_fused_step_gives_the_stage_kernels_numbers_bit_for_bit(path, varian
     n_star = model.number_density(start, nbr, d, s.re_n)
     div = (model.divergence_hs if s.div_mode else model.divergence)(ps, vs, start, nbr, d, s.re_g, s.n0_g)
     surf0, _ = model.surface(ps, s.kind, start, nbr, d, s.re_s, s.n0_s, cfg["model.beta"], c.dist_thr, s.rmax)
-    clusters.anchor_clusters(s.kind, surf0, start, nbr, d, s.re_l, s.re_s, s.n0_s, cfg["model.beta"])
+    low = model.number_density(start, nbr, d, s.re_s) < cfg["model.beta"] * s.n0_s
+    clusters.anchor_clusters(s.kind, surf0, low, start, nbr, d, s.re_l)
     assert np.array_equal(surf, surf0) and 0 < surf[: s.nf].sum() < s.nf
     b = model.source_term_all(n_star, div, s.n0_n, s.rho0, dt, src, c.gamma, c.relax, c.scope)
     system = model.assemble(s.kind, surf, p_dir, b, start, nbr, d, s.re_l, s.n0_l, s.lam, extra, s.lap_mode)

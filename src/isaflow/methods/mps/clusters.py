@@ -21,29 +21,34 @@ import numpy as np
 
 from ...core.jit import njit
 
-from .operators import DUMMY, JIT, weight
+from .operators import DUMMY, JIT
+
+UNSEEN, BOUNDED, FREE = 0, 1, 2  # a particle's cluster: not searched yet, has a Dirichlet particle, has none
 
 
 @njit(**JIT)
-def anchor_clusters(kind, surf, start, nbr, dist, re_l, re_s, n0_s, beta):
-    """Set surf (N,) bool in place for every particle of a Dirichlet-free cluster whose number density at re_s [cm]
-    is below beta n0_s.  Clusters: connected components of the non-dummy particles off the surface, linked by
-    every list entry closer than re_l [cm] (dist (M,), inf where unseen: model.assemble's couplings).  Serial (one
-    pass over the lists, a component at a time).  Returns the number of particles set."""
+def anchor_clusters(kind, surf, low, start, nbr, dist, re_l):
+    """Set surf (N,) bool in place for the particles of every Dirichlet-free cluster that the number-density test
+    found (low (N,): n* < beta n0 at the surface radius).  Clusters: connected components of the non-dummy particles
+    off the surface, linked by every list entry closer than re_l [cm] (dist (M,), inf where unseen: model.assemble's
+    couplings).  Only a cleared particle (low, not surf) can change, so a search starts from each such particle
+    not yet placed and stops at the first Dirichlet neighbour (or a particle already known to be bounded), its
+    particles then bounded; a search that ends without one has covered a whole free cluster.  Near a liquid's
+    surface a search ends within a few rows.  Serial.  Returns the number of particles set."""
     n = kind.shape[0]
-    seen = np.zeros(n, np.bool_)
+    state = np.zeros(n, np.int8)
     stack = np.empty(n, np.int64)
     members = np.empty(n, np.int64)
     added = 0
     for i0 in range(n):
-        if kind[i0] == DUMMY or surf[i0] or seen[i0]:
+        if not low[i0] or surf[i0] or kind[i0] == DUMMY or state[i0] != UNSEEN:
             continue
-        seen[i0] = True
+        state[i0] = FREE  # provisionally: the search's particles
         stack[0] = i0
         top = 1
         m = 0
-        anchored = False
-        while top > 0:
+        bounded = False
+        while top > 0 and not bounded:
             top -= 1
             i = stack[top]
             members[m] = i
@@ -52,20 +57,22 @@ def anchor_clusters(kind, surf, start, nbr, dist, re_l, re_s, n0_s, beta):
                 j = nbr[k]
                 if dist[k] >= re_l or kind[j] == DUMMY:
                     continue
-                if surf[j]:
-                    anchored = True
-                elif not seen[j]:
-                    seen[j] = True
+                if surf[j] or state[j] == BOUNDED:
+                    bounded = True
+                    break
+                if state[j] == UNSEEN:
+                    state[j] = FREE
                     stack[top] = j
                     top += 1
-        if anchored:
+        if bounded:  # every particle the search reached (popped or waiting) is in this bounded cluster
+            for q in range(m):
+                state[members[q]] = BOUNDED
+            for q in range(top):
+                state[stack[q]] = BOUNDED
             continue
         for q in range(m):
             i = members[q]
-            s = 0.0
-            for k in range(start[i], start[i + 1]):  # every listed neighbour, as operators.number_density
-                s += weight(dist[k], re_s)
-            if s < beta * n0_s:
+            if low[i]:
                 surf[i] = True
                 added += 1
     return added
