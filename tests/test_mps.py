@@ -12,7 +12,7 @@ import pytest
 from isaflow import runfile
 from isaflow.core import units
 from isaflow.methods import registry
-from isaflow.methods.mps import boundary, model, operators, outputs, pressure, settings, solver
+from isaflow.methods.mps import boundary, clusters, model, operators, outputs, pressure, settings, solver
 from isaflow.inputs import InputError as SceneError
 from isaflow.tank import load as load_tank
 
@@ -439,6 +439,38 @@ def test_compressibility_term_makes_a_pressure_equation_without_free_surface_def
         assert np.array_equal(A, A.T)
         ev = np.linalg.eigvalsh(A)
         assert ev.min() < 1e-9 if singular else ev.min() >= extra * (1 - 1e-9)
+
+
+def test_a_droplet_in_the_air_has_a_free_surface():
+    """Two particles alone in the air, 1.07 l0 apart, each the other's only neighbour (flow_mixed_dx3.45 with sqrt
+    pair distances, step 2,232: particles 115 and 143, n* = 1.89 against n0 = 18.98): the number-density test finds
+    both, the particle-distribution test clears both (each component of sum_j r_ij below l0), and without a
+    Dirichlet particle their pressure was fixed by the compressibility term alone (2.05e4 N/cm2, thrown apart at
+    1,700 cm/s, one over the left wall).  clusters.anchor_clusters puts them back on the free surface: P = 0, and
+    the column below keeps the surface the two tests give it."""
+    tank = load_tank(TANK)
+    cfg = settings.resolved(CFG, variant="mixed", resolution="dx3.45")
+    l0 = cfg["resolution.spacing"]
+    xr, floor = tank.first_vessel
+    block = boundary.liquid_block(xr, floor, tank.depth, l0)
+    pair = np.array([[50.0, 90.0], [50.0 + 0.6 * l0, 90.0 - 0.88 * l0]])
+    vel = np.zeros((len(block) + 2, 2))
+    vel[-2:] = [[-136.0, 153.0], [806.0, -865.0]]  # cm/s, approaching each other as 115 and 143 did
+    s = solver.State(tank, cfg, l0, np.concatenate([block, pair]), vel)
+    c = s.constants(cfg)
+    dt = solver.time_step(tank, l0, cfg["time.courant"])
+    s.neighbours(s.pos)
+    d = s.distances(s.pos)
+    surf, _ = model.surface(s.pos, s.kind, s.start, s.nbr, d, s.re_s, s.n0_s, c.beta, c.dist_thr, s.rmax)
+    assert not surf[s.nf - 2] and not surf[s.nf - 1]  # the distribution test clears the pair
+    before = surf.copy()
+    low = model.number_density(s.start, s.nbr, d, s.re_s) < c.beta * s.n0_s
+    assert low[s.nf - 2] and low[s.nf - 1]  # the number-density test finds them
+    assert clusters.anchor_clusters(s.kind, surf, low, s.start, s.nbr, d, s.re_l) == 2
+    assert surf[s.nf - 2] and surf[s.nf - 1] and np.array_equal(surf[: s.nf - 2], before[: s.nf - 2])
+    bad, _, _ = solver.step(s, dt, "mixed", cfg)
+    assert bad[0] == 0 and s.surf[s.nf - 2] and s.surf[s.nf - 1]
+    assert s.p[s.nf - 2] == 0.0 and s.p[s.nf - 1] == 0.0
 
 
 def test_compiled_cg_matches_a_direct_solve_and_is_the_same_serial_and_parallel():
@@ -928,6 +960,8 @@ def test_the_fused_step_gives_the_stage_kernels_numbers_bit_for_bit(path, varian
     n_star = model.number_density(start, nbr, d, s.re_n)
     div = (model.divergence_hs if s.div_mode else model.divergence)(ps, vs, start, nbr, d, s.re_g, s.n0_g)
     surf0, _ = model.surface(ps, s.kind, start, nbr, d, s.re_s, s.n0_s, cfg["model.beta"], c.dist_thr, s.rmax)
+    low = model.number_density(start, nbr, d, s.re_s) < cfg["model.beta"] * s.n0_s
+    clusters.anchor_clusters(s.kind, surf0, low, start, nbr, d, s.re_l)
     assert np.array_equal(surf, surf0) and 0 < surf[: s.nf].sum() < s.nf
     b = model.source_term_all(n_star, div, s.n0_n, s.rho0, dt, src, c.gamma, c.relax, c.scope)
     system = model.assemble(s.kind, surf, p_dir, b, start, nbr, d, s.re_l, s.n0_l, s.lam, extra, s.lap_mode)

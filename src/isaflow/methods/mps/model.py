@@ -28,6 +28,7 @@ from .operators import (CUT, DIM, DUMMY, FLUID, GRADIENTS, JIT, PAIRWISE, PAR, V
                         gradient_norm, gradient_row, lattice_constants, laplacian, near_thin, neighbour_list,
                         neighbourhood_min, number_density, offsets, pair_distance, plain_row, probe_pressure,
                         recorded_wall_terms, row_span, sees, visible_distances, wall_forces, wall_terms, weight)
+from .clusters import anchor_clusters
 from .pressure import cg_solve
 
 # source terms of the pressure equation (settings name -> id)
@@ -636,12 +637,12 @@ def _terms_row(i, ps, vs, start, nbr, tw, tside, near, thin, behind, cut2, re_n,
 
 @njit(inline="always", **JIT)
 def _terms_tail(i, nd, div, n_s, sx, sy, c, dt, source, a_d, a_v, n_now, n_prev):
-    """Particle i's (free surface, source term) of pressure_terms from its sums: number density nd, divergence div,
-    the surface test's number density n_s and offsets (sx, sy)."""
+    """Particle i's (free surface, number-density test alone, source term) of pressure_terms from its sums: number
+    density nd, divergence div, the surface test's number density n_s and offsets (sx, sy)."""
     bi = source_term(nd, div, c.n0_n, c.rho0, dt, source, c.gamma, a_d, a_v)
     if c.ecs:
         bi = bi + ecs_value(n_now[i], n_prev[i], c.n0_n, c.rho0, dt)
-    return on_surface(n_s, sx, sy, c.beta, c.n0_s, c.dist_thr), bi
+    return on_surface(n_s, sx, sy, c.beta, c.n0_s, c.dist_thr), n_s < c.beta * c.n0_s, bi
 
 
 @njit(**PAR)
@@ -650,10 +651,12 @@ def pressure_terms(ps, vs, kind, start, nbr, tw, tside, near, thin, c, n_now, n_
     rows are empty, neighbour_list), the free surface (surface; normals only where used: surface_mode, shifting) and
     the source term (number density re_n, divergence re_g, source_term_all relaxed, plus ecs_term with ECS): one pass
     for the settings' operators, the named alternatives (a surface radius of its own, the hs divergence, normals) each
-    a pass of its own over the stored distances.  Returns (dist (M,), surf (N,), normal (N, 2), b (N,))."""
+    a pass of its own over the stored distances.  Returns (dist (M,), surf (N,), low (N,): n* < beta n0 at re_s, the
+    surface test's number-density half (clusters.anchor_clusters), normal (N, 2), b (N,))."""
     n = ps.shape[0]
     dist = np.empty(nbr.shape[0])
     surf = np.zeros(n, np.bool_)
+    low = np.zeros(n, np.bool_)
     normal = np.zeros((n, 2))
     b = np.zeros(n)
     cut2 = c.rmax * c.rmax * CUT
@@ -682,11 +685,11 @@ def pressure_terms(ps, vs, kind, start, nbr, tw, tside, near, thin, c, n_now, n_
                                           c.rmax, dist, False, False)
         div_i = divergence_value(False, dv, c.n0_g) if mps_div else 0.0
         if alone:
-            surf[i], b[i] = _terms_tail(i, nd_i, div_i, nd_i, sx, sy, c, dt, source, a_d, a_v, n_now, n_prev)
+            surf[i], low[i], b[i] = _terms_tail(i, nd_i, div_i, nd_i, sx, sy, c, dt, source, a_d, a_v, n_now, n_prev)
         else:
             nd[i], div[i], offs[i, 0], offs[i, 1] = nd_i, div_i, sx, sy
     if alone:
-        return dist, surf, normal, b
+        return dist, surf, low, normal, b
     if hs_div:
         div = divergence_hs(ps, vs, start, nbr, dist, c.re_g, c.n0_g)
     n_s = number_density(start, nbr, dist, c.re_s) if c.re_s != c.re_n else nd
@@ -694,11 +697,11 @@ def pressure_terms(ps, vs, kind, start, nbr, tw, tside, near, thin, c, n_now, n_
     for i in prange(n):
         if kind[i] == DUMMY:
             continue
-        surf[i], b[i] = _terms_tail(i, nd[i], div[i], n_s[i], offs[i, 0], offs[i, 1], c, dt, source, a_d, a_v, n_now,
-                                    n_prev)
+        surf[i], low[i], b[i] = _terms_tail(i, nd[i], div[i], n_s[i], offs[i, 0], offs[i, 1], c, dt, source, a_d,
+                                            a_v, n_now, n_prev)
         if normals:
             normal[i, 0], normal[i, 1] = outward(sw[i, 0], sw[i, 1])
-    return dist, surf, normal, b
+    return dist, surf, low, normal, b
 
 
 @njit(**JIT)
@@ -707,7 +710,8 @@ def predict(pos, vel, p_prev, kind, tw, tside, thin, walls, grid_box, start, nbr
     """Everything of a step before the pressure solve, from the state (pos, vel; p_prev the last step's pressures):
     the lists (lists_at: at pos, then wherever the predicted positions move), the explicit half (explicit_pass),
     collisions (collide, cdist > 0, if a fluid particle may collide: may_collide), the guard (reflect), then at the
-    predicted state the distances, free surface and source (pressure_terms), the surface pressures (surface_mode) and
+    predicted state the distances, free surface and source (pressure_terms; clusters.anchor_clusters: the surface of a
+    droplet the particle-distribution test cleared), the surface pressures (surface_mode) and
     the system (assemble; extra its compressibility term).  n_prev: the number density at the previous step's start
     (ECS; empty: none yet).
     counts (4,) int64 [list builds, reflect steps, reflected particles, grazes] are added to.
@@ -731,8 +735,9 @@ def predict(pos, vel, p_prev, kind, tw, tside, thin, walls, grid_box, start, nbr
         ps, vs, hit = reflect(pos, ps, vs, kind, walls, c.restitution, 1e-6 * c.l0)
         count_hits(hit, counts)
         start, nbr, list_pos = lists_at(ps, kind, tw, tside, grid_box, start, nbr, list_pos, counts, c)
-    dist, surf, normal, b = pressure_terms(ps, vs, kind, start, nbr, tw, tside, near_thin(ps, thin, reach), thin, c,
-                                           n_now, n_prev, dt, source)
+    dist, surf, low, normal, b = pressure_terms(ps, vs, kind, start, nbr, tw, tside, near_thin(ps, thin, reach), thin,
+                                                c, n_now, n_prev, dt, source)
+    anchor_clusters(kind, surf, low, start, nbr, dist, c.re_l)
     if c.surface_mode == 2:
         p_dir = surface_values(ps, p_prev, kind, surf, normal, start, nbr, dist, c.re_g, c.n0_g, 0.5 * c.l0)
     else:

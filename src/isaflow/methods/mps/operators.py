@@ -52,8 +52,13 @@ def pair_distance(dx, dy):
     against 6.3 / 6.4 / 4.6), kept because sqrt's last-bit differences decide MPS outcomes (2026-12-03, a full run
     with sqrt): the flow flow_mixed_dx3.45 escapes (step 2,376: a particle thrown over the wall top at 1,570 cm/s),
     the standard column at l0 = 5.56 cm settles at a pressure slope 1.031 rho0 g (1.022 with np.hypot; bound +-3 %)
-    and the V tank of tests/test_compare.py is not at rest by its 8 s (at rest at 6.37 s with np.hypot).  A flow
-    that escapes by round-off is a defect of the wall treatment to fix before the faster distance can land."""
+    and the V tank of tests/test_compare.py is not at rest by its 8 s (at rest at 6.37 s with np.hypot).  The escape
+    was no wall's: a spray pair whose pressure only the compressibility term fixed (clusters.anchor_clusters, since
+    which 18 of 18 single and flow runs run without an escape with either distance).  The other two remain (sqrt,
+    2026-12-03): both columns' top rows are compressed to n* = 0.98-0.99 n0 with no neighbour above, so they sit at
+    the surface test's threshold; the V tank's top-row particles changed surface state 148 times after 5 s (9 with
+    np.hypot; no wall particle among them), and the column came to rest with its top two rows 20 / 16 particles
+    (18 / 18 with np.hypot): a free-surface defect, not a wall's, still to fix before the faster distance lands."""
     return np.hypot(dx, dy)
 
 
