@@ -41,12 +41,15 @@ def _reactions(pos, pi, pj, l_u, r_u, p, out):
 
 
 @njit(**JIT)
-def _largest_shift(a, b):
-    """Largest distance [cm] between a particle's positions in a and in b (N, 2)."""
-    out = 0.0
+def _shifts(a, b):
+    """(largest distance [cm], largest displacement component [cm]) between a particle's positions in a and in b
+    (N, 2), without a temporary array (the replay asks after every step)."""
+    dist, comp = 0.0, 0.0
     for i in range(a.shape[0]):
-        out = max(out, np.sqrt((a[i, 0] - b[i, 0]) ** 2 + (a[i, 1] - b[i, 1]) ** 2))
-    return out
+        dx, dy = a[i, 0] - b[i, 0], a[i, 1] - b[i, 1]
+        dist = max(dist, np.sqrt(dx * dx + dy * dy))
+        comp = max(comp, abs(dx), abs(dy))
+    return dist, comp
 
 
 @njit(**JIT)
@@ -71,10 +74,10 @@ def _measure(trail, n_done, step0, pbox, pair_l_u, pair_r_u, p, reach, pi, pj, v
     v1 = np.empty(v0.shape[0])
     for k in range(1, n_done + 1):
         before, now = trail[k - 1], trail[k]
-        move = max(move, np.abs(now - before).max())
-        if 2.0 * _largest_shift(now, ref) > reach:  # rebuild at now, far enough to hold the pairs before the step
-            pi, pj, v0 = _candidates(now, pbox, pair_l_u, reach + 2.0 * _largest_shift(now, before), p, pair_r_u,
-                                     before)
+        step_shift, step_comp = _shifts(now, before)
+        move = max(move, step_comp)
+        if 2.0 * _shifts(now, ref)[0] > reach:  # rebuild at now, far enough to hold the pairs before the step
+            pi, pj, v0 = _candidates(now, pbox, pair_l_u, reach + 2.0 * step_shift, p, pair_r_u, before)
             v1 = np.empty(v0.shape[0])
             ref[:] = now
         _reactions(now, pi, pj, pair_l_u, pair_r_u, p, v1)
