@@ -45,20 +45,42 @@ PAIRWISE = frozenset({2, 3, 4, 5})
 CUT = 1.0 + 1e-9
 
 
+# glibc's hypot (2.35+, sysdeps/ieee754/dbl-64/e_hypot.c, without FMA: the build numba's np.hypot calls here) takes
+# its common case for larger |x| <= 2^511 and smaller >= 2^-459; inside this narrower range pair_distance is its
+# arithmetic step for step, outside it calls np.hypot
+_HYPOT_LARGE, _HYPOT_TINY, _HYPOT_EPS = 2.0 ** 500, 2.0 ** -400, 2.0 ** -54
+
+
+@njit(inline="always", **JIT)
+def _hypot_kernel(ax, ay):
+    """glibc's hypot kernel for ax >= ay > ax 2^-54 (Borges 2019's one correction of sqrt(ax^2 + ay^2))."""
+    h = np.sqrt(ax * ax + ay * ay)
+    big = h <= 2.0 * ay
+    delta = h - ay if big else h - ax
+    t1 = ax * (2.0 * delta - ax) if big else 2.0 * delta * (ax - 2.0 * ay)
+    t2 = (delta - 2.0 * (ax - ay)) * delta if big else (4.0 * delta - ay) * ay + delta * delta
+    return h - (t1 + t2) / (2.0 * h)
+
+
 @njit(inline="always", **JIT)
 def pair_distance(dx, dy):
-    """|(dx, dy)| [cm] of a pair, by numba's np.hypot: 8x dearer per list entry than sqrt(dx^2 + dy^2) (22 against
-    2.7 ns; with sqrt the step's operators measured 3.1 / 3.1 / 2.0 x their floor at 234 / 609 / 4,640 particles
-    against 6.3 / 6.4 / 4.6), kept because sqrt's last-bit differences decide MPS outcomes (2026-12-03, a full run
-    with sqrt): the flow flow_mixed_dx3.45 escapes (step 2,376: a particle thrown over the wall top at 1,570 cm/s),
-    the standard column at l0 = 5.56 cm settles at a pressure slope 1.031 rho0 g (1.022 with np.hypot; bound +-3 %)
-    and the V tank of tests/test_compare.py is not at rest by its 8 s (at rest at 6.37 s with np.hypot).  The escape
-    was no wall's: a spray pair whose pressure only the compressibility term fixed (clusters.anchor_clusters, since
-    which 18 of 18 single and flow runs run without an escape with either distance).  The other two remain (sqrt,
-    2026-12-03): both columns' top rows are compressed to n* = 0.98-0.99 n0 with no neighbour above, so they sit at
-    the surface test's threshold; the V tank's top-row particles changed surface state 148 times after 5 s (9 with
-    np.hypot; no wall particle among them), and the column came to rest with its top two rows 20 / 16 particles
-    (18 / 18 with np.hypot): a free-surface defect, not a wall's, still to fix before the faster distance lands."""
+    """|(dx, dy)| [cm] of a pair, bit for bit numba's np.hypot (glibc's hypot: its common case inlined, the rest by the
+    call; tests/test_mps.py compares them over 3.5e6 pairs and the edge cases, 2.8e8 when written). The call itself cost
+    22 ns a list entry against 2.7 for sqrt(dx^2 + dy^2), but sqrt's last-bit differences decide MPS outcomes
+    (2026-12-03, a full run with sqrt): the flow flow_mixed_dx3.45 escaped (step 2,376: a particle thrown over the wall
+    top at 1,570 cm/s), the standard column at l0 = 5.56 cm settled at a pressure slope 1.031 rho0 g (1.022 with
+    np.hypot; bound +-3 %) and the V tank of tests/test_compare.py was not at rest by its 8 s (at rest at 6.37 s with
+    np.hypot). The escape was no wall's: a spray pair whose pressure only the compressibility term fixed
+    (clusters.anchor_clusters, since which 18 of 18 single and flow runs run without an escape with either distance).
+    The other two remain with sqrt: both columns' top rows are compressed to n* = 0.98-0.99 n0 with no neighbour above,
+    so they sit at the surface test's threshold; the V tank's top-row particles changed surface state 148 times after 5
+    s (9 with np.hypot), and the column came to rest with its top two rows 20 / 16 particles (18 / 18 with np.hypot):
+    outcomes that hang on the last bit of a distance, which this function keeps as np.hypot has it."""
+    x, y = abs(dx), abs(dy)
+    ax = y if x < y else x
+    ay = x if x < y else y
+    if ax <= _HYPOT_LARGE and (ay >= _HYPOT_TINY or ay == 0.0):
+        return ax + ay if ay <= ax * _HYPOT_EPS else _hypot_kernel(ax, ay)
     return np.hypot(dx, dy)
 
 
