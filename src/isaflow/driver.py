@@ -15,8 +15,8 @@ snapshots of the run's state on its declared cadence and the at-rest and wall nu
 - ``fraction_done()``: the fraction of that budget used, 0 to 1 (the ETA of the progress lines: the wall time so
   far times (1 - done) / done, i.e. the rate so far against t_max or the step budget);
 - ``t0``: the chain's time at this run's start [s] (the origin of time_to_rest);
-- ``rest_message(monitor)``, ``limit_message(monitor)``: the messages of 'converged' (at rest) and
-  'step_limit';
+- ``limit_message(monitor)``: the message of 'step_limit'; and ``rest_message(monitor)``, that of 'converged'
+  at rest, for a stepper driven with a rest criterion (``rest``) only;
 - ``progress(monitor)``: one progress line (the driver adds the ETA);
 - ``result(run)``: the contract.Result, from the final :class:`Run`;
 

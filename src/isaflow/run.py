@@ -20,7 +20,6 @@ from pathlib import Path
 from . import budget, methods, preflight, runfile, settings, tank as tanks
 from .inputs import InputError, printable
 
-PROGRESS_EVERY = 20.0  # s of wall time between progress lines (a log line at least every 30 s)
 HEARTBEAT = 25.0  # s: without any line for this long (compiling, a method's own pace), a 'running' line
 
 
@@ -135,24 +134,6 @@ class _Heartbeat:
         self._thread.join()
 
 
-def _progress(run_id, log, beat=None):
-    """A progress callback printing at most every PROGRESS_EVERY s: progress(step, measure name, value, units);
-    progress.log(text) prints a method's own progress line (it keeps its own pace), with the run id.  beat: the
-    run's _Heartbeat, told the last step so its lines say where the solver is."""
-    last = [time.perf_counter()]
-
-    def progress(step, name, value, units, force=False):
-        now = time.perf_counter()
-        if beat is not None:
-            beat.phase = f"solving, step {step}, {name} = {value:.4g} {units}"
-        if force or now - last[0] >= PROGRESS_EVERY:
-            last[0] = now
-            log(f"{run_id}: step {step:>9d}  {name} = {value:.4g} {units}")
-
-    progress.log = lambda text: log(f"{run_id}: {text}")
-    return progress
-
-
 def compile_method(method, threads=None, entry=None):
     """Bind this process to method's kernel generation (core.jit.use), compiling and sealing it first if no
     process has, then load (or compile) every kernel its runs time: the warm-up excluded from solver times.
@@ -174,7 +155,7 @@ def solve(p, log=None):
         beat.phase = "solving"
         started = runfile.now()
         result = p.entry.solve(p.tank, p.settings, p.variant, p.resolution, p.start,
-                               progress=_progress(p.run_id, beat.log, beat), threads=p.threads)
+                               log=lambda text: beat.log(f"{p.run_id}: {text}"), threads=p.threads)
     return result, started, runfile.now()
 
 

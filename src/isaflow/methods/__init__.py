@@ -13,9 +13,9 @@ claims modules and report fragments all come from here.
 
 A *tank method* (``tank=True``) runs on the shared tanks: its ``entry``
 module provides ``check(tank, settings, start)``,
-``solve(tank, settings, variant, resolution, start=None, progress=None,
-threads=None) -> contract.Result``, ``warm_up(threads)`` and
-``REFERENCES``; its ``values`` (``module:attribute``) is the schema of its
+``solve(tank, settings, variant, resolution, start=None, log=None,
+threads=None) -> contract.Result`` (log(text): its progress lines, from
+driver.drive), ``warm_up(threads)`` and ``REFERENCES``; its ``values`` (``module:attribute``) is the schema of its
 settings file (isaflow.settings).  Every method's ``checks`` module (pure
 Python, read while the workflow is parsed) has ``plausible(tank, settings,
 stability)`` and ``cost(tank, settings, particles) -> [isaflow.budget.Cost]``

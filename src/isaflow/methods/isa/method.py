@@ -49,7 +49,7 @@ def tank_difference(tank, pos0, weight, pitch, floor_y):
     return held, depth, "; ".join(notes) or "none"
 
 
-def solve(tank, settings, variant, resolution, start=None, progress=None, threads=None):
+def solve(tank, settings, variant, resolution, start=None, log=None, threads=None):
     """Relax the scene of tank, settings and variant (from start's final state if given) -> contract.Result."""
     scene = _scene(tank, settings, variant, start)
     extra = {}
@@ -64,7 +64,7 @@ def solve(tank, settings, variant, resolution, start=None, progress=None, thread
         pos0, weight, start_step, spacing, state = st["pos"], st["weight"], st["steps"], st["spacing"], st["state"]
         pitch, held, depth, diff = st["chain"]
         extra = dict(restart=st["restart"], start_sha256=st["sha256"], start_step=st["steps"])
-    result = solver.solve(scene, pos0, weight, start_step=start_step, progress=progress.log if progress else None,
+    result = solver.solve(scene, pos0, weight, start_step=start_step, log=log,
                           state=state, rest_depth=tank.depth, threads=threads)
     result.spacing = spacing
     result.params.update(layer_pitch=pitch, held_weight=held, initial_depth=depth, tank_difference=diff, **extra)

@@ -233,11 +233,11 @@ def _state_fields(vel, pos_build, chunk_start, kernel, recent):
     return {k: (d, np.asarray(arrays[k]), u, ln) for k, (d, u, ln) in STATE_VARS.items()}
 
 
-def solve(scene, pos0, weight, start_step=0, progress=None, state=None, rest_depth=float("nan"), threads=None):
+def solve(scene, pos0, weight, start_step=0, log=None, state=None, rest_depth=float("nan"), threads=None):
     """Relax ``pos0`` (N, 2) cm with per-particle ``weight`` (N,) N under an ISA scene.
 
     start_step: steps already taken (a continued run counts from there up to
-    solver.max_steps).  progress(text): the driver's progress lines (step, max|F|, ETA), one every
+    solver.max_steps).  log(text): the driver's progress lines (step, max|F|, ETA), one every
     driver.LOG_EVERY s of wall time.
     rest_depth: depth h [cm] of the rest criterion's e = KE / (W h) (overdamped variant only).
     state: {STATE_VARS name: array} of the run this one continues (same
@@ -251,7 +251,7 @@ def solve(scene, pos0, weight, start_step=0, progress=None, state=None, rest_dep
     """
     threads = thread_count(threads)
     with numba_threads(threads):
-        return _solve(scene, pos0, weight, start_step, progress, state, rest_depth, threads)
+        return _solve(scene, pos0, weight, start_step, log, state, rest_depth, threads)
 
 
 class _Stepper:
@@ -438,9 +438,6 @@ class _Stepper:
     def limit_message(self, monitor=None):
         return f"max|F| = {self._fmax():.4g} N >= f_tol = {self.s['f_tol']:g} N after {self.step} steps"
 
-    def rest_message(self, monitor):
-        raise AssertionError("ISA is never judged by the rest monitor (the overdamped variant's test is compiled)")
-
     def progress(self, monitor=None):
         return f"step {self.step:>9d}  max|F| = {self.fmax_last:.4g} N"
 
@@ -496,7 +493,7 @@ class _Stepper:
         )
 
 
-def _solve(scene, pos0, weight, start_step, progress, state, rest_depth, threads):
+def _solve(scene, pos0, weight, start_step, log, state, rest_depth, threads):
     """Build the stepper (kernels warmed) and drive it (driver.drive) -> contract.Result; arguments as solve's."""
     stepper = _Stepper(scene, pos0, weight, start_step, state, rest_depth, threads)
-    return driver.drive(stepper, None, progress, recording=stepper.recording())
+    return driver.drive(stepper, None, log, recording=stepper.recording())

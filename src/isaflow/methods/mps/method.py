@@ -84,7 +84,7 @@ def warm_up(threads=None):
     model.relaxation_factors(model.SOURCES["hattori"], model.RELAX_SCOPES["density"], 0.2)
 
 
-def solve(tank, settings, variant, resolution, start=None, progress=None, threads=None):
+def solve(tank, settings, variant, resolution, start=None, log=None, threads=None):
     """Run MPS on the tank (from start's final state if given) -> contract.Result."""
     l0 = float(settings["resolution.spacing"])
     flow = _flow(tank)
@@ -93,7 +93,7 @@ def solve(tank, settings, variant, resolution, start=None, progress=None, thread
     st = start_state(start) if start is not None else None
     if st is None and settings["start.on_wall_point"] is not None:
         st = on_wall_start(tank, l0, settings["start.on_wall_point"])
-    log = progress.log if progress is not None else (lambda msg: None)
+    log = log or (lambda msg: None)
     res = solver.solve(tank, settings, variant, l0, t_end, probes, start=st, log=log, threads=threads)
     res.spacing = l0
     return res

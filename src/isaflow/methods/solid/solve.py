@@ -164,9 +164,6 @@ class Stepper:
     def limit_message(self, monitor):
         return self.message("step_limit")
 
-    def rest_message(self, monitor):
-        return self.message("converged")
-
     def progress(self, monitor):
         return f"{self.label} step {self.st.steps} residual {self.resid:.3g}"
 

@@ -370,9 +370,6 @@ class Coupled:
     def limit_message(self, monitor):
         return f"{self.steps} steps of {self.dt:.4g} s"
 
-    def rest_message(self, monitor):
-        return self.limit_message(monitor)
-
     def progress(self, monitor):
         return f"vessel with water: step {self.done} of {self.steps}"
 

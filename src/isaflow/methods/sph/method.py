@@ -36,11 +36,11 @@ def warm_up(threads=None):
     block.warm_up()
 
 
-def solve(tank, settings, variant, resolution, start=None, progress=None, threads=None):
+def solve(tank, settings, variant, resolution, start=None, log=None, threads=None):
     """Run SPH on the tank (from start's final state if given) -> contract.Result."""
     s = S.physics(settings)
     start_ds = runfile.read(start) if start is not None else None
-    log = progress.log if progress is not None else (lambda msg: None)
+    log = log or (lambda msg: None)
     if s["domain"] == "periodic_block":
         res = block.run(tank, s, S.resolution(settings), log)
         res.variant = variant

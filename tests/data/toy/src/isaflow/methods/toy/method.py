@@ -168,10 +168,10 @@ class _Stepper:
                                         f"weight held at {self.held:g} N") if rounded else "none"})
 
 
-def solve(tank, settings, variant, resolution, start=None, progress=None, threads=None):
+def solve(tank, settings, variant, resolution, start=None, log=None, threads=None):
     """Drive the toy (driver.drive, judged at rest by isaflow.rest) -> contract.Result."""
     rest_cfg = R.load()
     stepper = _Stepper(tank, settings)
-    res = driver.drive(stepper, rest_cfg, progress.log if progress is not None else None, recording=stepper.recording())
+    res = driver.drive(stepper, rest_cfg, log, recording=stepper.recording())
     res.variant = variant
     return res
