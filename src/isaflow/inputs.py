@@ -171,8 +171,9 @@ def not_a_file(path):
     return "a directory" if p.is_dir() else "not a regular file" if p.exists() else "no such file"
 
 
-def read_yaml(path, what="file"):
-    """(text, mapping) of a YAML file; InputError naming the file otherwise."""
+def read_text(path, what="file"):
+    """The UTF-8 text of a file that may be read (a regular file of at most MAX_BYTES); InputError naming it
+    otherwise."""
     path = str(path)
     p = Path(path)
     try:
@@ -181,11 +182,15 @@ def read_yaml(path, what="file"):
             raise InputError(f"{path}: cannot read {what}: {kind}")
         if p.stat().st_size > MAX_BYTES:
             raise InputError(f"{path}: {what} is larger than {MAX_BYTES} bytes")
-        text = p.read_bytes().decode("utf-8")
+        return p.read_bytes().decode("utf-8")
     except OSError as err:
         raise InputError(f"{path}: cannot read {what}: {err.strerror or err}") from None
     except UnicodeDecodeError:
         raise InputError(f"{path}: {what} is not UTF-8 text") from None
+
+
+def _mapping(path, text, what):
+    """The YAML mapping of a file's text; InputError naming the file otherwise."""
     try:
         spec = parse_yaml(text)
     except InputError as err:
@@ -193,7 +198,13 @@ def read_yaml(path, what="file"):
     if not isinstance(spec, dict):
         raise InputError(f"{path}: field '(top level)': the {what} must be a mapping of fields, "
                          f"not {'an empty file' if spec is None else type(spec).__name__}")
-    return text, spec
+    return spec
+
+
+def read_yaml(path, what="file"):
+    """(text, mapping) of a YAML file; InputError naming the file otherwise."""
+    text = read_text(path, what)
+    return text, _mapping(str(path), text, what)
 
 
 def bad_string(text):
@@ -252,8 +263,21 @@ def validate(spec, schema, path):
         raise InputError(f"{path}: field '{printable(where)}': {printable(e.message, 200)}")
 
 
+# (path, text, id(schema)) -> (schema, mapping): each file's text parsed and checked once per process (the
+# workflow's parse loads config/rest.yaml and config/limits.yaml once per declared run, ~470 times); the schema is
+# kept so its id stays its own
+_LOADED = {}
+
+
 def load(path, schema, what="file"):
-    """(text, mapping) of a YAML file valid under schema; InputError naming the file and field otherwise."""
-    text, spec = read_yaml(path, what)
-    validate(spec, schema, str(path))
-    return text, spec
+    """(text, mapping) of a YAML file valid under schema; InputError naming the file and field otherwise.  The file
+    is read every time; text already parsed and checked under this schema object in this process is not parsed or
+    checked again (the mapping returned is a copy: callers may change it)."""
+    text = read_text(path, what)
+    key = (str(path), text, id(schema))
+    hit = _LOADED.get(key)
+    if hit is None or hit[0] is not schema:
+        spec = _mapping(str(path), text, what)
+        validate(spec, schema, str(path))
+        _LOADED[key] = hit = (schema, spec)
+    return text, copy.deepcopy(hit[1])

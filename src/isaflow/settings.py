@@ -96,11 +96,24 @@ RUN_SCHEMA = {
 }
 
 
+_SCHEMAS = {}  # (id(values), id(extra)) -> (values, extra, schema): one schema object per values (inputs.load's key)
+
+
 def file_schema(values, extra=None):
-    """JSON schema of a settings file whose values are ``values`` ({dotted key: value schema}).
+    """JSON schema of a settings file whose values are ``values`` ({dotted key: value schema}), built once per
+    values and extra object (the same object each call: inputs.load checks a file once per schema object).
 
     extra: {section: schema} of further top-level sections the method's file holds.
     """
+    hit = _SCHEMAS.get((id(values), id(extra)))
+    if hit is not None and hit[0] is values and hit[1] is extra:
+        return hit[2]
+    schema = _file_schema(values, extra)
+    _SCHEMAS[id(values), id(extra)] = (values, extra, schema)
+    return schema
+
+
+def _file_schema(values, extra):
     sets = overrides_schema(values)
     base = _tree(values)
     props = dict(base["properties"])
