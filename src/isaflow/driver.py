@@ -246,6 +246,14 @@ def _measures(result, rec, snaps, monitor, window_start, final):
     return out
 
 
+def rest_params(limit, window, last, t0):
+    """The rest attributes of a run judged at rest (its Result.params): the criterion's e limit and window [s], the
+    last e and the chain's time at the run's start [s]; one set of names for the driver's monitor and for a method
+    whose rest test is compiled into its own loop (ISA's overdamped variant)."""
+    return dict(rest_energy_ratio=float(limit), rest_window=float(window), final_energy_ratio=float(last),
+                start_time=float(t0))
+
+
 def drive(stepper, rest=None, log=None, every=LOG_EVERY, recording=None):
     """Advance ``stepper`` until an outcome; returns stepper.result(Run).
 
@@ -289,8 +297,7 @@ def drive(stepper, rest=None, log=None, every=LOG_EVERY, recording=None):
     final = snaps.final(stepper) if snaps is not None else None
     result = stepper.result(Run(status, message, wall_time, monitor, at))
     if monitor is not None:
-        result.params.update(rest_energy_ratio=monitor.limit, rest_window=monitor.window,
-                             final_energy_ratio=monitor.last, start_time=float(stepper.t0))
+        result.params.update(rest_params(monitor.limit, monitor.window, monitor.last, stepper.t0))
         result.measures.update(_rest_measures(monitor, samples, at))
     if snaps is not None:
         result.history.update(snaps.history())

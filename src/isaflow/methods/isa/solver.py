@@ -463,8 +463,7 @@ class _Stepper:
             sim_time = float(kernel[1])
             ke = 0.5 * float(np.sum(weight / G * np.sum(vel * vel, axis=1)))
             at_rest = kernel[2] >= 0 and sim_time - kernel[2] >= rest_cfg["window"] - 1e-12
-            params.update(rest_energy_ratio=rest_cfg["energy_ratio"], rest_window=rest_cfg["window"],
-                          final_energy_ratio=ke / e_norm, start_time=t_start,
+            params.update(driver.rest_params(rest_cfg["energy_ratio"], rest_cfg["window"], ke / e_norm, t_start),
                           particle_mass=float(weight[0] / G) if len(weight) else float("nan"))
             measures["time_to_rest"] = AT.measure(  # the compiled rest test's (the driver judges no rest here)
                 "time_to_rest", max(float(kernel[2]) - t_start, 0.0) if at_rest else float("nan"),
