@@ -1,5 +1,13 @@
 """The design floor of the ISA step (paper's update), timed against the project's by bench_step.py
-(a module of its own so that bench_step.py's compile probe still times isaflow's import)."""
+(a module of its own so that bench_step.py's compile probe still times isaflow's import).
+
+Below it, a scatter-free step (each particle's force gathered from a full list, every pair's law evaluated twice)
+was tried on bench_step's relaxed wide vessels (commit aab66c3, benchmarks/isa_scatter_free.py, removed after: its
+step loop repeated this one's): no form of it was faster.  1 thread, medians of interleaved calls, load 0.3-0.6,
+ns per particle-step at N = 997 / 9,450 / 30,240 / 100,170: project 13.12 / 11.21 / 11.38 / 12.18, this floor
+11.50 / 11.15 / 11.41 / 12.17, the best gather (sliced ELLPACK, vectorised across particles) 13.58 / 12.66 /
+13.02 / 13.85.  Gathering halves a pair-law entry's cost (1.45 against 2.9 ns with the scatter) but doubles the
+entries (5.6-6.8 against 2.8 per particle): the law's sqrt and division bound the step, not the scatter."""
 
 import numpy as np
 
