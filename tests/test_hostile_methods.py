@@ -402,14 +402,18 @@ PARSE_CASES = {
                             "config/claims/hattori.yaml: field 'derived.1.from'"),
     "derived_unread": ("config/claims/hattori.yaml", '- id: "mps:dilation_single_hattori_dx3.45"\n',
                        '- id: "mps:dilation_nobody"\n', "derived.2 ('mps:dilation_nobody'): no row or input"),
-    # a study case's override string with a comment ran without it; its errors named config/methods/isa.yaml
-    "study_override_comment": ("config/methods/isa_study.yaml", "set: [solver.du=10.0]", 'set: ["solver.du=10.0 # a"]',
-                               "config/methods/isa_study.yaml: field 'study.cases.value.list.du_large.set.0': "
-                               "override 'solver.du=10.0 # a': a comment"),
-    "study_override_quote_comment": ("config/methods/isa_study.yaml", "set: [solver.du=10.0]",
-                                     "set: [\"solver.du='10.0' # a\"]", "list.du_large.set.0': override"),
-    "study_override_unknown": ("config/methods/isa_study.yaml", "set: [solver.du=10.0]", "set: [solver.dx=10.0]",
-                               "config/methods/isa_study.yaml: field 'study.cases.value.list.du_large.set.0': "
+    # a study case's overrides were 'key=value' strings whose comments were dropped and whose sources were comments;
+    # they are sourced mappings now: a plain value, a bad source and an unknown key are refused naming the field
+    "study_override_unsourced": ("config/methods/isa_study.yaml",
+                                 'solver.du: {value: 10.0, source: "study plan: du = a = 2 l_bu (1000 x the paper\'s)"}',
+                                 "solver.du: 10.0",
+                                 "config/methods/isa_study.yaml: field 'study.cases.value.list.du_large.set.solver.du': "
+                                 "an override is a {value, source} mapping"),
+    "study_override_bad_source": ("config/methods/isa_study.yaml", 'source: "study plan: du = a = 2 l_bu',
+                                  'source: "because: du = a = 2 l_bu', "list.du_large.set.solver.du': field "
+                                  "'solver.du.source'"),
+    "study_override_unknown": ("config/methods/isa_study.yaml", "solver.du: {value: 10.0,", "solver.dx: {value: 10.0,",
+                               "config/methods/isa_study.yaml: field 'study.cases.value.list.du_large.set.solver.dx': "
                                "override field 'solver.dx': no such setting"),
     # YAML 1.1 reads 010 as 8: a file value the user typed as ten
     "octal_in_a_settings_file": ("config/methods/mps.yaml", "time.courant: {value: 0.1,", "time.courant: {value: 010,",

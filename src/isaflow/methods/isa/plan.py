@@ -12,7 +12,7 @@ import math
 
 from ... import settings as S
 from ... import tank as T
-from ...inputs import InputError, not_a_file
+from ...inputs import InputError, not_a_file, printable
 from .settings import RULES, VALUES, fire_dt_max
 
 VARIANTS = tuple(RULES)
@@ -101,7 +101,7 @@ def plan(study, spec):
                     group="stability_map", lattice=sm["lattice"], du_factor=f, k_factor=s)
     cs = study["cases"]
     for case, c in cs["list"].items():
-        extra_sets = case_sets(case, c.get("set", []))
+        extra_sets = case_sets(case, c.get("set", {}))
         cv = resolution_values(spec, c["resolution"], extra_sets)  # stiffness after the case's own overrides
         base = resolution_values(spec, c["resolution"])
         for var in c.get("variants", VARIANTS):
@@ -146,17 +146,16 @@ def check_names(study, spec):
                              f"({T.path_of(c['tank'])}: {kind})")
 
 
-def case_sets(case, items):
-    """{key: {value, source}} of a study case's ``set`` strings ('key=value'), each checked against the ISA values;
-    an error names the study file's field (``field 'study.cases.value.list.<case>.set.<k>'``; the workflow puts
-    the file's name before it)."""
-    out = {}
-    for k, item in enumerate(items):
-        where = f"field 'study.cases.value.list.{case}.set.{k}'"
-        key, leaf = S._parse(item, where, "override", source=f"study plan: case '{case}' of the study's cases")
+def case_sets(case, sets):
+    """{key: {value, source}} of a study case's ``set`` mapping, each checked against the ISA values; an error names
+    the study file's field (``field 'study.cases.value.list.<case>.set.<key>'``; the workflow puts the file's name
+    before it)."""
+    for key, leaf in sets.items():
+        where = f"field 'study.cases.value.list.{case}.set.{printable(key)}'"
+        if not (isinstance(leaf, dict) and set(leaf) == {"value", "source"}):
+            raise InputError(f"{where}: an override is a {{value, source}} mapping (the source says why)")
         S.apply(S.Settings({}, {}, where, {}), {key: leaf}, VALUES, where)
-        out[key] = leaf
-    return out
+    return dict(sets)
 
 
 def calibration(cal, runs, spec):
