@@ -181,26 +181,33 @@ def test_behaviour_classes():
     assert not sweep.ill_conditioned([1e3, 1e4, 1e3, 1e3], ns, band)  # one jump, no net growth beyond N
 
 
-def test_condition_estimate_matches_lapack_dgbcon():
-    # the same algorithm as LAPACK's dgbcon on the same factors: equal up to summation order (1e-9 relative)
+def test_band_factors_solves_and_estimate_match_lapack():
+    # band's plain loops are LAPACK's algorithms (dgbtf2, dgbtrs, dgbcon's dlacn2) on the same data: the same pivots,
+    # and factors, solves and estimate equal up to summation order and fused multiply-adds (round-off times cond)
     from scipy.linalg import lapack
 
-    from isaflow.methods.sph1d import condition
+    from isaflow.methods.sph1d import band
 
+    eps = np.finfo(float).eps
     for kernel, ratio, n in (("wendland_c2", 1.3, 64), ("cubic_spline", 2.0, 128), ("wendland_c6", 2.7, 256)):
         ab, b, kl = system.assemble(n, 100.0, ratio, KERNELS.index(kernel))
-        lu, ipiv, _ = lapack.dgbtrf(ab, kl, kl)
+        ref_lu, ref_ipiv, ref_info = lapack.dgbtrf(ab, kl, kl)
+        lu, ipiv, info = band.band_lu(ab, kl)
+        assert info == ref_info == 0 and np.array_equal(ipiv, ref_ipiv)
+        assert np.abs(lu - ref_lu).max() <= 10 * kl * eps * np.abs(ref_lu).max()
         anorm = np.abs(ab[kl:]).sum(axis=0).max()
-        rcond, _ = lapack.dgbcon(kl, kl, lu, ipiv, anorm)
-        ours = condition.inverse_norm_1(lu, ipiv, kl)
+        rcond, _ = lapack.dgbcon(kl, kl, ref_lu, ref_ipiv, anorm)
+        ours = band.inverse_norm_1(lu, ipiv, kl)
         assert ours == pytest.approx(1.0 / (rcond * anorm), rel=1e-9)
-        for transpose in (False, True):  # the band solves against LAPACK's on the same factors
+        for transpose in (False, True):  # the band solves against LAPACK's
             x = b.copy()
-            condition.band_solve(lu, ipiv, kl, x, transpose)
-            ref, _ = lapack.dgbtrs(lu, kl, kl, b[:, None], ipiv, trans=int(transpose))
+            band.band_solve(lu, ipiv, kl, x, transpose)
+            ref, _ = lapack.dgbtrs(ref_lu, kl, kl, b[:, None], ref_ipiv, trans=int(transpose))
             # same operations up to summation order: normwise differences are round-off times cond (eps cond)
-            tol = 10 * np.finfo(float).eps * ours * anorm
+            tol = 10 * eps * ours * anorm
             assert np.abs(x - ref[:, 0]).max() <= tol * np.abs(ref).max()
+    singular = np.zeros((4, 5))  # kl = 1, A = 0: info names the first zero pivot, as dgbtrf's
+    assert band.band_lu(singular, 1)[2] == lapack.dgbtrf(singular, 1, 1)[2] == 1
 
 
 def test_top_particle_on_the_surface_keeps_half_a_spacing_at_the_floor_and_the_one_neighbour_limit():

@@ -136,3 +136,25 @@ def test_polygon_areas_and_rest_levels_follow_the_walls():
     t = (-900 + np.sqrt(900**2 + 4 * 6 * 6720.0)) / 2
     assert theory.rest_level([box, trap], [0.0, -50.0], 8400.0, 1.25) == pytest.approx(t - 50.0, rel=1e-12)
     assert np.isnan(theory.rest_level([vee], [0.0], 1.25 * 3600.0 * 10, 1.25))  # more than the V holds
+
+
+def test_fixed_order_line_dot_and_solve_match_numpy_to_round_off():
+    """core.fixed_order's forms against numpy's BLAS/LAPACK ones: equal to round-off (their point, the same bits on
+    every machine, cannot be shown on one)."""
+    from isaflow.core import fixed_order as FO
+
+    rng = np.random.default_rng(7)
+    x, y = rng.uniform(0, 100, 257), rng.normal(size=257)
+    slope, intercept = FO.line(x, y)
+    ref = np.polyfit(x, y, 1)
+    assert slope == pytest.approx(ref[0], rel=1e-10, abs=1e-14) and intercept == pytest.approx(ref[1], rel=1e-10)
+    assert np.abs(FO.residual(x, y) - (y - np.polyval(ref, x))).max() < 1e-12
+    flat = FO.line(x, np.full_like(x, 72.39))
+    assert abs(flat[0]) < 1e-15 and flat[1] == pytest.approx(72.39, rel=1e-15)
+    a, b = rng.normal(size=(50, 2)), rng.normal(size=2)
+    assert np.abs(FO.dot2(a, b) - a @ b).max() < 1e-15
+    m, f = rng.normal(size=(2, 2)), rng.normal(size=2)
+    assert np.allclose(FO.solve2(m, f), np.linalg.solve(m, f), rtol=1e-12)
+    assert FO.det2(m) == pytest.approx(np.linalg.det(m), rel=1e-12)
+    with pytest.raises(ValueError, match="one x"):
+        FO.line([1.0, 1.0], [0.0, 1.0])

@@ -39,7 +39,7 @@ import numpy as np
 
 from . import at_rest, theory
 from . import tank as T
-from .core import neighbours as NB
+from .core import neighbours as NB, fixed_order as FO
 
 
 def vessel_view(ds, vessel=None):
@@ -206,7 +206,7 @@ def normal_loads(ds, vessel=None):
         e = walls[w, 2:] - walls[w, :2]
         n = np.array([-e[1], e[0]]) / np.hypot(e[0], e[1])
         on = cw == w
-        out[name] = float(np.sum((force[on] @ n) * (1 - 2 * side[on])))
+        out[name] = float(np.sum(FO.dot2(force[on], n) * (1 - 2 * side[on])))
     return out
 
 

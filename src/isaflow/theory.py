@@ -11,9 +11,12 @@ a method's own theory takes the weight it holds and the depth of its own free
 surface (metrics.load_errors).
 """
 
+import math
+
 import numpy as np
 
 from . import tank as T
+from .core import fixed_order as FO
 
 
 def surface_profile(pos, a, x_range):
@@ -42,8 +45,8 @@ def surface_slope(x, top):
     a liquid at rest has both about 0.  NaN for fewer than two strips."""
     if len(x) < 2:
         return float("nan"), float("nan")
-    k = np.polyfit(x, top, 1)[0]
-    return float(np.degrees(np.arctan(k))), float(top.max() - top.min())
+    k, _ = FO.line(x, top)
+    return math.degrees(math.atan(k)), float(top.max() - top.min())
 
 
 def specific_weight(total_weight, width, level, floor_y=0.0):

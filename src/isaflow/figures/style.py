@@ -9,6 +9,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+from ..core import fixed_order as FO  # noqa: E402
+
 plt.rcParams.update({"font.size": 9, "axes.titlesize": 9, "figure.dpi": 110, "savefig.dpi": 150})
 
 COMPUTED, THEORY, PAPER = "tab:blue", "tab:orange", "tab:red"
@@ -126,8 +128,8 @@ def surface_line(ax, ds, vessel, color, name=None):
                   f"slope {s['slope_deg']:.1f}°{_falls(s['slope_deg'])}, range {s['surface_range_cm']:.1f} cm; "
                   f"surface (+ half the layer pitch) at mean depth {depth:.1f} cm")
     if len(x) > 1:
-        k = np.polyfit(x, top, 1)
-        ax.plot(x, np.polyval(k, x), ":", color=color, lw=1, zorder=4)
+        k, c = FO.line(x, top)
+        ax.plot(x, k * np.asarray(x) + c, ":", color=color, lw=1, zorder=4)
     return s
 
 

@@ -11,6 +11,7 @@ import math
 import numpy as np
 
 from ... import metrics as M, theory as T
+from ...core import fixed_order as FO
 from ...quantities import Value, quantity
 from . import metrics as IM
 
@@ -116,7 +117,7 @@ def wall_distance(pos, walls):
     out = np.full(len(pos), np.inf)
     for x0, y0, x1, y1 in np.asarray(walls, float):
         e = np.array([x1 - x0, y1 - y0])
-        t = np.clip(((pos - [x0, y0]) @ e) / (e @ e), 0.0, 1.0)
+        t = np.clip(FO.dot2(pos - [x0, y0], e) / FO.dot2(e, e), 0.0, 1.0)
         d = pos - (np.array([x0, y0]) + t[:, None] * e)
         out = np.minimum(out, np.sqrt(d[:, 0] ** 2 + d[:, 1] ** 2))
     return out

@@ -5,6 +5,8 @@ Units: length cm, force N, stiffness N/cm.
 
 import numpy as np
 
+from ...core import fixed_order as FO
+
 
 def rhombs(pos0, a, tol=1e-6):
     """(R, 4) particle indices of the rhombic elements of a rhombic lattice (paper section 5).
@@ -71,8 +73,8 @@ def stiffness_matrix(pos, walls, wall_l_u, wall_r_u, pair_l_u, pair_r_u):
         add(j, i, -b)
     for x0, y0, x1, y1 in walls:
         e = np.array([x1 - x0, y1 - y0])
-        L2 = e @ e
-        t = ((pos - [x0, y0]) @ e) / L2
+        L2 = FO.dot2(e, e)
+        t = FO.dot2(pos - [x0, y0], e) / L2
         c = np.array([x0, y0]) + np.clip(t, 0, 1)[:, None] * e
         d = pos - c
         for i in np.flatnonzero(np.hypot(d[:, 0], d[:, 1]) < wall_l_u):

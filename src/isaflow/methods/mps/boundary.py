@@ -18,6 +18,7 @@ end, where the other vessel's liquid is seen in their place).
 import numpy as np
 from scipy.spatial import cKDTree
 
+from isaflow.core import fixed_order as FO
 from isaflow.core.geometry import inside_vessel
 from isaflow.core.panels import wall_panels
 
@@ -97,8 +98,8 @@ def wall_particles(walls, l0, layers=4, pressure_layers=2, thin=None):
         if thin[w]:
             continue
         rel = cand[:, :2] - a[w]
-        s = rel @ t[w]
-        d = rel @ nrm[w]
+        s = FO.dot2(rel, t[w])
+        d = FO.dot2(rel, nrm[w])
         keep &= ~((d > 1e-9) & (d < reach) & (s > -1e-9) & (s < L[w] + 1e-9) & (cw != w) & ~own_thin)
     cand = cand[keep]
     cand_w, cand_side, cand_s, cand_ds = cand[:, 3].astype(np.int64), cand[:, 4].astype(np.int64), cand[:, 5], cand[:, 6]
@@ -114,7 +115,7 @@ def wall_particles(walls, l0, layers=4, pressure_layers=2, thin=None):
     depth = np.full(len(cand), np.inf)
     for w in range(len(walls)):
         rel = cand[:, :2] - a[w]
-        u = np.clip(rel @ t[w], 0.0, L[w])
+        u = np.clip(FO.dot2(rel, t[w]), 0.0, L[w])
         d = np.hypot(*(rel - u[:, None] * t[w]).T)
         mine = np.where(thin[cand_w], cand_w == w, ~thin[w])
         depth = np.where(mine, np.minimum(depth, d), depth)
@@ -183,7 +184,7 @@ def load_map(walls, bnd, panel_length):
     pitch = np.zeros(len(walls))  # the rows' spacing along each wall (its first row's stretches)
     pitch[bnd["face_wall"]] = bnd["face_ds"]
     half = 0.5 * pitch[bw]
-    mid = np.clip(np.einsum("ij,ij->i", bnd["pos"] - a[bw], t[bw]), half, L[bw] - half)
+    mid = np.clip(FO.dot2(bnd["pos"] - a[bw], t[bw]), half, L[bw] - half)
     share = np.zeros((len(panel_wall), len(bw)))
     for q in range(len(panel_wall)):
         on = (bw == panel_wall[q]) & (bs == panel_side[q])

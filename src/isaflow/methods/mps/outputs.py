@@ -13,6 +13,7 @@ import numpy as np
 import pandas as pd
 
 from isaflow import metrics, runfile
+from isaflow.core import fixed_order as FO
 from isaflow.core.units import G
 
 
@@ -82,10 +83,9 @@ def pressure_profile(pos, p, l0, rho_g, depth, below=2.5):
     deep = d > below * l0
     if deep.sum() < 3:
         return np.nan, np.nan
-    A = np.column_stack([d[deep], np.ones(int(deep.sum()))])
-    coef = np.linalg.lstsq(A, p[deep], rcond=None)[0]
-    res = p[deep] - A @ coef
-    return float(coef[0] / rho_g), float(np.sqrt(np.mean(res**2)) / (rho_g * depth))
+    slope, _ = FO.line(d[deep], p[deep])
+    res = FO.residual(d[deep], p[deep])
+    return slope / rho_g, float(np.sqrt(np.mean(res**2)) / (rho_g * depth))
 
 
 def escape_depth(ds):
@@ -99,7 +99,7 @@ def escape_depth(ds):
     a, b = walls[w, :2], walls[w, 2:]
     t = (b - a) / np.hypot(*(b - a))
     normal = np.array([-t[1], t[0]])  # liquid on the wall's left
-    return float(-(ds["pos"].values[int(m.group(1))] - a) @ normal)
+    return float(-FO.dot2(ds["pos"].values[int(m.group(1))] - a, normal))
 
 
 def summary_row(path):

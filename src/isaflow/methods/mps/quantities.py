@@ -5,6 +5,7 @@ import math
 
 import numpy as np
 
+from ...core import fixed_order as FO
 from ...quantities import Value, quantity
 
 
@@ -24,7 +25,7 @@ def noise(ds, window=None):
     tt = t[win]
     mean = mag.mean(0)
     wet = mean > 0.01 * mean.max()
-    res = mag[:, wet] - np.array([np.polyval(np.polyfit(tt, mag[:, k], 1), tt) for k in np.flatnonzero(wet)]).T
+    res = np.array([FO.residual(tt, mag[:, k]) for k in np.flatnonzero(wet)]).T
     rel = float(np.mean(res.std(0) / mean[wet]))
     tot = res.sum(1)
     s = 0.0

@@ -13,6 +13,7 @@ sees the same lattice on both sides.
 
 import numpy as np
 
+from ...core import fixed_order as FO
 from ...core.geometry import inside_vessel
 from ...core.neighbours import build_pairs
 
@@ -202,7 +203,7 @@ def wall_contacts(walls, wpos, owner, force):
     for q, (w, (px, py), f) in enumerate(zip(owner, wpos, force)):
         x0, y0, x1, y1 = walls[w]
         e = np.array([x1 - x0, y1 - y0])
-        t = ((px - x0) * e[0] + (py - y0) * e[1]) / (e @ e)
+        t = ((px - x0) * e[0] + (py - y0) * e[1]) / FO.dot2(e, e)
         if 0.0 <= t <= 1.0 or (w, int(t > 1.0)) not in jt:
             tc = min(1.0, max(0.0, t))
             ws.append(w)
@@ -216,10 +217,10 @@ def wall_contacts(walls, wpos, owner, force):
             ek = walls[k, 2:] - walls[k, :2]
             n.append(np.array([-ek[1], ek[0]]) / np.hypot(*ek))  # liquid-side normal
         A = np.column_stack(n)
-        if abs(np.linalg.det(A)) < 1e-9:
-            coef = np.array([0.5, 0.5]) * (f @ n[0])
+        if abs(FO.det2(A)) < 1e-9:
+            coef = np.array([0.5, 0.5]) * FO.dot2(f, n[0])
         else:
-            coef = np.linalg.solve(A, f)
+            coef = FO.solve2(A, f)
         for k, c, nk in zip((w, other), coef, n):
             ws.append(k)
             pts.append(list(corner))

@@ -6,6 +6,7 @@ import math
 import numpy as np
 
 from ... import metrics as M, rest as REST
+from ...core import fixed_order as FO
 from ...core.units import G
 from ...quantities import Value, quantity
 
@@ -30,7 +31,7 @@ def dominant_over_sloshing(ds):
     side = [k for k in range(len(names)) if np.isclose(walls[k, 0], walls[k, 2])]
     t = ds["sample_time"].values
     y = np.abs(ds["sample_wall_resultant"].values[:, side, 0]).sum(1)
-    y = y - np.polyval(np.polyfit(t, y, 1), t)
+    y = FO.residual(t, y)
     spec = np.abs(np.fft.rfft(y)) ** 2
     f = float(np.fft.rfftfreq(len(y), float(np.median(np.diff(t))))[1:][np.argmax(spec[1:])])
     k = math.pi / M.vessel_view(ds)["width"]

@@ -3,7 +3,7 @@
 Merino-Alonso, Macia & Souto-Iglesias (2020), abstract only: a liquid column
 at rest, the SPH momentum balance grad p = -rho g at every particle, the kernel
 truncated at the free surface; A p = b is solved directly (no time stepping).
-Modules: ``system`` (assembly, banded), ``column`` (one solve), ``condition`` (its
+Modules: ``system`` (assembly, banded), ``column`` (one solve), ``band`` (its LU, solves and
 condition number, deterministically), ``closed_form`` (one neighbour per side), ``sweep``
 (N x h/dx x kernel, the classification), ``settings`` and ``checks`` (the values of
 config/methods/sph1d.yaml, plausibility and cost), ``pipeline`` (what the rules call),

@@ -28,6 +28,7 @@ import numpy as np
 from isaflow.core.smoothing import NORM, dw, kernel_id
 
 from .system import FLOORS, exact_pressure, positions, spacing
+from .column import quadratic_error
 
 
 def kappa(kernel, ratio):
@@ -66,5 +67,5 @@ def error(n, ratio, kernel, floor="mirror_hydrostatic", top_gap=0.5, gradient="s
     if top_gap == 0.5 and gradient == "symmetric":
         return np.sqrt((k - 1) ** 2 + (6 * (k - 1) * (k - beta) + 3 * (k - beta) ** 2) / (4.0 * n**2 - 1))
     p_ex = exact_pressure(positions(n, 1.0, top_gap), 1.0, 1.0)
-    return np.array([np.linalg.norm(pressure(n, r, kernel, floor, 1.0, 1.0, top_gap, gradient) - p_ex)
-                     / np.linalg.norm(p_ex) for r in np.atleast_1d(ratio)]).reshape(np.shape(k))
+    return np.array([quadratic_error(pressure(n, r, kernel, floor, 1.0, 1.0, top_gap, gradient), p_ex)
+                     for r in np.atleast_1d(ratio)]).reshape(np.shape(k))

@@ -1,14 +1,13 @@
-"""Solve one truncated SPH column: banded LU (LAPACK dgbtrf/dgbtrs), 1-norm condition number
-(Higham's estimate, ``condition``) and the quadratic error against the exact hydrostatic pressure."""
+"""Solve one truncated SPH column: banded LU and 1-norm condition number (Higham's estimate), both ``band``'s
+plain loops, and the quadratic error against the exact hydrostatic pressure (numpy's pairwise sums, not BLAS:
+the same bits on every machine)."""
 
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg import lapack
-
 from isaflow.core.smoothing import kernel_id
 
-from . import condition, system
+from . import band, system
 
 
 @dataclass
@@ -22,9 +21,15 @@ class ColumnSolution:
     status: str  # "converged" (solved) or "solver_failed" (A exactly singular)
 
 
+def norm_2(x):
+    """sqrt(sum x^2) by numpy's pairwise sum (np.linalg.norm calls BLAS ddot, whose order follows the CPU)."""
+    x = np.asarray(x, float)
+    return float(np.sqrt(np.sum(x * x)))
+
+
 def quadratic_error(p, p_exact):
     """Relative discrete L2 error sqrt(sum (p - p_ex)^2 dx) / sqrt(sum p_ex^2 dx) (dx cancels)."""
-    return float(np.linalg.norm(p - p_exact) / np.linalg.norm(p_exact))
+    return norm_2(p - p_exact) / norm_2(p_exact)
 
 
 def max_error(p, p_exact):
@@ -41,13 +46,13 @@ def solve_column(n, ratio, kernel, gradient="symmetric", floor="mirror_hydrostat
     z = system.positions(n, height, top_gap)
     p_ex = system.exact_pressure(z, height, rho_g)
     anorm = np.abs(ab[kl:]).sum(axis=0).max()  # 1-norm: largest column sum
-    lu, ipiv, info = lapack.dgbtrf(ab, kl, kl)
+    lu, ipiv, info = band.band_lu(ab, kl)
     if info != 0 or anorm == 0.0:
         nan = np.full(n, np.nan)
         return ColumnSolution(z, nan, p_ex, np.inf, np.inf, np.inf, "solver_failed")
-    p, info = lapack.dgbtrs(lu, kl, kl, b[:, None], ipiv)
-    p = p[:, 0]
-    cond = float(anorm * condition.inverse_norm_1(lu, ipiv, kl))
+    p = b.copy()
+    band.band_solve(lu, ipiv, kl, p, False)
+    cond = float(anorm * band.inverse_norm_1(lu, ipiv, kl))
     if not np.all(np.isfinite(p)):
         return ColumnSolution(z, p, p_ex, np.inf, np.inf, cond, "solver_failed")
     return ColumnSolution(z, p, p_ex, quadratic_error(p, p_ex), max_error(p, p_ex), cond, "converged")

@@ -70,7 +70,7 @@ def assemble_banded(n, height, ratio, kind, norm, c_self, beta, rho_g, kl, top_g
     """LAPACK band storage of A and the right-hand side b.
 
     Returns ab (2 kl + kl + 1, N) with A[i, j] = ab[2 kl + i - j, j] (the
-    layout dgbtrf expects, kl = ku rows of fill-in space on top) and b (N,).
+    layout of LAPACK dgbtrf and band.band_lu, kl = ku rows of fill-in space on top) and b (N,).
     A is in 1/cm, b in N/cm^3; top_gap [dx] as in spacing.
     """
     dx = height / (n - 0.5 + top_gap)  # spacing()
