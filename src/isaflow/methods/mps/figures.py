@@ -61,19 +61,25 @@ FLOW_COLUMNS = 5  # snapshots per flow row: a fifth of the time limit apart
 
 
 def _flow_columns(ds):
-    """(positions, times) of the FLOW_COLUMNS stored states nearest k / FLOW_COLUMNS of the run's time limit
-    after its start (k = 1 ...), the last the end state; the final state alone for a run without snapshots."""
+    """(positions, times) of the stored states nearest k / FLOW_COLUMNS of the run's time limit after its start
+    (k = 1 ...) that fall before its end, each state once, then the end state: a run that stopped early (converged)
+    has fewer columns; the final state alone for a run without snapshots."""
     if "snap_pos" not in ds:
         return ds["pos"].values[None], [float(ds["sim_time"])]
     t = ds["snap_time"].values
     t0, limit = float(ds.attrs.get("start_time", t[0])), float(ds.attrs["time_limit_s"])
-    keep = [int(np.argmin(np.abs(t - (t0 + limit * k / FLOW_COLUMNS)))) for k in range(1, FLOW_COLUMNS)] + [len(t) - 1]
+    keep = []
+    for k in range(1, FLOW_COLUMNS):
+        i = int(np.argmin(np.abs(t - (t0 + limit * k / FLOW_COLUMNS))))
+        if i < len(t) - 1 and i not in keep:
+            keep.append(i)
+    keep.append(len(t) - 1)
     return ds["snap_pos"].values[keep], t[keep]
 
 
 def flow(runs, outputs):
     """Rows: runs; columns: position snapshots of the flow [cm] with the walls: the stored ones nearest a fifth,
-    two fifths ... of the run's time limit after its start (the last: its end state)."""
+    two fifths ... of the run's time limit after its start, before its end (the last: its end state)."""
     out = outputs
     dss = [runfile.read(p) for p in runs]
     ncol = FLOW_COLUMNS
@@ -86,14 +92,15 @@ def flow(runs, outputs):
                         f"{m['surface_range_cm']:.1f} cm", (0, 1.32), xycoords="axes fraction", fontsize=8,
                         color=v.colour, fontweight="bold")
         snaps, times = _flow_columns(ds)
-        for ax, pos, t in zip(row, snaps, times):
+        for col, (ax, pos, t) in enumerate(zip(row, snaps, times)):
             for w in ds["wall_segment"].values:
                 ax.plot(w[[0, 2]], w[[1, 3]], "k-", lw=1)
             ax.plot(pos[:, 0], pos[:, 1], ".", color=v.colour, ms=1.5)
             ax.set_xlim(-10, 310)
             ax.set_ylim(-60, 110)
             ax.set_aspect("equal")
-            ax.set_title(f"l0 = {float(ds.attrs['spacing']):.3g} cm, t = {t:.2f} s", fontsize=7)
+            end = " (end state)" if col == len(snaps) - 1 else ""
+            ax.set_title(f"l0 = {float(ds.attrs['spacing']):.3g} cm, t = {t:.2f} s{end}", fontsize=7)
             ax.tick_params(labelsize=6)
         for ax in row[len(snaps):]:
             ax.axis("off")
@@ -101,7 +108,7 @@ def flow(runs, outputs):
         ax.set_xlabel("x [cm]", fontsize=7)
     for ax in axes[:, 0]:
         ax.set_ylabel("y [cm]", fontsize=7)
-    fig.suptitle("MPS flow into the second vessel: snapshots per pressure source term (last column: end state)", fontsize=9)
+    fig.suptitle("MPS flow into the second vessel: snapshots per pressure source term (last column: end state; a run that converged early has fewer)", fontsize=9)
     fig.tight_layout()
     save(fig, out)
 
