@@ -612,8 +612,9 @@ def may_collide(pos, ps, kind, nearest, cdist, reach):
 
 @njit(inline="always", **JIT)
 def _terms_row(i, ps, vs, start, nbr, tw, tside, near, thin, behind, cut2, re_n, re_g, rmax, dist, div, vis):
-    """Row i of pressure_terms: stores its entries' distances (inf: cut or unseen); returns (number density, K&O divergence sum (div), sum_j r_ij over r < rmax (x, y)).  div and vis are
-    constants at the call sites (_explicit_row)."""
+    """Row i of pressure_terms: stores its entries' distances (inf: cut or unseen); returns (number density, K&O
+    divergence sum (div), sum_j r_ij over r < rmax (x, y)).  div and vis are constants in each of _terms_rows' four
+    functions."""
     plain = plain_row(i, tw, near, thin)
     nd = dv = sx = sy = 0.0
     first, end = row_span(start, i)
@@ -633,6 +634,31 @@ def _terms_row(i, ps, vs, start, nbr, tw, tside, near, thin, behind, cut2, re_n,
             sx += dx
             sy += dy
     return nd, dv, sx, sy
+
+
+# _terms_row with its flags (divergence, visibility) constant, each a function of its own: pressure_terms' parallel
+# loop calls one of them.  Numba-inlined into the loop itself, the four copies took 32 of the method's 85 s of
+# compiling (parfor passes over the inlined bodies); as four small functions 6 s, at the same step cost.
+
+
+@njit(**JIT)
+def _row_div_vis(i, ps, vs, start, nbr, tw, tside, near, thin, behind, cut2, re_n, re_g, rmax, dist):
+    return _terms_row(i, ps, vs, start, nbr, tw, tside, near, thin, behind, cut2, re_n, re_g, rmax, dist, True, True)
+
+
+@njit(**JIT)
+def _row_div(i, ps, vs, start, nbr, tw, tside, near, thin, behind, cut2, re_n, re_g, rmax, dist):
+    return _terms_row(i, ps, vs, start, nbr, tw, tside, near, thin, behind, cut2, re_n, re_g, rmax, dist, True, False)
+
+
+@njit(**JIT)
+def _row_vis(i, ps, vs, start, nbr, tw, tside, near, thin, behind, cut2, re_n, re_g, rmax, dist):
+    return _terms_row(i, ps, vs, start, nbr, tw, tside, near, thin, behind, cut2, re_n, re_g, rmax, dist, False, True)
+
+
+@njit(**JIT)
+def _row_plain(i, ps, vs, start, nbr, tw, tside, near, thin, behind, cut2, re_n, re_g, rmax, dist):
+    return _terms_row(i, ps, vs, start, nbr, tw, tside, near, thin, behind, cut2, re_n, re_g, rmax, dist, False, False)
 
 
 @njit(inline="always", **JIT)
@@ -672,17 +698,17 @@ def pressure_terms(ps, vs, kind, start, nbr, tw, tside, near, thin, c, n_now, n_
         if kind[i] == DUMMY:
             continue
         if mps_div and vis:
-            nd_i, dv, sx, sy = _terms_row(i, ps, vs, start, nbr, tw, tside, near, thin, c.behind, cut2, c.re_n, c.re_g,
-                                          c.rmax, dist, True, True)
+            nd_i, dv, sx, sy = _row_div_vis(i, ps, vs, start, nbr, tw, tside, near, thin, c.behind, cut2, c.re_n,
+                                            c.re_g, c.rmax, dist)
         elif mps_div:
-            nd_i, dv, sx, sy = _terms_row(i, ps, vs, start, nbr, tw, tside, near, thin, c.behind, cut2, c.re_n, c.re_g,
-                                          c.rmax, dist, True, False)
+            nd_i, dv, sx, sy = _row_div(i, ps, vs, start, nbr, tw, tside, near, thin, c.behind, cut2, c.re_n, c.re_g,
+                                        c.rmax, dist)
         elif vis:
-            nd_i, dv, sx, sy = _terms_row(i, ps, vs, start, nbr, tw, tside, near, thin, c.behind, cut2, c.re_n, c.re_g,
-                                          c.rmax, dist, False, True)
+            nd_i, dv, sx, sy = _row_vis(i, ps, vs, start, nbr, tw, tside, near, thin, c.behind, cut2, c.re_n, c.re_g,
+                                        c.rmax, dist)
         else:
-            nd_i, dv, sx, sy = _terms_row(i, ps, vs, start, nbr, tw, tside, near, thin, c.behind, cut2, c.re_n, c.re_g,
-                                          c.rmax, dist, False, False)
+            nd_i, dv, sx, sy = _row_plain(i, ps, vs, start, nbr, tw, tside, near, thin, c.behind, cut2, c.re_n,
+                                          c.re_g, c.rmax, dist)
         div_i = divergence_value(False, dv, c.n0_g) if mps_div else 0.0
         if alone:
             surf[i], low[i], b[i] = _terms_tail(i, nd_i, div_i, nd_i, sx, sy, c, dt, source, a_d, a_v, n_now, n_prev)
