@@ -549,6 +549,14 @@ def _explicit_row(i, pos, vel, kind, start, nbr, tw, tside, near, thin, behind, 
     return lx, ly, nd, m2
 
 
+@njit(**JIT)
+def _explicit_any(i, pos, vel, kind, start, nbr, tw, tside, near, thin, behind, cut2, re_l, re_n, lap, ecs, vis):
+    """_explicit_row with its flags as arguments, a function of its own: the named options' case (ECS, or no
+    viscosity), called out of explicit_pass' parallel loop rather than numba-inlined into it a third time (compile
+    time; the settings' case keeps its two inlined copies with constant flags, where the step's cost is)."""
+    return _explicit_row(i, pos, vel, kind, start, nbr, tw, tside, near, thin, behind, cut2, re_l, re_n, lap, ecs, vis)
+
+
 @njit(**PAR)
 def explicit_pass(pos, vel, kind, start, nbr, tw, tside, near, thin, c, dt, gx, gy):
     """The explicit half (explicit) with the Laplacian of the velocity (laplacian, re_l, if nu > 0) and, with ECS, the
@@ -578,7 +586,7 @@ def explicit_pass(pos, vel, kind, start, nbr, tw, tside, near, thin, c, dt, gx, 
             lx *= cl
             ly *= cl
         elif not plain and ((fluid and lap) or (c.ecs and kind[i] != DUMMY)):
-            lx, ly, nd, nearest[i] = _explicit_row(i, pos, vel, kind, start, nbr, tw, tside, near, thin, c.behind, cut2,
+            lx, ly, nd, nearest[i] = _explicit_any(i, pos, vel, kind, start, nbr, tw, tside, near, thin, c.behind, cut2,
                                                    c.re_l, c.re_n, fluid and lap, c.ecs, vis)
             if c.ecs:
                 n_now[i] = nd
