@@ -1122,3 +1122,22 @@ def test_a_wall_crossing_is_an_escape_only_past_the_first_wall_particle_row(begi
         assert bad[0] == 2 and bad[1] == 0 and bad[2] == 1  # wall 1 is floor1
     else:
         assert bad[0] == 0 and 0.0 < deepest <= 0.5 * l0
+
+
+def test_flow_figure_columns_show_each_stored_state_once():
+    """mps_flow.png's columns (figures._flow_columns): a run that stopped before the later column times (the mixed
+    flow at rest at 17.16 s of a 24.3 s limit) shows each stored state once and then its end state, not its end
+    state twice; a run to its limit keeps FLOW_COLUMNS columns."""
+    import xarray as xr
+
+    from isaflow.methods.mps import figures
+
+    def run(t_end):
+        t = np.arange(0.0, t_end + 1e-9, 0.5)
+        return xr.Dataset({"snap_time": ("snap", t), "snap_pos": (("snap", "particle", "xy"), np.zeros((len(t), 1, 2)))},
+                          attrs={"start_time": 4.32, "time_limit_s": 20.0})
+
+    early = figures._flow_columns(run(17.16))[1]
+    assert len(early) == len(set(early)) == 4 and early[-1] == 17.0
+    full = figures._flow_columns(run(24.32))[1]
+    assert len(full) == len(set(full)) == figures.FLOW_COLUMNS and full[-1] == 24.0
