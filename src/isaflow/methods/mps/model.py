@@ -15,7 +15,7 @@ import collections
 
 import numpy as np
 from llvmlite import ir
-from numba import prange, types, uint64
+from numba import literally, prange, types, uint64
 from numba.extending import intrinsic
 
 from ...core.jit import njit
@@ -644,29 +644,15 @@ def _terms_row(i, ps, vs, start, nbr, tw, tside, near, thin, behind, cut2, re_n,
     return nd, dv, sx, sy
 
 
-# _terms_row with its flags (divergence, visibility) constant, each a function of its own: pressure_terms' parallel
-# loop calls one of them.  Numba-inlined into the loop itself, the four copies took 32 of the method's 85 s of
-# compiling (parfor passes over the inlined bodies); as four small functions 6 s, at the same step cost.
-
-
 @njit(**JIT)
-def _row_div_vis(i, ps, vs, start, nbr, tw, tside, near, thin, behind, cut2, re_n, re_g, rmax, dist):
-    return _terms_row(i, ps, vs, start, nbr, tw, tside, near, thin, behind, cut2, re_n, re_g, rmax, dist, True, True)
-
-
-@njit(**JIT)
-def _row_div(i, ps, vs, start, nbr, tw, tside, near, thin, behind, cut2, re_n, re_g, rmax, dist):
-    return _terms_row(i, ps, vs, start, nbr, tw, tside, near, thin, behind, cut2, re_n, re_g, rmax, dist, True, False)
-
-
-@njit(**JIT)
-def _row_vis(i, ps, vs, start, nbr, tw, tside, near, thin, behind, cut2, re_n, re_g, rmax, dist):
-    return _terms_row(i, ps, vs, start, nbr, tw, tside, near, thin, behind, cut2, re_n, re_g, rmax, dist, False, True)
-
-
-@njit(**JIT)
-def _row_plain(i, ps, vs, start, nbr, tw, tside, near, thin, behind, cut2, re_n, re_g, rmax, dist):
-    return _terms_row(i, ps, vs, start, nbr, tw, tside, near, thin, behind, cut2, re_n, re_g, rmax, dist, False, False)
+def _terms_row_fixed(i, ps, vs, start, nbr, tw, tside, near, thin, behind, cut2, re_n, re_g, rmax, dist, div, vis):
+    """_terms_row compiled once per value of its flags (numba.literally: div and vis literal constants at
+    pressure_terms' four call sites), a function of its own that the parallel loop calls.  Numba-inlined into the
+    loop itself, the four copies took 34 of the method's 85 s of compiling (parfor passes over the inlined bodies);
+    as four small functions 12 s, at the same step cost to 1 %."""
+    literally(div)
+    literally(vis)
+    return _terms_row(i, ps, vs, start, nbr, tw, tside, near, thin, behind, cut2, re_n, re_g, rmax, dist, div, vis)
 
 
 @njit(inline="always", **JIT)
@@ -706,17 +692,17 @@ def pressure_terms(ps, vs, kind, start, nbr, tw, tside, near, thin, c, n_now, n_
         if kind[i] == DUMMY:
             continue
         if mps_div and vis:
-            nd_i, dv, sx, sy = _row_div_vis(i, ps, vs, start, nbr, tw, tside, near, thin, c.behind, cut2, c.re_n,
-                                            c.re_g, c.rmax, dist)
+            nd_i, dv, sx, sy = _terms_row_fixed(i, ps, vs, start, nbr, tw, tside, near, thin, c.behind, cut2, c.re_n,
+                                                c.re_g, c.rmax, dist, True, True)
         elif mps_div:
-            nd_i, dv, sx, sy = _row_div(i, ps, vs, start, nbr, tw, tside, near, thin, c.behind, cut2, c.re_n, c.re_g,
-                                        c.rmax, dist)
+            nd_i, dv, sx, sy = _terms_row_fixed(i, ps, vs, start, nbr, tw, tside, near, thin, c.behind, cut2, c.re_n,
+                                                c.re_g, c.rmax, dist, True, False)
         elif vis:
-            nd_i, dv, sx, sy = _row_vis(i, ps, vs, start, nbr, tw, tside, near, thin, c.behind, cut2, c.re_n, c.re_g,
-                                        c.rmax, dist)
+            nd_i, dv, sx, sy = _terms_row_fixed(i, ps, vs, start, nbr, tw, tside, near, thin, c.behind, cut2, c.re_n,
+                                                c.re_g, c.rmax, dist, False, True)
         else:
-            nd_i, dv, sx, sy = _row_plain(i, ps, vs, start, nbr, tw, tside, near, thin, c.behind, cut2, c.re_n,
-                                          c.re_g, c.rmax, dist)
+            nd_i, dv, sx, sy = _terms_row_fixed(i, ps, vs, start, nbr, tw, tside, near, thin, c.behind, cut2, c.re_n,
+                                                c.re_g, c.rmax, dist, False, False)
         div_i = divergence_value(False, dv, c.n0_g) if mps_div else 0.0
         if alone:
             surf[i], low[i], b[i] = _terms_tail(i, nd_i, div_i, nd_i, sx, sy, c, dt, source, a_d, a_v, n_now, n_prev)
