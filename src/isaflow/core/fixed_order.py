@@ -1,4 +1,4 @@
-"""Small linear algebra in a fixed order, the same bits on every machine: least-squares lines, 2-vector dot
+"""Small linear algebra in a fixed order, the same bits on every machine: least-squares lines, 2-norms, 2-vector dot
 products, 2 x 2 solves.
 
 numpy's ``@``, ``np.dot``, ``np.linalg`` and ``np.polyfit`` call BLAS and LAPACK (OpenBLAS), whose kernels' summation
@@ -32,6 +32,12 @@ def residual(x, y):
     return np.asarray(y, float) - (slope * np.asarray(x, float) + intercept)
 
 
+def norm(x):
+    """sqrt(sum x^2) over every element of x, by numpy's pairwise sum (np.linalg.norm calls BLAS ddot)."""
+    x = np.asarray(x, float)
+    return float(np.sqrt(np.sum(x * x)))
+
+
 def dot2(a, b):
     """a . b over the last axis of length 2 (a, b broadcast: (..., 2) against (..., 2) or (2,)), in a's units
     times b's."""
@@ -42,7 +48,7 @@ def dot2(a, b):
 def solve2(m, f):
     """x (2,) with m x = f for a 2 x 2 m (Cramer's rule; the caller guards a singular m)."""
     (a, b), (c, d) = np.asarray(m, float)
-    det = a * d - b * c
+    det = det2(m)
     return np.array([(f[0] * d - b * f[1]) / det, (a * f[1] - c * f[0]) / det])
 
 

@@ -621,8 +621,8 @@ def may_collide(pos, ps, kind, nearest, cdist, reach):
 @njit(inline="always", **JIT)
 def _terms_row(i, ps, vs, start, nbr, tw, tside, near, thin, behind, cut2, re_n, re_g, rmax, dist, div, vis):
     """Row i of pressure_terms: stores its entries' distances (inf: cut or unseen); returns (number density, K&O
-    divergence sum (div), sum_j r_ij over r < rmax (x, y)).  div and vis are constants in each of _terms_rows' four
-    functions."""
+    divergence sum (div), sum_j r_ij over r < rmax (x, y)).  div and vis are constants in each compiled version of
+    _terms_row_fixed."""
     plain = plain_row(i, tw, near, thin)
     nd = dv = sx = sy = 0.0
     first, end = row_span(start, i)

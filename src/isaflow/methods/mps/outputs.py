@@ -83,8 +83,8 @@ def pressure_profile(pos, p, l0, rho_g, depth, below=2.5):
     deep = d > below * l0
     if deep.sum() < 3:
         return np.nan, np.nan
-    slope, _ = FO.line(d[deep], p[deep])
-    res = FO.residual(d[deep], p[deep])
+    slope, intercept = FO.line(d[deep], p[deep])
+    res = p[deep] - (slope * d[deep] + intercept)
     return slope / rho_g, float(np.sqrt(np.mean(res**2)) / (rho_g * depth))
 
 

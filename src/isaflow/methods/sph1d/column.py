@@ -5,6 +5,7 @@ the same bits on every machine)."""
 from dataclasses import dataclass
 
 import numpy as np
+from isaflow.core import fixed_order as FO
 from isaflow.core.smoothing import kernel_id
 
 from . import band, system
@@ -21,15 +22,9 @@ class ColumnSolution:
     status: str  # "converged" (solved) or "solver_failed" (A exactly singular)
 
 
-def norm_2(x):
-    """sqrt(sum x^2) by numpy's pairwise sum (np.linalg.norm calls BLAS ddot, whose order follows the CPU)."""
-    x = np.asarray(x, float)
-    return float(np.sqrt(np.sum(x * x)))
-
-
 def quadratic_error(p, p_exact):
     """Relative discrete L2 error sqrt(sum (p - p_ex)^2 dx) / sqrt(sum p_ex^2 dx) (dx cancels)."""
-    return norm_2(p - p_exact) / norm_2(p_exact)
+    return FO.norm(p - p_exact) / FO.norm(p_exact)
 
 
 def max_error(p, p_exact):
