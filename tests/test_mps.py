@@ -1134,7 +1134,8 @@ def test_flow_figure_columns_show_each_stored_state_once():
 
     def run(t_end):
         t = np.arange(0.0, t_end + 1e-9, 0.5)
-        return xr.Dataset({"snap_time": ("snap", t), "snap_pos": (("snap", "particle", "xy"), np.zeros((len(t), 1, 2)))},
+        pos = np.zeros((len(t), 1, 2))
+        return xr.Dataset({"snap_time": ("snap", t), "snap_pos": (("snap", "particle", "xy"), pos)},
                           attrs={"start_time": 4.32, "time_limit_s": 20.0})
 
     early = figures._flow_columns(run(17.16))[1]

@@ -108,7 +108,8 @@ def flow(runs, outputs):
         ax.set_xlabel("x [cm]", fontsize=7)
     for ax in axes[:, 0]:
         ax.set_ylabel("y [cm]", fontsize=7)
-    fig.suptitle("MPS flow into the second vessel: snapshots per pressure source term (last column: end state; a run that converged early has fewer)", fontsize=9)
+    fig.suptitle("MPS flow into the second vessel: snapshots per pressure source term (last column: end state; "
+                 "a run that converged early has fewer)", fontsize=9)
     fig.tight_layout()
     save(fig, out)
 
