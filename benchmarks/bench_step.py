@@ -474,7 +474,7 @@ def state_diff(capped_file, newton_file, vessel=None):
     ea, eb = metrics.load_errors(a, vessel, "level"), metrics.load_errors(b, vessel, "level")
     view = metrics.vessel_view(a, vessel)
     tol = tolerances(dict(depth=ea["depth"], weight=ea["weight"]), float(a.attrs["spacing"]),
-                     int(view["inside"].sum()), float(a.attrs["f_tol"]))
+                     int(view["inside"].sum()), float(a.attrs["solver.f_tol"]))
     return dict(level_diff_cm=eb["level"] - ea["level"], level_tol_cm=tol["level"][0],
                 side_err_diff=eb["side_err"] - ea["side_err"], side_tol=tol["side"][0],
                 floor_err_diff=eb["floor_err"] - ea["floor_err"], floor_tol=tol["floor"][0])

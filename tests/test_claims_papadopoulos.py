@@ -99,7 +99,7 @@ def test_replay_repeats_the_run_bit_for_bit(small_runs, tmp_path):
     replay as the registry's derived file (rule derived): 0.18 w on the coarse lattice at the kept k_p."""
     ds = runfile.read(small_runs["isa:single_coarse"])
     r = replay.pair_increments(ds)
-    du, kp = float(ds.attrs["du"]), float(ds.attrs["pair_r_u"]) / float(ds.attrs["pair_l_u"])
+    du, kp = float(ds.attrs["solver.du"]), float(ds.attrs["forces.pair.r_u"]) / float(ds.attrs["forces.pair.l_u"])
     assert r["identical"] and r["steps"] == int(ds["steps"])
     assert r["max_component_move_cm"] <= du * (1 + 1e-10)
     assert 0 < r["max_pair_increment_N"] <= kp * 2 * math.sqrt(2) * du
@@ -215,6 +215,6 @@ def test_a_run_file_of_the_overdamped_variant_keeps_its_time_and_energy(tmp_path
     out = tmp_path / "od.nc"
     assert run_isa(out, "single", "coarse", "overdamped", ["solver.max_steps=400"], accept=("converged", "step_limit")) == 0
     ds = runfile.read(out)
-    assert ds.attrs["status"] == "step_limit" and float(ds["sim_time"]) == pytest.approx(400 * float(ds.attrs["dt"]))
+    assert ds.attrs["status"] == "step_limit" and float(ds["sim_time"]) == pytest.approx(400 * float(ds.attrs["solver.dt"]))
     assert "hist_energy" in ds and float(ds.attrs["damping"]) == pytest.approx(
-        2 * float(ds.attrs["zeta"]) * math.sqrt(50.0 / G * float(ds.attrs["lambda_max"])))
+        2 * float(ds.attrs["solver.zeta"]) * math.sqrt(50.0 / G * float(ds.attrs["solver.lambda_max"])))

@@ -124,7 +124,7 @@ def test_every_method_holds_the_weight_and_loads_the_walls_as_the_theory(vee_run
             surface = (-pitch, float(r["initial_depth_cm"]) - H)
         else:
             assert r["status"] == "converged"  # at rest: the momentum bound holds over the load window
-            window = float(ds.attrs.get("load_window", ds.attrs.get("average_window_s", np.nan)))
+            window = float(ds.attrs.get("load_window", ds.attrs.get("time.average_window", np.nan)))
             depth = max(H, float(r["initial_depth_cm"]))
             bound = 2 * math.sqrt(2 * float(ds.attrs["rest_energy_ratio"]) * depth / G) / window
             assert abs(walls[1] / W - 1) <= bound and abs(walls[0]) <= bound * W

@@ -809,7 +809,7 @@ def test_mass_momentum_and_recorded_variant(column_runs, tmp_path):
         ds = runfile.to_dataset(r, tank, {"command": "test"}, runfile.now(), runfile.now(), COARSE)
         runfile.write(ds, tmp_path / f"{v}.nc")
         back = runfile.read(tmp_path / f"{v}.nc")
-        assert back.attrs["variant"] == v and back.attrs["source_term"] == v
+        assert back.attrs["variant"] == v
         assert back.attrs["variant_label"] == registry()["mps"].variants[v].label
         assert back["pressure"].attrs["units"] == "N cm-2"
         a = back.attrs

@@ -100,14 +100,14 @@ def test_literal_update_settles_in_a_cycle_at_the_stability_floor(single_runs, n
     ds = single_runs[name, "paper"]
     a = ds.attrs
     assert a["status"] == "cycle" and a["cycle_period"] == 2
-    lam, floor = isa_theory.step_floor(ds["pos"].values, ds["wall_segment"].values, a["wall_l_u"], a["wall_r_u"],
-                                   a["pair_l_u"], a["pair_r_u"], a["du"])
+    lam, floor = isa_theory.step_floor(ds["pos"].values, ds["wall_segment"].values, a["forces.wall.l_u"], a["forces.wall.r_u"],
+                                   a["forces.pair.l_u"], a["forces.pair.r_u"], a["solver.du"])
     tail = ds["hist_fmax"].values[-20:]
     lo, hi = ds["hist_fmax_lo"].values[-20:].min(), ds["hist_fmax_hi"].values[-20:].max()
-    assert lo > 10 * a["f_tol"]
+    assert lo > 10 * a["solver.f_tol"]
     assert lo < floor < hi
     assert 0.5 * (lo + hi) == pytest.approx(floor, rel=0.05)
-    assert np.all(tail > a["f_tol"])
+    assert np.all(tail > a["solver.f_tol"])
 
 
 @pytest.mark.parametrize("name", PAPER_LEVEL)

@@ -11,6 +11,7 @@ import yaml
 from isaflow import cli, runfile, settings as S, tank as T
 from isaflow.inputs import InputError
 from isaflow.methods.isa import scene
+from isaflow.methods.isa import settings as isa_settings
 from isaflow.methods.isa.settings import VALUES
 
 from conftest import ISA_SETTINGS, ROOT, TANKS, TINY, run_spec, write_spec
@@ -133,11 +134,16 @@ def test_tiny_scene_end_to_end_through_the_command_line(tmp_path):
     # every variable has units; provenance is complete
     assert all("units" in ds[v].attrs for v in ds.variables if v not in ds.coords)
     for key in ("git_commit", "git_dirty", "tank_sha256", "settings_sha256", "package_versions", "command",
-                "time_coverage_start", "time_coverage_end", "Conventions", "variant_label", "settings_resolved",
+                "time_coverage_start", "time_coverage_end", "Conventions", "variant_label", "settings_sources",
                 "tank_weight", "tank_rho_g", "layer_pitch", "held_weight", "tank_difference", "threads"):
         assert ds.attrs[key] not in ("", None), key
     assert "ACDD" in ds.attrs["Conventions"] and "numba==" in ds.attrs["package_versions"]
-    assert "solver.du = 0.01" in ds.attrs["settings_resolved"]
+    # the settings under their dotted keys (settings.attributes): as written, or derived where the file says null
+    assert ds.attrs["solver.du"] == 0.01 and "solver.du: cm" in ds.attrs["settings_units"].splitlines()
+    f_ref = isa_settings.f_ref_default(0.01, ds.attrs["forces.wall.r_u"] / ds.attrs["forces.wall.l_u"],
+                                       ds.attrs["forces.pair.r_u"] / ds.attrs["forces.pair.l_u"])
+    assert ds.attrs["solver.f_ref"] == pytest.approx(f_ref, rel=1e-15) and "solver.f_ref: derived" in \
+        ds.attrs["settings_sources"]
     assert not list(tmp_path.glob(".*partial*"))
 
 

@@ -53,7 +53,7 @@ def hydrostatic_run(h=60.0, a=10.0, width=100.0, w=50.0):
          "contact_point": (("contact", "xy"), cp[keep]),
          "contact_force": (("contact", "xy"), normal[keep] * mag[keep, None]), "residual": ((), 0.05)},
         coords={"wall": ["left", "floor", "right"], "xy": ["x", "y"]})
-    ds.attrs.update(spacing=a, wall_l_u=5.0, wall_r_u=10000.0, pair_l_u=a / np.sqrt(2), pair_r_u=500 * a / np.sqrt(2))
+    ds.attrs.update(spacing=a, **{"forces.wall.l_u": 5.0, "forces.wall.r_u": 10000.0, "forces.pair.l_u": a / np.sqrt(2), "forces.pair.r_u": 500 * a / np.sqrt(2)})
     return ds
 
 
@@ -86,7 +86,7 @@ def test_halved_side_loads_show_in_every_side_measure():
 def test_law_usage_by_hand():
     ds = hydrostatic_run(h=60.0)
     pos = ds["pos"].values.copy()
-    l_pu = ds.attrs["pair_l_u"]
+    l_pu = ds.attrs["forces.pair.l_u"]
     pos[1] = pos[0] + [0.5 * l_pu, 0.0]  # one pair at half the pair law's range
     ds["pos"].values[:] = pos
     u = metrics.law_usage(ds)

@@ -165,15 +165,10 @@ def write(p, result, started, finished, command=None):
     prov = runfile.provenance(files, command)
     prov.update(run_id=p.run_id, run_label=p.label or "none", resolution=p.resolution,
                 stability_case=int(p.stability),
-                settings_resolved=settings_text(p.settings),
                 threads=result.params.get("threads", p.threads or 0))
+    prov.update(settings.attributes(p.settings, {k: v for k, v in result.params.items() if k in p.settings}))
     ds = runfile.to_dataset(result, p.tank, prov, started, finished, references=p.entry.REFERENCES)
     runfile.write(ds, p.out)
-
-
-def settings_text(s):
-    """The resolved settings as 'key = value  # source' lines (a run-file attribute)."""
-    return "\n".join(f"{k} = {v!r}  # {s.sources.get(k, '')}" for k, v in sorted(s.items()))
 
 
 def run(method, tank, variant, resolution, out, settings_path=None, overrides=(), start=None,

@@ -17,11 +17,13 @@ A method gives the JSON schema of each value by dotted key (its ``VALUES``);
 refused everywhere.  :func:`load` applies a resolution, then a variant, then
 overrides (``key=value`` strings parsed as hardened YAML, or ``{key: leaf}``
 mappings) and checks every value again.  Every error is one line naming the
-file and the field (inputs.InputError).  Pure Python (yaml, jsonschema): the
+file and the field (inputs.InputError).  A run file holds the resolved settings under their dotted keys
+(:func:`attributes`, the one naming rule; figures, tables and claims read those names).  Pure Python (yaml, jsonschema): the
 workflow reads settings while it is parsed.
 """
 
 import copy
+import json
 
 from . import inputs
 from .inputs import InputError
@@ -41,6 +43,12 @@ OUTCOMES = {
     "solver_failed": "an implicit (pressure) solve did not reach its tolerance",
 }
 OUTCOME_NAMES = list(OUTCOMES)
+
+
+def with_units(units, schema):
+    """A value's schema (a method's VALUES entry) with its units, which the run file records (settings_units,
+    :func:`attributes`); jsonschema ignores the keyword."""
+    return {**schema, "units": units}
 
 
 def leaf(value_schema):
@@ -295,3 +303,41 @@ def load(path, values, variant=None, resolution=None, overrides=(), what="settin
     if overrides:
         apply(s, overrides, values, path)
     return s
+
+
+def attribute(value):
+    """One setting's value as a netCDF attribute: numbers and strings as they are, booleans as 0 / 1 (a CF
+    flag), anything else (null, lists, mappings, an integer netCDF cannot hold) as JSON text."""
+    value = value.item() if hasattr(value, "item") and not isinstance(value, (list, dict)) else value  # NumPy scalar
+    if isinstance(value, bool):
+        return int(value)
+    if isinstance(value, int) and -2**63 <= value < 2**63 or isinstance(value, (float, str)):
+        return value
+    return json.dumps(value, sort_keys=True, separators=(",", ":"))
+
+
+def attributes(settings, derived=None):
+    """The run-file naming rule: {dotted key: attribute} of every resolved setting, one attribute per key
+    under the key's own name (``solver.du``, ``forces.wall.l_u``), plus ``settings_sources`` ("key: source"
+    lines) and ``settings_units`` ("key: units" lines, the ``units`` of each value's schema in VALUES).
+
+    derived: {dotted key: value} a method computed for a setting its file leaves null (ISA's ``solver.f_ref``);
+    a derived value for a setting the file gives is refused unless equal (the method ran with another value).
+    """
+    derived = derived or {}
+    schema = settings.schema or {}
+    out, sources, units = {}, [], []
+    for key in sorted(settings):
+        value, source = settings[key], settings.sources.get(key, "")
+        if key in derived:
+            if value is not None and derived[key] != value:
+                raise ValueError(f"{settings.path}: field '{key}': the method ran with {derived[key]!r}, the settings "
+                                 f"say {value!r}")
+            if value is None:
+                value, source = derived[key], f"derived: computed by the method (the file leaves it null; {source})"
+        out[key] = attribute(value)
+        sources.append(f"{key}: {source}")
+        if schema.get(key, {}).get("units"):
+            units.append(f"{key}: {schema[key]['units']}")
+    out.update(settings_sources="\n".join(sources), settings_units="\n".join(units))
+    return out

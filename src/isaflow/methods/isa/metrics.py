@@ -51,7 +51,7 @@ def wall_law_usage(ds):
         return dict(max_wall_reaction_N=np.nan, wall_gap_reduction=np.nan)
     mag = np.hypot(*ds["contact_force"].values.T)
     gap = np.hypot(*(ds["pos"].values[ds["contact_particle"].values] - ds["contact_point"].values).T)
-    return dict(max_wall_reaction_N=float(mag.max()), wall_gap_reduction=float(1.0 - gap.min() / ds.attrs["wall_l_u"]))
+    return dict(max_wall_reaction_N=float(mag.max()), wall_gap_reduction=float(1.0 - gap.min() / ds.attrs["forces.wall.l_u"]))
 
 
 def stress_ratio(ds, vessel=None):
@@ -63,20 +63,20 @@ def stress_ratio(ds, vessel=None):
     scale with K, so 1 - K is the side-wall deficit a solid-like lattice shows.
     Point-particle (ISA) runs only: NaN for methods without the pair law.
     """
-    if "pair_l_u" not in ds.attrs:
+    if "forces.pair.l_u" not in ds.attrs:
         return float("nan")
     v = vessel_view(ds, vessel)
     pos = ds["pos"].values
     a = ds.attrs
     (x0, x1), y0 = v["x_range"], v["floor_y"]
     h = level_of(ds, vessel) - y0
-    pi, pj = pairs(pos, float(a["pair_l_u"]))
+    pi, pj = pairs(pos, float(a["forces.pair.l_u"]))
     d = pos[pi] - pos[pj]
     mid = 0.5 * (pos[pi] + pos[pj])
     sel = ((mid[:, 0] > x0 + 0.2 * (x1 - x0)) & (mid[:, 0] < x1 - 0.2 * (x1 - x0))
            & (mid[:, 1] > y0 + 0.1 * h) & (mid[:, 1] < y0 + 0.6 * h))
     dist = np.hypot(d[sel, 0], d[sel, 1])
-    force = float(a["pair_r_u"]) * (1 - dist / float(a["pair_l_u"]))  # repulsive magnitude, N
+    force = float(a["forces.pair.r_u"]) * (1 - dist / float(a["forces.pair.l_u"]))  # repulsive magnitude, N
     sxx = np.sum(force * d[sel, 0] ** 2 / dist)
     syy = np.sum(force * d[sel, 1] ** 2 / dist)
     return float(sxx / syy) if syy > 0 else float("nan")
@@ -91,9 +91,9 @@ def run_row(ds, vessel=None):
         method=ds.attrs.get("method", "isa"),
         variant=ds.attrs["variant"],
         particles=int(ds.sizes["particle"]),
-        du_cm=float(ds.attrs.get("du", np.nan)),
+        du_cm=float(ds.attrs.get("solver.du", np.nan)),
         spacing_cm=float(ds.attrs["spacing"]),
-        f_tol_N=float(ds.attrs.get("f_tol", np.nan)),
+        f_tol_N=float(ds.attrs.get("solver.f_tol", np.nan)),
         steps=int(ds["steps"]),
         wall_time_s=float(ds["wall_time"]),
         status=ds.attrs["status"],
@@ -132,8 +132,8 @@ def convergence_measures(ds):
     a = ds.attrs
     out = {"lambda_max": np.nan, "stability_floor_N": np.nan, "band_lo_N": np.nan, "band_hi_N": np.nan}
     if a.get("method") == "isa" and ds.sizes["particle"] <= EIGEN_LIMIT and np.isfinite(ds["pos"].values).all():
-        lam, floor = theory.step_floor(ds["pos"].values, ds["wall_segment"].values, a["wall_l_u"], a["wall_r_u"],
-                                       a["pair_l_u"], a["pair_r_u"], a["du"])
+        lam, floor = theory.step_floor(ds["pos"].values, ds["wall_segment"].values, a["forces.wall.l_u"], a["forces.wall.r_u"],
+                                       a["forces.pair.l_u"], a["forces.pair.r_u"], a["solver.du"])
         out.update(lambda_max=lam, stability_floor_N=floor)
     if "hist_fmax_lo" in ds:
         out.update(band_lo_N=float(ds["hist_fmax_lo"].values[-10:].min()),
@@ -179,8 +179,8 @@ def law_usage(ds):
     if not np.isfinite(pos).all():
         return out
     mag = np.hypot(*ds["contact_force"].values.T)
-    out["wall_use"] = float(mag.max() / a["wall_r_u"]) if len(mag) else 0.0
-    l_u = float(a["pair_l_u"])
+    out["wall_use"] = float(mag.max() / a["forces.wall.r_u"]) if len(mag) else 0.0
+    l_u = float(a["forces.pair.l_u"])
     pi, pj = pairs(pos, l_u)
     if len(pi):
         d = np.hypot(*(pos[pi] - pos[pj]).T)
@@ -207,7 +207,7 @@ def transfer_curve(chain):
     x = ds["pos0"].values[:, 0]
     fs.append(float(np.count_nonzero((x >= x2[0]) & (x < x2[1]))) / ds.sizes["particle"])
     for d in chain:
-        dt = float(d.attrs["dt"]) if d.attrs.get("variant") == "overdamped" else 1.0
+        dt = float(d.attrs["solver.dt"]) if d.attrs.get("variant") == "overdamped" else 1.0
         ts += list((d["sample_step"].values - t0) * dt)
         fs += list(d["sample_vessel_count"].values[:, -1] / d.sizes["particle"])
     return np.array(ts, float), np.array(fs, float)

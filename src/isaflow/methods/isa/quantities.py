@@ -38,15 +38,15 @@ def level_above_floor(ds, vessel=None, level=SURFACE):
 @quantity("largest step component over du, minus 1", fmt=".3g")
 def step_excess(ds):
     """max over steps and particles of max(|u_x|, |u_y|) / du - 1 (the solver records the largest increment)."""
-    return float(ds.attrs["max_step_move"]) / float(ds.attrs["du"]) - 1.0
+    return float(ds.attrs["max_step_move"]) / float(ds.attrs["solver.du"]) - 1.0
 
 
 @quantity("largest initial overlap into a law's range", "cm", fmt=".3g")
 def initial_overlap(ds):
     """max(l_bu - l_b, l_pu - l_p) over the initial particles and pairs: <= 0 means every force starts at zero."""
     pos0 = ds["pos0"].values
-    gb = float(wall_distance(pos0, ds["wall_segment"].values).min()) - float(ds.attrs["wall_l_u"])
-    gp = _min_pair_distance(pos0, 2 * float(ds.attrs["pair_l_u"])) - float(ds.attrs["pair_l_u"])
+    gb = float(wall_distance(pos0, ds["wall_segment"].values).min()) - float(ds.attrs["forces.wall.l_u"])
+    gp = _min_pair_distance(pos0, 2 * float(ds.attrs["forces.pair.l_u"])) - float(ds.attrs["forces.pair.l_u"])
     return Value(-min(gb, gp), f"l_b - l_bu {gb:+.3g} cm, l_p - l_pu {gp:+.3g} cm")
 
 
@@ -105,9 +105,9 @@ def pair_increment(runs, typed_precision):
     ds, replay = runs
     w = float(ds["weight"].values.max())
     x = replay["max_pair_increment"].item() / w
-    kp = float(ds.attrs["pair_r_u"]) / float(ds.attrs["pair_l_u"])
+    kp = float(ds.attrs["forces.pair.r_u"]) / float(ds.attrs["forces.pair.l_u"])
     return Value(x / (1 + typed_precision), f"{x:.9f} w at step {replay['at_step'].item():,}; 2 k_p du = "
-                                            f"{2 * kp * float(ds.attrs['du']):.3g} N, w = {w:g} N")
+                                            f"{2 * kp * float(ds.attrs['solver.du']):.3g} N, w = {w:g} N")
 
 
 # ------------------------------------------------------------------------------------------ the laws
@@ -132,13 +132,13 @@ def _min_pair_distance(pos, cutoff):
 @quantity("|l_bu - nearest initial wall distance|", "cm", fmt=".3g")
 def lbu_rule(ds):
     lb = float(wall_distance(ds["pos0"].values, ds["wall_segment"].values).min())
-    return Value(abs(float(ds.attrs["wall_l_u"]) - lb), f"l_bu {float(ds.attrs['wall_l_u']):g} cm, nearest {lb:.7g} cm")
+    return Value(abs(float(ds.attrs["forces.wall.l_u"]) - lb), f"l_bu {float(ds.attrs['forces.wall.l_u']):g} cm, nearest {lb:.7g} cm")
 
 
 @quantity("|l_pu - a / sqrt(2)|", "cm", fmt=".3g")
 def lpu_rule(ds):
     side = float(ds.attrs["spacing"]) / math.sqrt(2)
-    return Value(abs(float(ds.attrs["pair_l_u"]) - side), f"l_pu {float(ds.attrs['pair_l_u']):.7f} cm, a/sqrt(2) {side:.7f}")
+    return Value(abs(float(ds.attrs["forces.pair.l_u"]) - side), f"l_pu {float(ds.attrs['forces.pair.l_u']):.7f} cm, a/sqrt(2) {side:.7f}")
 
 
 @quantity("largest wall reaction", "kN", fmt=".3f")
@@ -154,7 +154,7 @@ def wall_gap_reduction(ds):
 @quantity("k_p / k_b", fmt=".6g")
 def stiffness_ratio(ds):
     a = ds.attrs
-    return (float(a["pair_r_u"]) / float(a["pair_l_u"])) / (float(a["wall_r_u"]) / float(a["wall_l_u"]))
+    return (float(a["forces.pair.r_u"]) / float(a["forces.pair.l_u"])) / (float(a["forces.wall.r_u"]) / float(a["forces.wall.l_u"]))
 
 
 @quantity("largest departure of a refined input from its section 6.1 rule", "relative", fmt=".3g")
@@ -163,12 +163,12 @@ def refined_rules(ds, rbu_factor, kp_over_kb, increment_over_w):
     reaction increment of a pair one of whose particles moves du along it, k_p du, vs increment_over_w w, as the
     coarse application reads the du rule: k_p du = 1000 N/cm x 0.01 cm = w/5) of |value / rule - 1|."""
     a = ds.attrs
-    kb, kp = float(a["wall_r_u"]) / float(a["wall_l_u"]), float(a["pair_r_u"]) / float(a["pair_l_u"])
+    kb, kp = float(a["forces.wall.r_u"]) / float(a["forces.wall.l_u"]), float(a["forces.pair.r_u"]) / float(a["forces.pair.l_u"])
     w = float(ds["weight"].values.max())
-    rules = {"R_bu / 10 max R_b": (float(a["wall_r_u"]), rbu_factor * IM.wall_law_usage(ds)["max_wall_reaction_N"]),
-             "l_bu / initial gap": (float(a["wall_l_u"]), float(wall_distance(ds["pos0"].values, ds["wall_segment"].values).min())),
+    rules = {"R_bu / 10 max R_b": (float(a["forces.wall.r_u"]), rbu_factor * IM.wall_law_usage(ds)["max_wall_reaction_N"]),
+             "l_bu / initial gap": (float(a["forces.wall.l_u"]), float(wall_distance(ds["pos0"].values, ds["wall_segment"].values).min())),
              "k_p / k_b / (1/2)": (kp / kb, kp_over_kb),
-             "k_p du / (w/5)": (kp * float(a["du"]), w * increment_over_w)}
+             "k_p du / (w/5)": (kp * float(a["solver.du"]), w * increment_over_w)}
     off = {k: x / y - 1 for k, (x, y) in rules.items()}
     return Value(max(abs(v) for v in off.values()), ", ".join(f"{k} {v:+.1%}" for k, v in off.items()))
 
@@ -310,7 +310,7 @@ def left_force(ds):
 def settle_move(runs):
     """[run, its capped continuation]: max |pos_settled - pos_end| / du."""
     end, settled = runs
-    return Value(float(np.abs(settled["pos"].values - end["pos"].values).max()) / float(end.attrs["du"]),
+    return Value(float(np.abs(settled["pos"].values - end["pos"].values).max()) / float(end.attrs["solver.du"]),
                  f"continuation {settled.attrs['status']} at step {int(settled['steps']):,}")
 
 
@@ -336,7 +336,7 @@ def pairs_per_particle(ds):
     """Mean pair-list entries per particle (pairs within l_pu + skin, what the compiled loop evaluates per step) over
     the run's recorded states: initial, snapshots, final."""
     states = [ds["pos0"].values, *(list(ds["snap_pos"].values) if "snap_pos" in ds else []), ds["pos"].values]
-    rc = float(ds.attrs["pair_l_u"]) + float(ds.attrs["skin"])
+    rc = float(ds.attrs["forces.pair.l_u"]) + float(ds.attrs["solver.skin"])
     return float(np.mean([len(M.pairs(np.asarray(p, float), rc)[0]) / len(p) for p in states]))
 
 

@@ -20,7 +20,7 @@ from ...core.jit import njit
 from ...core.neighbours import build_pairs
 from . import relax as R
 from .forces import law_over_d
-from .settings import RULES
+from .settings import LAW_EXPONENT, RULES
 
 JIT = dict(cache=True, nogil=True)
 
@@ -107,11 +107,11 @@ def pair_increments(ds):
     pos = np.array(ds["pos0"].values, float)
     weight = np.array(ds["weight"].values, float)
     vel, force = np.zeros_like(pos), np.zeros_like(pos)
-    wp, pp = float(a.get("wall_p", 1.0)), float(a.get("pair_p", 1.0))
-    l_u, r_u = float(a["pair_l_u"]), float(a["pair_r_u"])
-    args = (float(a["wall_l_u"]), float(a["wall_r_u"]), l_u, r_u, int(RULES[a["variant"]]), float(a["du"]),
-            float(a["f_ref"]), float(a["dt_max"]), float(a["f_tol"]))
-    chunk, steps = int(a["chunk"]), int(ds["steps"])
+    wp, pp = LAW_EXPONENT[a["forces.wall.law"]], LAW_EXPONENT[a["forces.pair.law"]]
+    l_u, r_u = float(a["forces.pair.l_u"]), float(a["forces.pair.r_u"])
+    args = (float(a["forces.wall.l_u"]), float(a["forces.wall.r_u"]), l_u, r_u, int(RULES[a["variant"]]), float(a["solver.du"]),
+            float(a["solver.f_ref"]), float(a["solver.dt_max"]), float(a["solver.f_tol"]))
+    chunk, steps = int(a["solver.chunk"]), int(ds["steps"])
     lo, hi = pos.min(0) - 100.0, pos.max(0) + 100.0
     pbox = np.array([min(lo[0], box[0]), min(lo[1], box[1]), max(hi[0], box[2]), max(hi[1], box[3])])
     reach = 0.5 * l_u
@@ -121,7 +121,7 @@ def pair_increments(ds):
     worst, at, move, done = 0.0, -1, 0.0, 0
     while done < steps:
         k_max = min(chunk, steps - done)
-        n_done, _, _ = R.relax_resume(pos, vel, weight, walls, box, *args, k_max, float(a["skin"]), force,
+        n_done, _, _ = R.relax_resume(pos, vel, weight, walls, box, *args, k_max, float(a["solver.skin"]), force,
                                       np.zeros(k_max), np.empty_like(pos), np.zeros(5), False, 1, wp, pp, trail)
         pi, pj, v0, worst, at, move = _measure(trail, n_done, done, pbox, l_u, r_u, pp, reach, pi, pj, v0, ref,
                                                worst, at, move)

@@ -101,23 +101,25 @@ def _read_start(scene, ds, src, where):
     return pos, weight, steps, spacing, _restart_state(scene, ds, n, src)
 
 
-DYNAMICS = ("du", "f_tol", "f_ref", "dt_max", "skin", "chunk", "wall_l_u", "wall_r_u", "pair_l_u", "pair_r_u",
-            "wall_p", "pair_p")
-OVERDAMPED_DYNAMICS = ("zeta", "lambda_max", "dt")
-LAW_DEFAULT = 1.0  # the law exponent of run files written before the law option (all linear)
+# {run-file attribute (the setting's dotted key): name in settings(scene)} of the values a continuation must share
+DYNAMICS = {**{f"solver.{k}": k for k in ("du", "f_tol", "f_ref", "dt_max", "skin", "chunk", "stop_on_cycle")},
+            **{f"forces.{w}.{k}": f"{w}_{k}" for w in ("wall", "pair") for k in ("l_u", "r_u")}}
+OVERDAMPED_DYNAMICS = {f"solver.{k}": k for k in ("zeta", "lambda_max", "dt")}
+LAWS = ("forces.wall.law", "forces.pair.law")
 
 
 def _restart_state(scene, ds, n, src):
     """(state or None, why) of an open run file: its solver state if its dynamics equal this scene's."""
     s = settings(scene)
     differ = ["variant"] if ds.attrs.get("variant") != s["variant"] else []
-    keys = DYNAMICS + ("stop_on_cycle",) + (OVERDAMPED_DYNAMICS if s["variant"] == "overdamped" else ())
-    for k in keys:
+    keys = {**DYNAMICS, **(OVERDAMPED_DYNAMICS if s["variant"] == "overdamped" else {})}
+    for attr, name in keys.items():
         try:
-            if float(ds.attrs.get(k, LAW_DEFAULT) if k in ("wall_p", "pair_p") else ds.attrs[k]) != float(s[k]):
-                differ.append(k)
+            if float(ds.attrs[attr]) != float(s[name]):
+                differ.append(attr)
         except (KeyError, TypeError, ValueError):
-            differ.append(k)
+            differ.append(attr)
+    differ += [k for k in LAWS if ds.attrs.get(k) != scene.spec["forces"][k.split(".")[1]]["law"]]
     if "wall_segment" not in ds or ds["wall_segment"].shape != scene.walls.shape or \
             not np.array_equal(ds["wall_segment"].values, scene.walls):
         differ.append("walls")

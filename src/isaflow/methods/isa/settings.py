@@ -10,6 +10,7 @@ dt_max, skin, the overdamped step) from the force laws.  This module imports no 
 import math
 
 from ...core.units import G  # cm/s^2 (a constants module: no numerics imported)
+from ...settings import with_units as _in
 
 RULE_IDS = {"paper": 0, "capped": 1, "fire": 2, "overdamped": 3, "newton_lm": 4}  # relax.PAPER, CAPPED, FIRE;
 # dynamics.OVERDAMPED; newton.NEWTON (tested equal)
@@ -25,33 +26,34 @@ _LAW = {"enum": list(LAW_EXPONENT)}
 _HISTORY = {"type": "object", "additionalProperties": False, "properties": {
     "every": {"type": "integer", "minimum": 1, "maximum": 10**15},
     "walls": {"type": "boolean"}, "vessels": {"type": "boolean"}}}
+
 # {dotted key: JSON schema of the value} of config/methods/isa.yaml
 VALUES = {
-    "particles.weight": _POS,  # N per particle
-    "particles.points": {"type": ["array", "null"], "minItems": 1, "items": {
-        "type": "array", "items": {"type": "number"}, "minItems": 2, "maxItems": 2}},  # cm; null: the lattice
-    "particles.lattice.a": _POS,  # cm, rhomb diagonal
+    "particles.weight": _in("N", _POS),  # per particle
+    "particles.points": _in("cm", {"type": ["array", "null"], "minItems": 1, "items": {
+        "type": "array", "items": {"type": "number"}, "minItems": 2, "maxItems": 2}}),  # null: the lattice
+    "particles.lattice.a": _in("cm", _POS),  # rhomb diagonal
     "particles.lattice.rows": {"anyOf": [_COUNT, {"type": "null"}]},  # null: fill the first vessel (scene.vessel_fill)
     "particles.lattice.row_lengths": {"type": "array", "items": _COUNT, "minItems": 1, "maxItems": 2},
-    "particles.lattice.center_x": {"type": "number"},  # cm
-    "particles.lattice.bottom_y": {"type": "number"},  # cm
+    "particles.lattice.center_x": _in("cm", {"type": "number"}),
+    "particles.lattice.bottom_y": _in("cm", {"type": "number"}),
     "particles.lattice.kind": {"enum": ["rhombic", "square"]},
-    "particles.lattice.jitter": {"type": "number", "minimum": 0, "maximum": 0.25},  # fraction of a
+    "particles.lattice.jitter": _in("1", {"type": "number", "minimum": 0, "maximum": 0.25}),  # fraction of a
     "particles.lattice.seed": {"type": "integer", "minimum": 0, "maximum": 2**31 - 1},
-    "forces.wall.law": _LAW, "forces.wall.l_u": _POS, "forces.wall.r_u": _POS,  # cm, N
-    "forces.pair.law": _LAW, "forces.pair.l_u": _POS, "forces.pair.r_u": _POS,
-    "solver.du": _POS,  # cm
-    "solver.f_tol": _POS,  # N
+    "forces.wall.law": _LAW, "forces.wall.l_u": _in("cm", _POS), "forces.wall.r_u": _in("N", _POS),
+    "forces.pair.law": _LAW, "forces.pair.l_u": _in("cm", _POS), "forces.pair.r_u": _in("N", _POS),
+    "solver.du": _in("cm", _POS),
+    "solver.f_tol": _in("N", _POS),
     "solver.max_steps": {"type": "integer", "minimum": 1, "maximum": 10**15},
-    "solver.f_ref": _OPT_POS, "solver.dt_max": _OPT_POS, "solver.skin": _OPT_POS,
+    "solver.f_ref": _in("N", _OPT_POS), "solver.dt_max": _in("s", _OPT_POS), "solver.skin": _in("cm", _OPT_POS),
     "solver.chunk": {"type": "integer", "minimum": 100, "maximum": 10**12},
     "solver.stop_on_cycle": {"type": "boolean"},
     "solver.history": _HISTORY,
     # the stored states (driver.Recording): steps between snapshots in a single vessel and in a tank of vessels
     "solver.snapshot_every_single": _COUNT, "solver.snapshot_every_flow": _COUNT,
-    "solver.snapshot_megabytes": _POS,  # 10^6 bytes the kept snapshots may take before they are thinned
-    # the overdamped variant (dynamics.py): damping ratio zeta of the stiffest mode lambda_max [N/cm], time step [s]
-    "solver.zeta": _POS, "solver.lambda_max": _POS, "solver.dt": _OPT_POS,
+    "solver.snapshot_megabytes": _in("1e6 byte", _POS),  # 10^6 bytes the kept snapshots may take before they are thinned
+    # the overdamped variant (dynamics.py): damping ratio zeta of the stiffest mode lambda_max, time step
+    "solver.zeta": _in("1", _POS), "solver.lambda_max": _in("N cm-1", _POS), "solver.dt": _in("s", _OPT_POS),
 }
 
 
@@ -66,6 +68,8 @@ def own_tank(tank, settings):
 # stiffness: both come from the Gershgorin bound lambda_max <= 2 k_b + 12 k_p
 # (two walls, six neighbours) of the stiffness matrix.
 PAIR_NEIGHBOURS = 6
+DERIVED = ("f_ref", "dt_max", "skin")  # solver.<name> computed from the force laws when the file leaves it null
+# (and solver.dt, of the overdamped variant only); the run file records the value used (settings.attributes)
 SKIN_FRACTION = 0.3  # neighbour-list skin as a fraction of the pair range l_pu
 
 

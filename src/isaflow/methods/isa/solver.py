@@ -23,7 +23,7 @@ from . import dynamics as D
 from . import forces as F
 from . import newton as NW
 from . import relax as R
-from .settings import RULES, settings
+from .settings import DERIVED, RULES, settings
 
 CYCLE_WINDOW, CYCLE_MAX_PERIOD, CYCLE_RTOL = 400, 50, 1e-6
 # where each outcome is detected (for the report)
@@ -453,11 +453,11 @@ class _Stepper:
             message = f"max|F| = {fmax:.4g} N < f_tol = {s['f_tol']:g} N after {step} steps"
         sim_time = float("nan")
         part, wall, point, cforce = contacts(pos, walls, s)
-        dynamic = ("zeta", "lambda_max", "dt", "damping")
-        params = {k: v for k, v in s.items() if k not in ("history", "variant", "stop_on_cycle")
-                  and (overdamped or k not in dynamic)}
-        params.update(cycle_period=int(self.period), stop_on_cycle=int(s["stop_on_cycle"]),
-                      nonfinite_particle=int(self.bad_particle), max_step_move=self.max_step_move)
+        # the settings reach the run file under their own dotted keys (run.write, settings.attributes); here only
+        # the values derived from the force laws for those the file leaves null, and the run's own diagnostics
+        params = {f"solver.{k}": s[k] for k in DERIVED + (("dt",) if overdamped else ())}
+        params.update(cycle_period=int(self.period), nonfinite_particle=int(self.bad_particle),
+                      max_step_move=self.max_step_move, **({"damping": s["damping"]} if overdamped else {}))
         measures = {}
         if overdamped:
             sim_time = float(kernel[1])

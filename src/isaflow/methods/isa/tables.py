@@ -38,7 +38,7 @@ def table1(rows, run_files, benchmark_files):
             "paper_steps": r["steps"],
             "paper_time": r["time"],
             "ours_particles": int(last.sizes["particle"]),
-            "ours_du_mm": float(last.attrs["du"]) * 10.0,
+            "ours_du_mm": float(last.attrs["solver.du"]) * 10.0,
             "ours_steps": int(last["steps"]),
             "ours_status": last.attrs["status"],
             "ours_max_force_N": round(float(last["residual"]), 4),
@@ -77,7 +77,7 @@ def _stem(p):
 def _base_row(sid, ds):
     a = ds.attrs
     return dict(run=sid, tank=a["tank"], resolution=a["resolution"], variant=a["variant"], particles=int(ds.sizes["particle"]),
-                du_cm=float(a["du"]), f_tol_N=float(a["f_tol"]), steps=int(ds["steps"]),
+                du_cm=float(a["solver.du"]), f_tol_N=float(a["solver.f_tol"]), steps=int(ds["steps"]),
                 wall_time_s=float(ds["wall_time"]), status=a["status"],
                 outcome_detail=outcome_detail(a["status"], a["status_message"]), residual=float(ds["residual"]))
 
@@ -130,7 +130,7 @@ def fire_tables(tuning, references, outputs, meta, paper, required_ratio):
         ds = read(p)
         row = _base_row(sid, ds)
         row.update(lattice=m["lattice"], du_factor=m["du_factor"], dt_factor=m["dt_factor"],
-                   dt_max_s=float(ds.attrs["dt_max"]), a_cm=float(ds.attrs["spacing"]),
+                   dt_max_s=float(ds.attrs["solver.dt_max"]), a_cm=float(ds.attrs["spacing"]),
                    level_cm=metrics.surface_of(ds))
         grid.append(row)
     grid = pd.DataFrame(grid).sort_values(["lattice", "du_factor", "dt_factor"], key=_lattice_key)
@@ -172,14 +172,14 @@ def stability_row(sid, ds, m):
     """Outcome and its context of one stability run: k_b du / w, du / a, law usage, level."""
     a = ds.attrs
     row = _base_row(sid, ds)
-    kb = a["wall_r_u"] / a["wall_l_u"]
+    kb = a["forces.wall.r_u"] / a["forces.wall.l_u"]
     w = float(ds["weight"].values.max())
     lat_a = float(a.get("spacing", np.nan))  # absent: no lattice spacing (coincident particles)
     pos = ds["pos"].values
     finite = bool(np.isfinite(pos).all())
-    row.update(variant_label=a["variant_label"], message=a["status_message"], max_steps=int(a["max_steps"]), k_wall=kb,
-               k_pair=a["pair_r_u"] / a["pair_l_u"], weight_N=w, a_cm=lat_a, k_du_over_w=kb * a["du"] / w,
-               du_over_a=a["du"] / lat_a if np.isfinite(lat_a) else np.nan, positions_finite=finite,
+    row.update(variant_label=a["variant_label"], message=a["status_message"], max_steps=int(a["solver.max_steps"]), k_wall=kb,
+               k_pair=a["forces.pair.r_u"] / a["forces.pair.l_u"], weight_N=w, a_cm=lat_a, k_du_over_w=kb * a["solver.du"] / w,
+               du_over_a=a["solver.du"] / lat_a if np.isfinite(lat_a) else np.nan, positions_finite=finite,
                floor_cm=float(ds["wall_segment"].values[:, [1, 3]].min()),
                top_cm=float(pos[:, 1].max()) if finite else np.nan, top0_cm=float(ds["pos0"].values[:, 1].max()),
                level_cm=metrics.surface_of(ds) if finite and np.isfinite(lat_a) else np.nan)
@@ -295,8 +295,8 @@ def calibration_table(runs, outputs):
     rows = []
     for p in runs:
         ds = read(p)
-        kb = ds.attrs["wall_r_u"] / ds.attrs["wall_l_u"]
-        kp = ds.attrs["pair_r_u"] / ds.attrs["pair_l_u"]
+        kb = ds.attrs["forces.wall.r_u"] / ds.attrs["forces.wall.l_u"]
+        kp = ds.attrs["forces.pair.r_u"] / ds.attrs["forces.pair.l_u"]
         e = metrics.load_errors(ds, None, "own")
         rows.append(dict(run=Path(p).stem.removeprefix("cal_").rsplit("_kb", 1)[0], resolution=ds.attrs["resolution"],
                          variant=ds.attrs["variant"], k_wall=kb, ratio=round(kp / kb, 6),

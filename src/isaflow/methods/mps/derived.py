@@ -131,7 +131,7 @@ def dilation(ds, e=DILATION):
     n_star = density(1.0 + e)
     det = (1.0 + e) ** 2
     div = 2.0 * e / ((1.0 + e) * dt)
-    source = model.SOURCES[str(ds.attrs["source_term"])]
+    source = model.SOURCES[str(ds.attrs["variant"])]
     s_model = float(model.source_term(n_star, div, n0, rho0, dt, source, cfg["model.gamma_mixed"], 1.0))
 
     def eq6(rho_star):
@@ -147,5 +147,5 @@ def dilation(ds, e=DILATION):
               ("n0_file", float(ds.attrs["n0_density"]), "1", "reference number density the run file records"),
               ("relaxation", cfg["model.relaxation"], "1", "the run's relaxation coefficient"))
     out = xr.Dataset({k: ((), np.float64(v), {"units": u, "long_name": n}) for k, v, u, n in values})
-    out.attrs.update(relaxation_scope=str(cfg["model.relaxation_scope"]), source_term=str(ds.attrs["source_term"]))
+    out.attrs.update(relaxation_scope=str(cfg["model.relaxation_scope"]), source_term=str(ds.attrs["variant"]))
     return out

@@ -131,10 +131,10 @@ def rest(runs, outputs, before=()):
     for ax, name in zip(axes[0], VARIANTS):
         mine = _by_variant(dss, name)
         for ds, c in mine:
-            old = ds.attrs["gradient_model"] != "variational"
+            old = ds.attrs["model.gradient"] != "variational"
             e_mean = float(ds.attrs["window_energy_ratio_mean"])
             ax.semilogy(ds["sample_time"].values, ds["sample_energy_ratio"].values, color=c, lw=0.9 if old else 1.2,
-                        ls="--" if old else "-", label=f"l0 = {float(ds.attrs['spacing']):.3g} cm, {ds.attrs['gradient_model']} "
+                        ls="--" if old else "-", label=f"l0 = {float(ds.attrs['spacing']):.3g} cm, {ds.attrs['model.gradient']} "
                                                          f"({ds.attrs['status']}; last {float(ds.attrs['rest_window']):g} s: mean {e_mean:.1e})")
         if mine:
             ax.axhline(float(mine[0][0].attrs["rest_energy_ratio"]), color="k", ls=":", lw=0.8)

@@ -109,9 +109,9 @@ def summary_row(path):
     stem = a.get("run_id", Path(path).stem)
     case = stem.split("_")[0]
     side, side_err = side_loads(ds)
-    row = dict(run=stem, case=case, tank=a["scene"], source_term=a["variant"], courant=float(a["courant"]), dt_s=float(a["dt_s"]),
+    row = dict(run=stem, case=case, tank=a["scene"], source_term=a["variant"], courant=float(a["time.courant"]), dt_s=float(a["dt_s"]),
                sim_time_s=float(ds["sim_time"]), start_state=a.get("start_state", ""),
-               relaxation=float(a.get("relaxation", np.nan)), label=a.get("run_label", ""),
+               relaxation=float(a.get("model.relaxation", np.nan)), label=a.get("run_label", ""),
                max_solve_residual=float(a["max_solve_residual"]), rms_speed_cm_s=float(ds["residual"]),
                escapes=int(a.get("escapes", int(a["status"] == "escaped"))), energy_ratio=float(a["final_energy_ratio"]),
                rest_energy_ratio=float(a["rest_energy_ratio"]), time_to_rest_s=time_to_rest(ds),
@@ -132,7 +132,7 @@ def summary_row(path):
                                                             float(a["spacing"]), rho_g, float(a["initial_depth"]))
     row.update(window_energy_mean=float(a.get("window_energy_ratio_mean", np.nan)),
                window_energy_max=float(a.get("window_energy_ratio_max", np.nan)),
-               gradient=a.get("gradient_model", ""))
+               gradient=a.get("model.gradient", ""))
     rel, absn, probe = noise(ds)
     u = ds["sample_rms_speed"].values
     row.update(panel_noise_rel=rel, panel_noise_N=absn, min_rms_speed_cm_s=float(u.min()),

@@ -43,7 +43,7 @@ def noise_trend(runs, min_ratio, window=None):
     final window); the largest over the smallest, divided by the threshold max(min_ratio, 1 + 2 sqrt(2) /
     sqrt(2 (n_eff - 1))) that two noise levels of n_eff effective samples must exceed to differ; 0 when the noise is
     not monotone in dt."""
-    vals = [(float(ds.attrs["courant"]), *noise(ds, window)) for ds in runs]
+    vals = [(float(ds.attrs["time.courant"]), *noise(ds, window)) for ds in runs]
     x = [v[1] for v in vals]
     neff = min((v[2] for v in vals if v[2] > 1), default=0)
     thr = max(min_ratio, 1 + 2 * math.sqrt(2) / math.sqrt(2 * (neff - 1))) if neff > 1 else min_ratio

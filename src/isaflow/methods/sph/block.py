@@ -254,7 +254,7 @@ class _BlockStepper:
             "density": (("particle",), self.rho.copy(), DENSITY_2D, "particle density"),
             "velocity": (("particle", "xy"), self.v.copy(), VELOCITY, "particle velocity"),
         }
-        params = {f"sph_{k}": (str(v_) if isinstance(v_, (bool, list)) else v_) for k, v_ in s.items()}
+        params = {}  # the settings themselves reach the run file under their dotted keys (run.write)
         params.update(
             domain="periodic_block", box_width=float(box[0]), box_height=float(box[1]), cell_dx=dx * (1 + e),
             cell_dy=dy * (1 + e), smoothing_length=self.h, sound_speed=self.c0, dt=dt, particle_mass=self.mass,

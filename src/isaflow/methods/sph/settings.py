@@ -29,37 +29,38 @@ def own_tank(tank, settings):
     return () if drop == settings["settings.max_drop"] else (f"settings.max_drop={drop!r}",)
 
 
+_in = S.with_units  # a value's schema with the units its run-file attribute carries (settings_units)
 SETTINGS = {
     "kernel": {"enum": ["cubic_spline", "wendland_c2"]},
-    "h_factor": _POS,            # h / spacing
+    "h_factor": _in("1", _POS),  # h / spacing
     "density": {"enum": ["summation", "continuity"]},
     "eos": {"enum": ["tait", "linear"]},
-    "gamma": _POS,               # Tait exponent
-    "sound_speed_factor": _POS,  # c0 / sqrt(2 g max_drop)
-    "max_drop": _POS,            # cm
+    "gamma": _in("1", _POS),  # Tait exponent
+    "sound_speed_factor": _in("1", _POS),  # c0 / sqrt(2 g max_drop)
+    "max_drop": _in("cm", _POS),
     "negative_pressure": {"enum": ["clamp", "keep"]},
-    "alpha": _NONNEG,            # artificial viscosity
+    "alpha": _in("1", _NONNEG),  # artificial viscosity
     "wall_viscosity": {"type": "boolean"},
-    "delta": _NONNEG,            # density diffusion coefficient
-    "repulsion_radius": _NONNEG,  # Lennard-Jones wall repulsion range / cell spacing (0: off)
-    "cfl": _POS,                 # dt = cfl h / c0
-    "skin": _NONNEG,             # neighbour-list skin / h
-    "t_max_single": _POS,        # s
-    "t_max_flow": _POS,          # s
-    "chunk_time": _POS,          # s
-    "panel_length": _POS,        # cm
-    "snapshot_every_single": _POS,  # s between snapshots (driver.Recording), single vessel
-    "snapshot_every_flow": _POS,    # s between snapshots, a tank of vessels
-    "snapshot_megabytes": _POS,     # 10^6 bytes the kept snapshots may take before they are thinned
+    "delta": _in("1", _NONNEG),  # density diffusion coefficient
+    "repulsion_radius": _in("1", _NONNEG),  # Lennard-Jones wall repulsion range / cell spacing (0: off)
+    "cfl": _in("1", _POS),  # dt = cfl h / c0
+    "skin": _in("1", _NONNEG),  # neighbour-list skin / h
+    "t_max_single": _in("s", _POS),
+    "t_max_flow": _in("s", _POS),
+    "chunk_time": _in("s", _POS),
+    "panel_length": _in("cm", _POS),
+    "snapshot_every_single": _in("s", _POS),  # between snapshots (driver.Recording), single vessel
+    "snapshot_every_flow": _in("s", _POS),  # between snapshots, a tank of vessels
+    "snapshot_megabytes": _in("1e6 byte", _POS),  # what the kept snapshots may take before they are thinned
     "domain": {"enum": ["tank", "periodic_block"]},  # the tank's walls, or its liquid lattice made periodic (block)
-    "stretch": {"type": "number", "exclusiveMinimum": -0.5, "maximum": 1.0},  # block: uniform linear strain
-    "perturbation": _NONNEG,     # block: random initial displacement / spacing
+    "stretch": _in("1", {"type": "number", "exclusiveMinimum": -0.5, "maximum": 1.0}),  # block: uniform linear strain
+    "perturbation": _in("1", _NONNEG),  # block: random initial displacement / spacing
     "seed": {"type": "integer", "minimum": 0},  # block: seed of the perturbation
-    "t_max_block": _POS,         # s
+    "t_max_block": _in("s", _POS),
 }
 VALUES = {**{f"settings.{k}": v for k, v in SETTINGS.items()},
           "resolution.particles": {"type": ["integer", "null"], "minimum": 4},
-          "resolution.spacing": {"type": ["number", "null"], "exclusiveMinimum": 0},
+          "resolution.spacing": _in("cm", {"type": ["number", "null"], "exclusiveMinimum": 0}),
           "resolution.on_wall": {"type": "boolean"}}
 
 

@@ -369,7 +369,7 @@ class _Stepper:
                              "acceleration at the end (its viscosity took the half-step velocities; a continuation "
                              "starts from it)"),
         }
-        params = {f"sph_{k}": (str(v_) if isinstance(v_, (bool, list)) else v_) for k, v_ in s.items()}
+        params = {}  # the settings themselves reach the run file under their dotted keys (run.write)
         initial_depth = st["depth0"]
         diff = [f"weakly compressible: the column holds {held:g} N compressed to its hydrostatic density, its "
                 f"surface {initial_depth:.4g} cm (tank {tank.depth:g} cm)"] if start is None else [

@@ -49,7 +49,7 @@ def overdamped_figure(inputs, outputs, isa_chain=("flow_incomplete", "flow_compl
         t, f = metrics.transfer_curve([d])
         go, t50 = metrics.normalised_curve(t, f, TAU)
         ax_f.plot(TAU, go, color=c, lw=1.3, ls="--",
-                  label=f"overdamped, zeta = {float(d.attrs['zeta']):g} (t_50 = {t50:.3g} s): sup |diff| "
+                  label=f"overdamped, zeta = {float(d.attrs['solver.zeta']):g} (t_50 = {t50:.3g} s): sup |diff| "
                         f"{np.abs(go - g).max():.3f}")
     ax_f.set_xlabel("tau = t / t_50 (the paper's update: steps; overdamped: time)")
     ax_f.set_ylabel("fraction of the particles in the second vessel")
@@ -65,7 +65,7 @@ def overdamped_figure(inputs, outputs, isa_chain=("flow_incomplete", "flow_compl
     ax_s.plot(*isa["pos"].values.T, "o", ms=3.2, color=COMPUTED,
               label=f"paper's update: {flow_measures(isa)['particles_left']} left ({isa.attrs['status']})")
     ax_s.plot(*od["pos"].values.T, "o", ms=5.5, mfc="none", color=OD_COLOURS[0],
-              label=f"overdamped zeta {float(od.attrs['zeta']):g}: {flow_measures(od)['particles_left']} left "
+              label=f"overdamped zeta {float(od.attrs['solver.zeta']):g}: {flow_measures(od)['particles_left']} left "
                     f"({od.attrs['status']}, t = {float(od['sim_time']):.3g} s)")
     second = vessels(isa)[-1]
     fl = metrics.vessel_view(isa, second)["floor_y"]
@@ -77,17 +77,17 @@ def overdamped_figure(inputs, outputs, isa_chain=("flow_incomplete", "flow_compl
     ax_s.legend(loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=1, fontsize=8, frameon=False)
     # (c) the single vessel's overdamped history
     so = runs[singles[0]]
-    tt = (so["hist_step"].values - int(so["start_step"])) * float(so.attrs["dt"])
+    tt = (so["hist_step"].values - int(so["start_step"])) * float(so.attrs["solver.dt"])
     e = so["hist_energy"].values / (float(so["weight"].values.sum()) * float(so.attrs["tank_depth"]))
     ax_e.semilogy(tt, np.maximum(e, 1e-16), color=OD_COLOURS[0], label="kinetic energy e = KE / (W h)")
     ax_e.semilogy(tt, so["hist_fmax"].values, color="k", lw=0.8, label="max|F| (N)")
     ax_e.axhline(float(so.attrs["rest_energy_ratio"]), color=OD_COLOURS[0], ls=":", lw=1,
                  label=f"rest: e < {float(so.attrs['rest_energy_ratio']):g} (config/rest.yaml)")
-    ax_e.axhline(float(so.attrs["f_tol"]), color="k", ls=":", lw=1, label=f"f_tol = {float(so.attrs['f_tol']):g} N")
+    ax_e.axhline(float(so.attrs["solver.f_tol"]), color="k", ls=":", lw=1, label=f"f_tol = {float(so.attrs['solver.f_tol']):g} N")
     ax_e.set_xlabel("t (s)")
     ax_e.set_ylabel("e = KE / (W h) (1); max|F| (N)")
-    ax_e.set_title(f"(d) single vessel, overdamped (zeta {float(so.attrs['zeta']):g}, dt = "
-                   f"{float(so.attrs['dt']):.3g} s): {so.attrs['status']} at t = {float(so['sim_time']):.3g} s")
+    ax_e.set_title(f"(d) single vessel, overdamped (zeta {float(so.attrs['solver.zeta']):g}, dt = "
+                   f"{float(so.attrs['solver.dt']):.3g} s): {so.attrs['status']} at t = {float(so['sim_time']):.3g} s")
     ax_e.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2, fontsize=8, frameon=False)
     # (d) single-vessel end states
     si = runs[single]
@@ -97,7 +97,7 @@ def overdamped_figure(inputs, outputs, isa_chain=("flow_incomplete", "flow_compl
     for k, c in zip(singles, OD_COLOURS):
         d = runs[k]
         ax_v.plot(*d["pos"].values.T, "o", ms=5.5, mfc="none", color=c,
-                  label=f"overdamped zeta {float(d.attrs['zeta']):g} ({d.attrs['status']}): surface {surface_of(d):.2f} cm, "
+                  label=f"overdamped zeta {float(d.attrs['solver.zeta']):g} ({d.attrs['status']}): surface {surface_of(d):.2f} cm, "
                         f"particle by particle at most "
                         f"{np.abs(d['pos'].values - si['pos'].values).max():.2g} cm from the update's")
     ax_v.set_aspect("equal")
@@ -117,7 +117,7 @@ def _end_states(ax_n, ax_h, isa, ods):
     """Particles left and second-vessel surface of the paper's update (first bar) and of every overdamped run, with
     the bands of pap-7-strong-damping around the update's values: half a floor row (B / a / 2 particles) and a/4."""
     runs = [isa, *ods]
-    names = ["update"] + [f"zeta {float(d.attrs['zeta']):g}" for d in ods]
+    names = ["update"] + [f"zeta {float(d.attrs['solver.zeta']):g}" for d in ods]
     colours = [COMPUTED, *OD_COLOURS]
     second = vessels(isa)[-1]
     v = metrics.vessel_view(isa, second)

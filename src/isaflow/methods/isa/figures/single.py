@@ -58,7 +58,7 @@ def inputs_figure(inputs, outputs, inferred=None):
     axb.plot(rh[:, 0], rh[:, 1], "-o", color=COMPUTED)
     axb.plot([c[0] - a / 2, c[0] + a / 2], [c[1]] * 2, "--", color="gray")
     axb.plot([c[0]] * 2, [c[1] - a / 2, c[1] + a / 2], "--", color="gray")
-    wl = float(ds.attrs["wall_l_u"])
+    wl = float(ds.attrs["forces.wall.l_u"])
     floor_y = c[1] - a / 2 - float(pos[:, 1].min() - ds["wall_segment"].values[:, [1, 3]].min())
     axb.axhline(floor_y, color="k", lw=2.5)
     axb.annotate("", (c[0] + 0.15 * a, floor_y), (c[0] + 0.15 * a, c[1] - a / 2), arrowprops=dict(arrowstyle="<->"))
@@ -74,13 +74,13 @@ def inputs_figure(inputs, outputs, inferred=None):
     axb.set_xlabel("x (cm)")
     axb.set_ylabel("y (cm)")
     axb.set_title("(b) rhombic element and distance from the boundary")
-    _law_axes(ax[1, 0], wl, float(ds.attrs["wall_r_u"]), "b", "(c) boundary-particle function $R_b - l_b$")
-    _law_axes(ax[1, 1], float(ds.attrs["pair_l_u"]), float(ds.attrs["pair_r_u"]), "p",
+    _law_axes(ax[1, 0], wl, float(ds.attrs["forces.wall.r_u"]), "b", "(c) boundary-particle function $R_b - l_b$")
+    _law_axes(ax[1, 1], float(ds.attrs["forces.pair.l_u"]), float(ds.attrs["forces.pair.r_u"]), "p",
               "(d) inter-particle function $R_p - l_p$",
               note=f"\ncalibrated to the paper's levels\n(config/inferred.yaml); the literal\n"
-                   f"k_p = k_b/2 would be {float(ds.attrs['wall_r_u']) / wl / 2:.4g} N/cm")
+                   f"k_p = k_b/2 would be {float(ds.attrs['forces.wall.r_u']) / wl / 2:.4g} N/cm")
     fig.subplots_adjust(hspace=0.3)
-    fig.suptitle(f"Inputs of scene {case_name(ds)}: du = {ds.attrs['du'] * 10:g} mm, f_tol = {ds.attrs['f_tol']:g} N "
+    fig.suptitle(f"Inputs of scene {case_name(ds)}: du = {ds.attrs['solver.du'] * 10:g} mm, f_tol = {ds.attrs['solver.f_tol']:g} N "
                  f"(solver: {ds.attrs['variant_label']})")
     inferred_note(fig, inferred)
     save(fig, outputs)
@@ -269,26 +269,26 @@ def convergence_figure(inputs, outputs):
     fig, axes = plt.subplots(1, len(scenes), figsize=(6 * len(scenes), 4.2), squeeze=False)
     for ax, sc in zip(axes[0], scenes):
         here = [d for d in runs if lattice(d) == sc]
-        xmax = max(int(d["steps"]) for d in here if int(d.attrs.get("stop_on_cycle", 1)))
-        for ds in (d for d in here if not int(d.attrs.get("stop_on_cycle", 1))):
+        xmax = max(int(d["steps"]) for d in here if int(d.attrs.get("solver.stop_on_cycle", 1)))
+        for ds in (d for d in here if not int(d.attrs.get("solver.stop_on_cycle", 1))):
             lo, hi = float(ds["hist_fmax_lo"].values[-10:].min()), float(ds["hist_fmax_hi"].values[-10:].max())
             ax.errorbar([xmax * 1.03], [np.sqrt(lo * hi)], yerr=[[np.sqrt(lo * hi) - lo], [hi - np.sqrt(lo * hi)]],
                         color="tab:purple", capsize=4, lw=2,
                         label=f"the paper's version (k_p = k_b / 2, its own stop rule; claims judged on it):\n"
                               f"-> {ds.attrs['status']} "
                               f"at step {int(ds['steps']):,}, last band {lo:.3g}-{hi:.3g} N (right edge)")
-        for ds in (d for d in here if int(d.attrs.get("stop_on_cycle", 1))):
+        for ds in (d for d in here if int(d.attrs.get("solver.stop_on_cycle", 1))):
             a = ds.attrs
             st = ds["hist_step"].values
             line, = ax.plot(st, ds["hist_fmax"].values, lw=0.8, label=f"{a['variant_label']}\n-> {a['status']} at step {int(ds['steps']):,}"
                             + (" (detected: max|F| repeats, not a convergence step)" if a["status"] == "cycle" else ""))
             ax.fill_between(st, ds["hist_fmax_lo"].values, ds["hist_fmax_hi"].values, color=line.get_color(), alpha=0.25, lw=0)
             if a["variant"] == "paper":
-                lam, floor = theory.step_floor(ds["pos"].values, ds["wall_segment"].values, a["wall_l_u"],
-                                               a["wall_r_u"], a["pair_l_u"], a["pair_r_u"], a["du"])
+                lam, floor = theory.step_floor(ds["pos"].values, ds["wall_segment"].values, a["forces.wall.l_u"],
+                                               a["forces.wall.r_u"], a["forces.pair.l_u"], a["forces.pair.r_u"], a["solver.du"])
                 ax.axhline(floor, color=line.get_color(), ls="--", lw=1,
                            label=f"stability floor λ_max du/2 = {floor:.3g} N (λ_max = {lam:.0f} N/cm)")
-        ax.axhline(float(runs[0].attrs["f_tol"]), color="k", ls=":", label="f_tol = 0.1 N")
+        ax.axhline(float(runs[0].attrs["solver.f_tol"]), color="k", ls=":", label="f_tol = 0.1 N")
         ax.set_yscale("log")
         ax.set_xlabel("algorithm step")
         ax.set_ylabel("max|F| (N)")
