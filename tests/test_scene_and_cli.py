@@ -147,6 +147,32 @@ def test_tiny_scene_end_to_end_through_the_command_line(tmp_path):
     assert not list(tmp_path.glob(".*partial*"))
 
 
+@pytest.mark.parametrize("method", ["isa", "sph", "mps"])
+def test_every_real_setting_has_units_and_every_setting_one_attribute(method):
+    """The run-file naming rule (settings.attributes): each dotted key once, under its own name, and the units of
+    every real-valued setting (integers are counts) recorded in settings_units."""
+    import importlib
+
+    from isaflow import settings as S
+
+    values = importlib.import_module(f"isaflow.methods.{method}.settings").VALUES
+
+    def types(v):
+        return v.get("type") if isinstance(v.get("type"), list) else [v.get("type")]
+
+    assert [k for k, v in values.items() if "number" in types(v) and not v.get("units")] == []
+
+    class Resolved(dict):  # a resolved Settings' interface as attributes() reads it
+        path, schema = "x.yaml", values
+        sources = {k: "literature: x" for k in values}
+
+    attrs = S.attributes(Resolved({k: 1.5 if "number" in types(v) else None for k, v in values.items()}))
+    assert set(attrs) == set(values) | {"settings_sources", "settings_units"}
+    assert len(attrs["settings_sources"].splitlines()) == len(values)
+    assert {line.split(": ")[0] for line in attrs["settings_units"].splitlines()} == \
+        {k for k, v in values.items() if v.get("units")}
+
+
 def test_a_declared_run_runs_by_its_id(tmp_path):
     out = tmp_path / "sc.nc"
     assert cli.main(["run", "--method", "isa", "--run", "single_coarse", "-o", str(out)]) == 0
