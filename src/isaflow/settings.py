@@ -17,9 +17,10 @@ A method gives the JSON schema of each value by dotted key (its ``VALUES``);
 refused everywhere.  :func:`load` applies a resolution, then a variant, then
 overrides (``key=value`` strings parsed as hardened YAML, or ``{key: leaf}``
 mappings) and checks every value again.  Every error is one line naming the
-file and the field (inputs.InputError).  A run file holds the resolved settings under their dotted keys
-(:func:`attributes`, the one naming rule; figures, tables and claims read those names).  Pure Python (yaml, jsonschema): the
-workflow reads settings while it is parsed.
+file and the field (inputs.InputError).  A run file holds the resolved settings
+under their dotted keys (:func:`attributes`, the one naming rule; figures, tables
+and claims read those names).  Pure Python (yaml, jsonschema): the workflow reads
+settings while it is parsed.
 """
 
 import copy

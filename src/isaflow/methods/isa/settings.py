@@ -51,7 +51,7 @@ VALUES = {
     "solver.history": _HISTORY,
     # the stored states (driver.Recording): steps between snapshots in a single vessel and in a tank of vessels
     "solver.snapshot_every_single": _COUNT, "solver.snapshot_every_flow": _COUNT,
-    "solver.snapshot_megabytes": _in("1e6 byte", _POS),  # 10^6 bytes the kept snapshots may take before they are thinned
+    "solver.snapshot_megabytes": _in("1e6 byte", _POS),  # what the kept snapshots may take before they are thinned
     # the overdamped variant (dynamics.py): damping ratio zeta of the stiffest mode lambda_max, time step
     "solver.zeta": _in("1", _POS), "solver.lambda_max": _in("N cm-1", _POS), "solver.dt": _in("s", _OPT_POS),
 }
